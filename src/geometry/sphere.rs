@@ -1,0 +1,146 @@
+use glam::DVec3;
+
+use super::{HitRecord, Interval, Ray, Shape};
+
+/// A sphere. A negative radius keeps the same surface but flips the outward normal
+/// (`(P - C) / r`), which the course uses for hollow glass-like shells.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// The centre.
+    pub center: DVec3,
+    /// The radius; negative flips the normal.
+    pub radius: f64,
+}
+
+impl Sphere {
+    /// A sphere at `center` with `radius` (negative allowed).
+    pub const fn new(center: DVec3, radius: f64) -> Self {
+        Self { center, radius }
+    }
+
+    /// The two roots `(t_near, t_far)` of `|O + t d - C|^2 = r^2`, or `None` when the ray misses
+    /// the sphere's surface.
+    ///
+    /// Computed the robust way of *Ray Tracing Gems* ch. 7 rather than the course's naive
+    /// `half_b^2 - a c`: the discriminant as `a (r^2 - |f - (f.d / a) d|^2)` (the squared distance
+    /// of the centre from the line, which does not cancel catastrophically far from the sphere),
+    /// and the roots as `c / q` and `q / a` with `q = -(b' + sign(b') sqrt(disc))`, which avoids
+    /// the cancellation of `-b' + sqrt(disc)`.
+    #[inline]
+    pub fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
+        let d = ray.direction;
+        let f = ray.origin - self.center;
+        let a = d.dot(d);
+        let half_b = f.dot(d);
+        let r2 = self.radius * self.radius;
+        let perpendicular = f - d * (half_b / a);
+        let disc = a * (r2 - perpendicular.dot(perpendicular));
+        // `!(disc >= 0)` also rejects NaN.
+        if !(disc >= 0.0) {
+            return None;
+        }
+        let c = f.dot(f) - r2;
+        let q = -(half_b + disc.sqrt().copysign(half_b));
+        if q == 0.0 {
+            // Tangent with the origin on the tangent point's plane: a double root at -b'/a.
+            let t = -half_b / a;
+            return Some((t, t));
+        }
+        let t0 = c / q;
+        let t1 = q / a;
+        Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) })
+    }
+
+    /// The spherical surface coordinates `(u, v)` in `[0, 1]` of a point whose outward unit
+    /// normal is `n` (`u` around the y axis from -x, `v` from -y to +y), as the book defines them.
+    pub fn surface_coordinates(n: DVec3) -> (f64, f64) {
+        let theta = libm::acos(-n.y);
+        let phi = libm::atan2(-n.z, n.x) + std::f64::consts::PI;
+        (
+            phi / (2.0 * std::f64::consts::PI),
+            theta / std::f64::consts::PI,
+        )
+    }
+
+    /// The root the course takes: the near one if the interval surrounds it, else the far one.
+    #[inline]
+    fn pick_root(&self, ray: &Ray, interval: Interval) -> Option<f64> {
+        let (near, far) = self.roots(ray)?;
+        if interval.surrounds(near) {
+            Some(near)
+        } else if interval.surrounds(far) {
+            Some(far)
+        } else {
+            None
+        }
+    }
+}
+
+impl Shape for Sphere {
+    fn intersect(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
+        let t = self.pick_root(ray, interval)?;
+        let outward = (ray.at(t) - self.center) / self.radius;
+        let uv = Sphere::surface_coordinates(outward * self.radius.signum());
+        Some(HitRecord::new(ray, t, outward, uv))
+    }
+
+    #[inline]
+    fn hit_t(&self, ray: &Ray, interval: Interval) -> Option<f64> {
+        self.pick_root(ray, interval)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn head_on_hit_takes_the_near_root_and_faces_the_ray() {
+        let s = Sphere::new(DVec3::new(0.0, 0.0, -5.0), 1.0);
+        let ray = Ray::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0));
+        let hit = s.intersect(&ray, Interval::CAMERA).unwrap();
+        assert_eq!(hit.t, 4.0);
+        assert_eq!(hit.normal, DVec3::new(0.0, 0.0, 1.0));
+        assert!(hit.front_face);
+    }
+
+    #[test]
+    fn from_inside_takes_the_far_root_with_back_face() {
+        let s = Sphere::new(DVec3::ZERO, 2.0);
+        let ray = Ray::new(DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0));
+        let hit = s.intersect(&ray, Interval::CAMERA).unwrap();
+        assert_eq!(hit.t, 2.0);
+        assert!(!hit.front_face);
+        assert_eq!(hit.normal, DVec3::new(-1.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn negative_radius_flips_the_outward_normal_only() {
+        let ray = Ray::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0));
+        let pos = Sphere::new(DVec3::new(0.0, 0.0, -5.0), 1.0).intersect(&ray, Interval::CAMERA);
+        let neg = Sphere::new(DVec3::new(0.0, 0.0, -5.0), -1.0).intersect(&ray, Interval::CAMERA);
+        let (pos, neg) = (pos.unwrap(), neg.unwrap());
+        assert_eq!(pos.t, neg.t);
+        assert!(pos.front_face && !neg.front_face);
+        // The normal always faces the ray.
+        assert_eq!(pos.normal, neg.normal);
+    }
+
+    #[test]
+    fn open_interval_rejects_a_root_on_its_end() {
+        let s = Sphere::new(DVec3::new(0.0, 0.0, -5.0), 1.0);
+        let ray = Ray::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0));
+        // Near root 4 is on the end: the far root 6 is outside too.
+        assert!(s.intersect(&ray, Interval::new(0.0, 4.0)).is_none());
+        assert_eq!(s.hit_t(&ray, Interval::new(4.0, 10.0)), Some(6.0));
+    }
+
+    #[test]
+    fn miss_and_nan_are_misses() {
+        let s = Sphere::new(DVec3::new(0.0, 3.0, -5.0), 1.0);
+        let ray = Ray::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0));
+        assert!(s.intersect(&ray, Interval::CAMERA).is_none());
+        let nan = Ray::new(DVec3::ZERO, DVec3::new(f64::NAN, 0.0, -1.0));
+        assert!(s.intersect(&nan, Interval::CAMERA).is_none());
+    }
+}

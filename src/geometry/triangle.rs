@@ -1,0 +1,156 @@
+use glam::DVec3;
+
+use super::{HitRecord, Interval, Ray, Shape, unit_vector};
+
+/// A triangle `(a, b, c)` intersected watertightly (Woop, Benthin and Wald, JCGT 2013).
+///
+/// The ray is moved to the origin and sheared so that it runs along +z; the three edge functions
+/// are then 2D cross products of the transformed vertices. An edge shared by two triangles yields
+/// the exact negation of the same floating-point value in both, so a ray through the edge hits at
+/// least one of them. Edges are closed (an edge function of zero counts as inside); both faces are
+/// hit; `t` must lie in the *closed* interval, as for quads.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// The first vertex.
+    pub a: DVec3,
+    /// The second vertex.
+    pub b: DVec3,
+    /// The third vertex.
+    pub c: DVec3,
+    /// `unit((b - a) x (c - a))`.
+    pub normal: DVec3,
+}
+
+impl Triangle {
+    /// A triangle with vertices `a`, `b`, `c` (counter-clockwise seen from the normal's side).
+    pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Self {
+        Self {
+            a,
+            b,
+            c,
+            normal: unit_vector((b - a).cross(c - a)),
+        }
+    }
+
+    /// The watertight decision with `(t, beta, gamma)`, the barycentric weights of `b` and `c`.
+    #[inline]
+    fn solve(&self, ray: &Ray, interval: Interval) -> Option<(f64, f64, f64)> {
+        let d = ray.direction;
+        let ad = d.abs();
+        // The axis along which the direction is largest becomes z.
+        let kz = if ad.x > ad.y {
+            if ad.x > ad.z { 0 } else { 2 }
+        } else if ad.y > ad.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding: swap when the direction points down the z axis.
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = d[kz];
+        if dz == 0.0 || !dz.is_finite() {
+            return None;
+        }
+        let sx = d[kx] / dz;
+        let sy = d[ky] / dz;
+        let sz = 1.0 / dz;
+
+        let a = self.a - ray.origin;
+        let b = self.b - ray.origin;
+        let c = self.c - ray.origin;
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+
+        // Edge functions: U for edge bc, V for ca, W for ab.
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let negative = u < 0.0 || v < 0.0 || w < 0.0;
+        let positive = u > 0.0 || v > 0.0 || w > 0.0;
+        if (negative && positive) || u.is_nan() || v.is_nan() || w.is_nan() {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+        let t = (u * az + v * bz + w * cz) / det;
+        if !interval.contains(t) {
+            return None;
+        }
+        Some((t, v / det, w / det))
+    }
+}
+
+impl Shape for Triangle {
+    #[inline]
+    fn intersect(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
+        let (t, beta, gamma) = self.solve(ray, interval)?;
+        if !self.normal.is_finite() {
+            return None;
+        }
+        Some(HitRecord::new(ray, t, self.normal, (beta, gamma)))
+    }
+
+    #[inline]
+    fn hit_t(&self, ray: &Ray, interval: Interval) -> Option<f64> {
+        self.intersect(ray, interval).map(|h| h.t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> Triangle {
+        Triangle::new(
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, -1.0),
+            DVec3::new(0.0, 1.0, -1.0),
+        )
+    }
+
+    #[test]
+    fn interior_hit_has_barycentrics() {
+        let ray = Ray::new(DVec3::new(0.25, 0.5, 0.0), DVec3::new(0.0, 0.0, -1.0));
+        let hit = tri().intersect(&ray, Interval::CAMERA).unwrap();
+        assert_eq!(hit.t, 1.0);
+        assert_eq!(hit.uv, (0.25, 0.5));
+        assert!(hit.front_face);
+    }
+
+    #[test]
+    fn vertices_and_edges_are_closed_and_outside_misses() {
+        let down = DVec3::new(0.0, 0.0, -1.0);
+        for p in [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::new(0.5, 0.5, 0.0),
+            DVec3::new(0.5, 0.0, 0.0),
+        ] {
+            assert!(
+                tri()
+                    .intersect(&Ray::new(p, down), Interval::CAMERA)
+                    .is_some(),
+                "{p}"
+            );
+        }
+        let out = Ray::new(DVec3::new(0.6, 0.6, 0.0), down);
+        assert!(tri().intersect(&out, Interval::CAMERA).is_none());
+    }
+
+    #[test]
+    fn back_face_is_hit_with_flipped_normal() {
+        let ray = Ray::new(DVec3::new(0.25, 0.25, -2.0), DVec3::new(0.0, 0.0, 1.0));
+        let hit = tri().intersect(&ray, Interval::CAMERA).unwrap();
+        assert!(!hit.front_face);
+        assert_eq!(hit.normal, DVec3::new(0.0, 0.0, -1.0));
+    }
+}

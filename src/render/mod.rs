@@ -1,0 +1,12 @@
+//! The renderer: a seeded random stream per pixel, the course's integrator, and rows rendered in
+//! parallel into a film whose bytes do not depend on the number of threads.
+
+mod film;
+mod integrator;
+mod renderer;
+mod sampler;
+
+pub use film::{Film, encode_course_png};
+pub use integrator::{radiance, sky};
+pub use renderer::{PixelJitter, RenderError, RenderOptions, render};
+pub use sampler::PixelSampler;
