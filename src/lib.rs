@@ -1,6 +1,21 @@
-//! rtoracle: geometry core (work in progress)
+//! # rtoracle
+//!
+//! A test oracle and verification harness for ray tracers, built for the course "Ray Tracing in
+//! Entertainment Industry" (after *Ray Tracing in One Weekend*) and for any renderer that wants
+//! to be checked.
+//!
+//! A short tour:
+//! - [`geometry`]: rays, intervals, hit records and the reference primitives (sphere, quad,
+//!   watertight triangle) in `f64`, following the course's semantics.
+//! - [`scene`]: materials, the course's camera, TOML scene files and the built-in scenes.
+//! - [`render`]: the course's integrator and a renderer that gives the same bytes for a seed on
+//!   any number of threads.
+//! - [`image_io`]: PNG and OpenEXR, written atomically.
+//! - [`oracle`]: the vector format and the exact intersection oracle.
 #![warn(missing_docs)]
+
 pub mod geometry;
 pub mod image_io;
+pub mod oracle;
 pub mod render;
 pub mod scene;

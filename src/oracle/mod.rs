@@ -1,0 +1,4 @@
+//! The intersection oracle: the language-agnostic vector format (more to come: exact decisions,
+//! error bands, edge-case generators).
+
+pub mod vectors;

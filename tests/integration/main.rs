@@ -1,0 +1,4 @@
+//! One integration-test binary with a module per area (as ripgrep does).
+
+mod common;
+mod render;
