@@ -78,8 +78,15 @@ pub enum GoldenError {
 
 /// Lower-case hex SHA-256 of the scene's canonical TOML ([`SceneDescription::to_toml`]).
 pub fn scene_sha256(description: &SceneDescription) -> String {
-    let digest = Sha256::digest(description.to_toml().as_bytes());
-    digest.iter().map(|b| format!("{b:02x}")).collect()
+    sha256_hex(description.to_toml().as_bytes())
+}
+
+/// Lower-case hex SHA-256 of `bytes`.
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 /// The string attributes of a golden of `scene` rendered with `spp` samples and `seed`.
@@ -418,15 +425,19 @@ mod tests {
 
     #[test]
     fn scene_hash_is_sha256_of_the_toml() {
-        // Independent check: SHA-256 of the empty string is a published constant.
+        // Published test vectors (FIPS 180-2): "" and "abc".
         assert_eq!(
-            format!("{:x}", Sha256::digest(b"")),
+            sha256_hex(b""),
             "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
+        );
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
         );
         let d = builtin("week04-quad").unwrap();
         let h = scene_sha256(&d);
         assert_eq!(h.len(), 64);
-        assert_eq!(h, format!("{:x}", Sha256::digest(d.to_toml().as_bytes())));
+        assert_eq!(h, sha256_hex(d.to_toml().as_bytes()));
         assert_ne!(h, scene_sha256(&builtin("week04-sphere").unwrap()));
     }
 }
