@@ -314,8 +314,9 @@ pub fn compare_goldens(
     }
     const MEAN: [&str; 3] = ["R", "G", "B"];
     const VARIANCE: [&str; 3] = ["variance.R", "variance.G", "variance.B"];
-    let mut layers: Vec<(&[[f32; 3]], &[[f32; 3]], [&'static str; 3])> =
-        vec![(&expected.mean, &actual.mean, MEAN)];
+    // (expected values, actual values, channel names) per layer.
+    type LayerPair<'a> = (&'a [[f32; 3]], &'a [[f32; 3]], [&'static str; 3]);
+    let mut layers: Vec<LayerPair> = vec![(&expected.mean, &actual.mean, MEAN)];
     match (&expected.variance, &actual.variance) {
         (Some(e), Some(a)) => layers.push((e, a, VARIANCE)),
         (None, None) => {}
