@@ -190,8 +190,8 @@ pub fn embedded_golden_image(scene: &str) -> Option<ExrImage> {
 ///
 /// The reference is bit-reproducible (f64 arithmetic, libm's `tan`, a seeded stream per pixel),
 /// so a regenerated golden normally equals the committed one exactly; the tolerance only absorbs
-/// last-bit differences (a few f32 ulps) and still catches a single changed sample out of 4096
-/// anywhere with a colour step larger than about 0.01.
+/// last-bit differences (a few f32 ulps) and still catches a single sample out of 4096 changing
+/// colour by more than about 0.05.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
     /// Absolute allowance.

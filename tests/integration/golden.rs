@@ -76,6 +76,63 @@ fn assert_exr_snapshot(name: &str, bytes: Vec<u8>) {
     });
 }
 
+#[test]
+fn exr_comparator_tells_pixels_from_bytes() {
+    // Stored snapshots as insta loads them; copies with a changed pixel and a changed version.
+    let dir = tempfile::tempdir().unwrap();
+    let stored = snapshot_file("week04-sphere");
+    let meta = stored.with_extension("");
+    let image = read_exr(&stored).unwrap();
+    let film_of = |img: &ExrImage| {
+        let to = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
+            v.iter()
+                .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                .collect()
+        };
+        rtoracle::render::Film {
+            width: img.width,
+            height: img.height,
+            samples_per_pixel: 4096,
+            mean: to(&img.mean),
+            variance: img.variance.as_deref().map(to),
+        }
+    };
+    let copy = |name: &str, img: &ExrImage| {
+        let bytes = encode_exr(&film_of(img), &img.attributes, Path::new(name)).unwrap();
+        let snap = dir.path().join(format!("{name}.snap"));
+        std::fs::copy(&meta, &snap).unwrap();
+        std::fs::write(dir.path().join(format!("{name}.snap.exr")), bytes).unwrap();
+        Snapshot::from_file(&snap).unwrap()
+    };
+    let original = Snapshot::from_file(&meta).unwrap();
+    let same = copy("same", &image);
+
+    let mut tampered = image.clone();
+    tampered.variance.as_mut().unwrap()[1000][2] += 1e-3;
+    let tampered = copy("tampered", &tampered);
+
+    let mut newer = image.clone();
+    for (k, v) in &mut newer.attributes {
+        if k == ATTR_VERSION {
+            *v = "99.0.0".into();
+        }
+    }
+    let newer = copy("newer", &newer);
+
+    let c = ExrComparator;
+    assert!(c.matches(&original, &same));
+    assert!(
+        c.matches_fully(&original, &same),
+        "re-encoding gives the same bytes"
+    );
+    assert!(!c.matches(&original, &tampered));
+    assert!(
+        c.matches(&original, &newer),
+        "only the tool version differs"
+    );
+    assert!(!c.matches_fully(&original, &newer));
+}
+
 fn golden_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("golden")
 }
@@ -221,14 +278,16 @@ fn prefix_bound_is_tight_and_holds() {
 
 #[test]
 fn snapshots_are_the_golden_files() {
+    // The same test the snapshot comparator makes (the snapshot tests check fresh renders against
+    // both; this one says which pair to update when only the files were touched).
     for scene in ["week04-sphere", "week04-quad"] {
         let snap = read_exr(&snapshot_file(scene)).unwrap();
-        assert_same_pixels(
-            &committed(scene),
-            &snap,
-            &format!(
-                "golden/{scene}.exr vs its insta snapshot (update both: `rtoracle golden`, then `INSTA_UPDATE=always cargo test`)"
-            ),
+        let diff = compare_goldens(&committed(scene), &snap, &Tolerance::default());
+        assert!(
+            diff.is_match(),
+            "golden/{scene}.exr vs its insta snapshot: {}; update both: `rtoracle golden`, then \
+             `INSTA_UPDATE=always cargo test --test integration golden::`",
+            diff.summary(snap.width * snap.height)
         );
     }
 }
