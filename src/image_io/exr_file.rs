@@ -248,6 +248,7 @@ pub fn decode_exr(bytes: &[u8], name: &Path) -> Result<ExrImage, ImageError> {
             "is not an OpenEXR file (it does not start with the EXR magic number)",
         ));
     }
+    check_sizes(bytes, name)?;
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -400,6 +401,56 @@ pub fn decode_exr(bytes: &[u8], name: &Path) -> Result<ExrImage, ImageError> {
     })
 }
 
+/// The smallest limit on the decoded pixel bytes of a file (see [`check_sizes`]).
+const MIN_DECODED_LIMIT: usize = 256 << 20;
+
+/// How many times its own size a file may expand to when decoded (deflate's largest ratio is
+/// about 1032).
+const MAX_EXPANSION: usize = 2048;
+
+/// Refuses a header whose sizes the file cannot hold, before anything is allocated for them: the
+/// offset tables need 8 bytes per block, and the decoded samples may take at most
+/// `max(256 MiB, 2048 x the file's length)` bytes. A damaged size field otherwise makes the
+/// decoder try to allocate gigabytes and abort the process.
+fn check_sizes(bytes: &[u8], name: &Path) -> Result<(), ImageError> {
+    let damaged = |message: String| {
+        ImageError::format(
+            name,
+            format!("is a truncated or damaged OpenEXR file: {message}"),
+        )
+    };
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), true)
+        .map_err(|e| damaged(one_line(&e.to_string())))?;
+    let mut blocks = 0usize;
+    let mut decoded = 0usize;
+    for header in meta.headers.iter() {
+        blocks = blocks.saturating_add(header.chunk_count);
+        let size = header.layer_size;
+        decoded = decoded.saturating_add(
+            size.0
+                .saturating_mul(size.1)
+                .saturating_mul(header.channels.bytes_per_pixel.max(1)),
+        );
+    }
+    if blocks.saturating_mul(8) > bytes.len() {
+        return Err(damaged(format!(
+            "its header promises {blocks} blocks, more than its {} bytes can hold",
+            bytes.len()
+        )));
+    }
+    let limit = MIN_DECODED_LIMIT.max(bytes.len().saturating_mul(MAX_EXPANSION));
+    if decoded > limit {
+        let size = meta.headers[0].layer_size;
+        return Err(damaged(format!(
+            "its header describes {}x{} pixels ({decoded} bytes of samples), too many for a {}-byte file",
+            size.0,
+            size.1,
+            bytes.len()
+        )));
+    }
+    Ok(())
+}
+
 /// The channel called `label` of `layer`.
 fn find<'a>(
     layer: &'a Layer<AnyChannels<FlatSamples>>,
@@ -532,6 +583,21 @@ mod tests {
             let err = decode_exr(&good[..cut], p).unwrap_err().to_string();
             assert!(err.starts_with("bad.exr: "), "{cut}: {err}");
             assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+
+    #[test]
+    fn damaged_bytes_never_panic() {
+        let good = encode_exr(&film(true), &attrs(), Path::new("t.exr")).unwrap();
+        for at in 4..good.len() {
+            for value in [0u8, 1, 0x7f, 0x80, 0xff, good[at] ^ 0x10] {
+                let mut bad = good.clone();
+                bad[at] = value;
+                // Either an error or an image; never a panic or an absurd allocation.
+                if let Ok(img) = decode_exr(&bad, Path::new("t.exr")) {
+                    assert_eq!(img.mean.len(), img.width * img.height);
+                }
+            }
         }
     }
 
