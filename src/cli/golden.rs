@@ -39,7 +39,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         args.scenes.clone()
     };
     for scene in &scenes {
-        builtin(scene).with_context(|| "--scenes".to_string())?;
+        builtin(scene).context("--scenes")?;
     }
     if args.check {
         check(&args.dir, &scenes, spp)
