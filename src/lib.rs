@@ -12,9 +12,12 @@
 //!   any number of threads.
 //! - [`image_io`]: PNG and OpenEXR, written atomically.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
+//! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
+//!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
 #![warn(missing_docs)]
 
 pub mod geometry;
+pub mod grade;
 pub mod image_io;
 pub mod oracle;
 pub mod render;

@@ -1,0 +1,133 @@
+//! `feedback.md`: what failed, in plain words, for the student, with the smallest failing case
+//! ready to run and the heatmaps. Groups that are not visible only say that their result comes
+//! later.
+
+use std::fmt::Write;
+
+use crate::grade::inputs::{FailureKind, FailureSummary, ImageVerdict};
+use crate::grade::rubric::Visibility;
+use crate::grade::{CheckResult, CheckStatus, GradeReport};
+
+fn fmt_points(x: f64) -> String {
+    let s = format!("{x:.2}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// The failure a student should look at first: one that ran (not a time-out or not run when
+/// another exists), with the fewest edge-case tags, then the shortest reproduction.
+pub fn smallest_failure(failures: &[FailureSummary]) -> Option<&FailureSummary> {
+    failures.iter().filter(|f| f.definite).min_by_key(|f| {
+        (
+            matches!(f.kind, FailureKind::NotRun | FailureKind::Timeout),
+            f.tags.len(),
+            f.repro.len(),
+            f.id.clone(),
+        )
+    })
+}
+
+fn result_word(c: &CheckResult) -> &'static str {
+    match c.status {
+        CheckStatus::Passed => "passed",
+        CheckStatus::Failed => "failed",
+        CheckStatus::Error => "could not be checked",
+        CheckStatus::Skipped => "not scored",
+    }
+}
+
+/// `feedback.md` text.
+pub fn render(report: &GradeReport) -> String {
+    let mut md = String::new();
+    let _ = writeln!(md, "# Feedback for {}\n", report.submission);
+    let _ = writeln!(
+        md,
+        "**Score: {} / {}** ({} rubric)\n",
+        fmt_points(report.score),
+        fmt_points(report.max_score),
+        report.rubric
+    );
+    md.push_str("| Check | Points | Result |\n|---|---:|---|\n");
+    for c in &report.checks {
+        if c.visibility == Visibility::Visible {
+            let _ = writeln!(
+                md,
+                "| {} | {} / {} | {} |",
+                c.name,
+                fmt_points(c.score),
+                fmt_points(c.max_score),
+                result_word(c)
+            );
+        } else {
+            let _ = writeln!(md, "| {} | hidden | shown later |", c.name);
+        }
+    }
+    if let Some(fatal) = &report.code.fatal {
+        let _ = writeln!(
+            md,
+            "\n## Your code could not be run\n\nNo intersection test could run, so the code checks score 0. \
+             Python said:\n\n```\n{}\n```\n\nRun `python3 -c \"import RT_object\"` in your folder to see the same error.",
+            fatal.trim_end()
+        );
+    }
+    for c in &report.checks {
+        if c.visibility != Visibility::Visible || c.status == CheckStatus::Passed {
+            continue;
+        }
+        let _ = writeln!(
+            md,
+            "\n## {}: {} / {}\n",
+            c.name,
+            fmt_points(c.score),
+            fmt_points(c.max_score)
+        );
+        if c.image.is_none() && report.code.fatal.is_some() {
+            md.push_str("Not run: your code could not be imported (see above).\n");
+            continue;
+        }
+        let _ = writeln!(md, "{}", c.message);
+        if let Some(f) = smallest_failure(&c.failures) {
+            let _ = writeln!(
+                md,
+                "\nThe smallest failing case is `{}`{}: {}. To run it yourself, save this as \
+                 `repro.py` in your submission folder and run `python3 repro.py`:\n\n```python\n{}```",
+                f.id,
+                if f.tags.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", f.tags.join(", "))
+                },
+                f.message,
+                f.repro
+            );
+            if c.failures.len() > 1 {
+                md.push_str("\nOther failing cases:\n\n");
+                for g in c.failures.iter().filter(|g| g.id != f.id) {
+                    let _ = writeln!(md, "- `{}`: {}", g.id, g.message);
+                }
+            }
+        }
+        if let Some(img) = &c.image {
+            if let Some(h) = &img.heatmap {
+                if img.verdict != ImageVerdict::Pass {
+                    let _ = writeln!(
+                        md,
+                        "\nWhere your image differs from the reference (red):\n\n![difference heatmap for {}]({})",
+                        img.file, h
+                    );
+                }
+            }
+        }
+    }
+    let shown: Vec<&CheckResult> = report
+        .checks
+        .iter()
+        .filter(|c| c.visibility == Visibility::Visible && c.status == CheckStatus::Passed)
+        .collect();
+    if !shown.is_empty() {
+        md.push_str("\n## Passed\n\n");
+        for c in shown {
+            let _ = writeln!(md, "- {}: {}", c.name, c.message);
+        }
+    }
+    md
+}
