@@ -30,6 +30,9 @@ struct FixtureImage {
     seed: u64,
     #[serde(default)]
     width: Option<usize>,
+    /// `"course"` (default) or `"linear"` (the square root forgotten).
+    #[serde(default)]
+    encoding: Option<String>,
 }
 
 /// `tests/fixtures/submissions` of this crate.
@@ -91,7 +94,15 @@ pub fn materialize(name: &str, dest: &Path) -> Result<Vec<String>, String> {
             &Rgb8Image {
                 width: film.width,
                 height: film.height,
-                data: film.to_course_rgb8(),
+                data: match img.encoding.as_deref() {
+                    None | Some("course") => film.to_course_rgb8(),
+                    Some("linear") => film
+                        .mean
+                        .iter()
+                        .flat_map(|c| c.to_array().map(|x| (255.0 * x.clamp(0.0, 0.999)) as u8))
+                        .collect(),
+                    Some(other) => return Err(format!("{name}: unknown encoding {other:?}")),
+                },
             },
         )
         .map_err(|e| e.to_string())?;

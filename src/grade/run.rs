@@ -7,7 +7,8 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::inputs::{
-    CodeChecker, CodeOutcome, FailureSummary, GroupCounts, ImageChecker, ImageOutcome, ImageVerdict,
+    CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
+    ImageVerdict,
 };
 use super::report;
 use super::rubric::{Group, GroupKind, Rubric, Visibility, sha256_hex};
@@ -184,6 +185,19 @@ pub enum GradeError {
     Format(String),
 }
 
+/// The failure a student should look at first: one that ran (not a time-out or not run when
+/// another exists), with the fewest edge-case tags, then the shortest reproduction.
+pub fn smallest_failure(failures: &[FailureSummary]) -> Option<&FailureSummary> {
+    failures.iter().filter(|f| f.definite).min_by_key(|f| {
+        (
+            matches!(f.kind, FailureKind::NotRun | FailureKind::Timeout),
+            f.tags.len(),
+            f.repro.len(),
+            f.id.clone(),
+        )
+    })
+}
+
 /// Rounds to 1/100 of a point.
 pub fn round2(x: f64) -> f64 {
     (x * 100.0).round() / 100.0
@@ -227,20 +241,27 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
         } else {
             group.points * passed as f64 / total as f64
         };
-        let mut message = format!(
-            "{passed} of {total} {shape} test vectors answered correctly ({} wrong, {} raised an exception, {} timed out or crashed, {} not run){}.",
-            counts.failed,
-            counts.errors,
-            counts.timeouts,
-            counts.not_run,
-            if group.all_or_nothing && passed < total {
-                "; this group is all-or-nothing"
-            } else {
-                ""
+        let mut parts = Vec::new();
+        for (n, what) in [
+            (counts.failed, "wrong"),
+            (counts.errors, "raised an exception"),
+            (counts.timeouts, "timed out or crashed Python"),
+            (counts.not_run, "not run"),
+        ] {
+            if n > 0 {
+                parts.push(format!("{n} {what}"));
             }
-        );
-        if let Some(f) = failures.first() {
-            message.push_str(&format!(" First failure, {}: {}", f.id, f.message));
+        }
+        let mut message = format!("{passed} of {total} {shape} test vectors answered correctly");
+        if !parts.is_empty() {
+            message.push_str(&format!(" ({})", parts.join(", ")));
+        }
+        message.push('.');
+        if group.all_or_nothing && passed < total {
+            message.push_str(" This group is all-or-nothing.");
+        }
+        if let Some(f) = smallest_failure(&failures) {
+            message.push_str(&format!(" Smallest failing case, {}: {}.", f.id, f.message));
         }
         let status = if passed == total {
             CheckStatus::Passed
@@ -569,4 +590,281 @@ pub fn grade_to_dir(
     let report = grade(submission, rubric, code, images, out_dir)?;
     write_reports(&report, out_dir, formats)?;
     Ok(report)
+}
+
+#[cfg(test)]
+pub(crate) mod fakes {
+    //! Test doubles of the two interfaces.
+    use super::*;
+    use crate::oracle::vectors::ShapeKind;
+
+    /// Answers with fixed counts per shape (and an optional fatal error).
+    pub struct FakeCode {
+        pub counts: BTreeMap<ShapeKind, GroupCounts>,
+        pub fatal: Option<String>,
+        pub panic_on: Option<String>,
+    }
+
+    impl FakeCode {
+        pub fn new(sphere: GroupCounts, quad: GroupCounts) -> Self {
+            FakeCode {
+                counts: [(ShapeKind::Sphere, sphere), (ShapeKind::Quad, quad)].into(),
+                fatal: None,
+                panic_on: None,
+            }
+        }
+    }
+
+    /// `total` definite vectors of which `passed` passed and the rest failed as `kind`.
+    pub fn counts(total: usize, passed: usize) -> GroupCounts {
+        GroupCounts {
+            definite_total: total,
+            passed,
+            failed: total - passed,
+            ..Default::default()
+        }
+    }
+
+    impl CodeChecker for FakeCode {
+        fn check(&self, submission: &Path, groups: &[ShapeKind]) -> CodeOutcome {
+            if let Some(name) = &self.panic_on {
+                if submission.ends_with(name) {
+                    panic!("fake checker told to panic on {name}");
+                }
+            }
+            CodeOutcome {
+                per_group: groups
+                    .iter()
+                    .map(|g| (*g, self.counts.get(g).cloned().unwrap_or_default()))
+                    .collect(),
+                failures: vec![],
+                fatal: self.fatal.clone(),
+                stderr_tail: String::new(),
+                sandbox: serde_json::Value::Null,
+            }
+        }
+        fn describe(&self) -> String {
+            "fake".into()
+        }
+        fn vectors_sha256(&self) -> String {
+            "v".into()
+        }
+    }
+
+    /// Gives a fixed verdict per scene.
+    pub struct FakeImage(pub BTreeMap<String, ImageVerdict>);
+
+    impl ImageChecker for FakeImage {
+        fn check(&self, _: &Path, scene: &str, _: &Path) -> ImageOutcome {
+            ImageOutcome {
+                verdict: self.0.get(scene).cloned().unwrap_or(ImageVerdict::Pass),
+                metrics: serde_json::json!({}),
+                diagnosis: None,
+                heatmap: None,
+            }
+        }
+        fn describe(&self) -> String {
+            "fake".into()
+        }
+        fn golden_sha256(&self, scene: &str) -> String {
+            format!("golden-{scene}")
+        }
+    }
+
+    pub fn all_pass() -> FakeImage {
+        FakeImage(BTreeMap::new())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fakes::*;
+    use super::*;
+
+    fn run(rubric: &Rubric, code: &FakeCode, images: &FakeImage) -> GradeReport {
+        let sub = tempfile::tempdir().unwrap();
+        std::fs::write(sub.path().join("RT_object.py"), "x = 1\n").unwrap();
+        let out = tempfile::tempdir().unwrap();
+        grade(sub.path(), rubric, code, images, out.path()).unwrap()
+    }
+
+    fn score(r: &GradeReport, id: &str) -> f64 {
+        r.checks.iter().find(|c| c.id == id).unwrap().score
+    }
+
+    #[test]
+    fn points_are_proportional_to_definite_vectors_passed_and_ids_start_with_the_group() {
+        let r = run(
+            &Rubric::week04(),
+            &FakeCode::new(counts(4, 3), counts(3, 1)),
+            &all_pass(),
+        );
+        assert_eq!(score(&r, "sphere.intersect"), 22.5); // 30 * 3/4
+        assert_eq!(score(&r, "quad.intersect"), 10.0); // 30 * 1/3
+        assert_eq!(r.score, 22.5 + 10.0 + 40.0);
+        assert_eq!(r.max_score, 100.0);
+        for c in &r.checks {
+            assert!(c.id.starts_with(&c.group), "{}", c.id);
+        }
+        assert_eq!(
+            r.reproducibility.goldens_sha256["week04-quad"],
+            "golden-week04-quad"
+        );
+        assert_eq!(
+            r.reproducibility.submission_sha256["RT_object.py"],
+            sha256_hex(b"x = 1\n")
+        );
+    }
+
+    #[test]
+    fn errors_timeouts_and_not_run_never_earn_points() {
+        let sphere = GroupCounts {
+            definite_total: 4,
+            passed: 1,
+            errors: 1,
+            timeouts: 1,
+            not_run: 1,
+            ..Default::default()
+        };
+        let r = run(
+            &Rubric::week04(),
+            &FakeCode::new(sphere, counts(2, 2)),
+            &all_pass(),
+        );
+        assert_eq!(score(&r, "sphere.intersect"), 7.5);
+        let c = &r.checks[0];
+        assert_eq!(c.status, CheckStatus::Failed);
+        assert!(c.message.contains("1 of 4 sphere test vectors answered correctly (1 raised an exception, 1 timed out or crashed Python, 1 not run)."), "{}", c.message);
+    }
+
+    #[test]
+    fn all_or_nothing_ambiguous_scoring_and_visibility_follow_the_rubric() {
+        let text = crate::grade::rubric::WEEK04_RUBRIC
+            .replacen(
+                "points = 30\nvisibility = \"visible\"",
+                "points = 30\nall_or_nothing = true\nvisibility = \"after_due_date\"",
+                1,
+            )
+            .replacen(
+                "shape = \"quad\"\npoints = 30",
+                "shape = \"quad\"\npoints = 30\nscore_ambiguous = true",
+                1,
+            );
+        let rubric = Rubric::from_toml(&text, "t.toml").unwrap();
+        let mut quad = counts(2, 2);
+        quad.ambiguous = 2;
+        quad.ambiguous_passed = 1;
+        let mut sphere = counts(4, 3);
+        sphere.ambiguous = 5;
+        let r = run(&rubric, &FakeCode::new(sphere, quad), &all_pass());
+        assert_eq!(score(&r, "sphere.intersect"), 0.0); // 3 of 4, all-or-nothing
+        assert_eq!(r.checks[0].visibility, Visibility::AfterDueDate);
+        // Ambiguous sphere vectors: reported as a separate, unscored check.
+        let amb = r
+            .checks
+            .iter()
+            .find(|c| c.id == "sphere.ambiguous")
+            .unwrap();
+        assert_eq!(
+            (amb.score, amb.max_score, amb.status),
+            (0.0, 0.0, CheckStatus::Skipped)
+        );
+        // Quad scores ambiguous vectors: (2 + 1) of (2 + 2).
+        assert_eq!(score(&r, "quad.intersect"), 22.5);
+        assert!(r.checks.iter().all(|c| c.id != "quad.ambiguous"));
+    }
+
+    #[test]
+    fn an_import_error_zeroes_the_code_groups_only_and_unusable_images_score_zero() {
+        let mut code = FakeCode::new(counts(2, 2), counts(2, 2));
+        code.fatal = Some("SyntaxError: expected ':'".into());
+        let images = FakeImage(
+            [(
+                "week04-quad".to_string(),
+                ImageVerdict::Unusable("week04_quad.png is missing".into()),
+            )]
+            .into(),
+        );
+        let r = run(&Rubric::week04(), &code, &images);
+        assert_eq!(score(&r, "sphere.intersect"), 0.0);
+        assert_eq!(score(&r, "quad.intersect"), 0.0);
+        assert_eq!(score(&r, "image.week04-sphere"), 20.0);
+        assert_eq!(score(&r, "image.week04-quad"), 0.0);
+        assert_eq!(r.score, 20.0);
+        assert!(r.checks[0].message.contains("SyntaxError"));
+        let quad_image = &r.checks[3];
+        assert_eq!(quad_image.status, CheckStatus::Error);
+        assert!(
+            quad_image.message.contains("week04_quad.png is missing"),
+            "{}",
+            quad_image.message
+        );
+    }
+
+    #[test]
+    fn a_missing_folder_is_the_only_error_and_formats_parse() {
+        let out = tempfile::tempdir().unwrap();
+        let e = grade(
+            Path::new("/no/such/dir"),
+            &Rubric::week04(),
+            &FakeCode::new(counts(1, 1), counts(1, 1)),
+            &all_pass(),
+            out.path(),
+        )
+        .unwrap_err();
+        assert_eq!(e.to_string(), "/no/such/dir: no such submission folder");
+        assert_eq!(Format::parse_list("all").unwrap(), Format::ALL);
+        assert_eq!(
+            Format::parse_list("markdown,json").unwrap(),
+            [Format::Json, Format::Markdown]
+        );
+        assert!(Format::parse_list("json,pdf").is_err());
+    }
+
+    #[test]
+    fn a_panicking_submission_does_not_stop_the_batch() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["a", "b", "c"] {
+            std::fs::create_dir(dir.path().join(name)).unwrap();
+        }
+        let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
+        code.panic_on = Some("b".into());
+        let out = dir.path().join("out");
+        let entries = crate::grade::batch::grade_batch(
+            dir.path(),
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        // The output folder inside the batch folder is not taken for a submission.
+        assert_eq!(
+            entries.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(),
+            ["a", "b", "c"]
+        );
+        assert!(entries[1].result.is_err());
+        let csv = std::fs::read_to_string(out.join("gradebook.csv")).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(
+            lines,
+            [
+                "submission,score,max_score,sphere,quad,image.week04-sphere,image.week04-quad,status",
+                "a,85,100,15,30,20,20,ok",
+                "b,,100,,,,,error: the grader panicked on this submission",
+                "c,85,100,15,30,20,20,ok",
+            ]
+        );
+        assert!(out.join("a/report.json").is_file() && out.join("c/report.json").is_file());
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        assert!(
+            summary.contains("3 submissions, 2 graded, 1 could not be graded"),
+            "{summary}"
+        );
+        assert!(
+            summary.contains("| `sphere.intersect` Sphere intersection | 2 |"),
+            "{summary}"
+        );
+    }
 }

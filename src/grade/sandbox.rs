@@ -324,17 +324,35 @@ mod tests {
         let sandbox = Sandbox::new(SandboxPolicy::default(), &[]).unwrap();
         let mut child = sandbox
             .command(Path::new("/bin/sh"))
-            .args(["-c", "sleep 30 & sleep 30"])
+            .args(["-c", "sleep 30 & echo $! > grandchild; wait"])
             .spawn()
             .unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(100));
+        let pid_file = sandbox.dir().join("grandchild");
+        let mut waited = 0;
+        while !pid_file.exists() && waited < 100 {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+            waited += 1;
+        }
+        let grandchild: u32 = std::fs::read_to_string(&pid_file)
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap();
         let facts = sandbox.facts(Some(&child));
-        let pgid = child.id() as libc::pid_t;
         kill_group(&mut child);
-        std::thread::sleep(std::time::Duration::from_millis(50));
-        // SAFETY: signal 0 only checks whether the group still exists.
-        let alive = unsafe { libc::kill(-pgid, 0) } == 0;
-        assert!(!alive, "the process group survived");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        // Gone, or a zombie waiting for init to reap it: either way, not running.
+        let state = std::fs::read_to_string(format!("/proc/{grandchild}/stat"))
+            .ok()
+            .and_then(|s| {
+                s.rsplit(')')
+                    .next()
+                    .map(|r| r.trim().chars().next().unwrap_or('?'))
+            });
+        assert!(
+            matches!(state, None | Some('Z') | Some('X')),
+            "grandchild state {state:?}"
+        );
         // SAFETY: geteuid has no preconditions.
         if unsafe { libc::geteuid() } == 0 {
             assert_eq!(facts.network_isolated, Some(true));

@@ -9,7 +9,7 @@ use crate::grade::{CheckStatus, GradeReport};
 /// One test's output text (Markdown): the message, then the first failure's reproduction.
 fn test_output(check: &crate::grade::CheckResult) -> String {
     let mut out = check.message.clone();
-    if let Some(f) = check.failures.iter().find(|f| f.definite) {
+    if let Some(f) = crate::grade::smallest_failure(&check.failures) {
         out.push_str(&format!(
             "\n\nSmallest failing case to run yourself:\n\n```python\n{}```",
             f.repro

@@ -4,26 +4,13 @@
 
 use std::fmt::Write;
 
-use crate::grade::inputs::{FailureKind, FailureSummary, ImageVerdict};
+use crate::grade::inputs::ImageVerdict;
 use crate::grade::rubric::Visibility;
-use crate::grade::{CheckResult, CheckStatus, GradeReport};
+use crate::grade::{CheckResult, CheckStatus, GradeReport, smallest_failure};
 
 fn fmt_points(x: f64) -> String {
     let s = format!("{x:.2}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
-
-/// The failure a student should look at first: one that ran (not a time-out or not run when
-/// another exists), with the fewest edge-case tags, then the shortest reproduction.
-pub fn smallest_failure(failures: &[FailureSummary]) -> Option<&FailureSummary> {
-    failures.iter().filter(|f| f.definite).min_by_key(|f| {
-        (
-            matches!(f.kind, FailureKind::NotRun | FailureKind::Timeout),
-            f.tags.len(),
-            f.repro.len(),
-            f.id.clone(),
-        )
-    })
 }
 
 fn result_word(c: &CheckResult) -> &'static str {

@@ -273,8 +273,13 @@ fn as_vec3(v: &Value) -> Option<[f64; 3]> {
     Some([as_f64(&a[0])?, as_f64(&a[1])?, as_f64(&a[2])?])
 }
 
-/// Judges one answer: `Ok(true)` right, `Ok(false)` a definite answer expected but not given is
-/// impossible here; `Err((kind, message))` when it is wrong.
+/// `|a - b| <= tol`, false when either is NaN.
+fn within(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol
+}
+
+/// Judges one answer: `Ok(())` when it is right (or anything goes), `Err((kind, message))` when
+/// it is wrong.
 fn judge(case: &Case, answer: &Value) -> Result<(), (FailureKind, String)> {
     if let Some(err) = answer.get("error") {
         let ty = err
@@ -321,7 +326,7 @@ fn judge(case: &Case, answer: &Value) -> Result<(), (FailureKind, String)> {
     };
     if let Some(te) = e.t {
         let tol = e.t_tol.unwrap_or(1e-9 * te.abs().max(1.0));
-        if !((t - te).abs() <= tol) {
+        if !within(t, te, tol) {
             return Err((
                 FailureKind::Mismatch,
                 format!("t = {}, expected {} (tolerance {})", py(t), py(te), py(tol)),
@@ -329,7 +334,7 @@ fn judge(case: &Case, answer: &Value) -> Result<(), (FailureKind, String)> {
         }
     }
     if let Some(ne) = e.normal {
-        if (0..3).any(|k| !((normal[k] - ne[k]).abs() <= 1e-6)) {
+        if (0..3).any(|k| !within(normal[k], ne[k], 1e-6)) {
             return Err((
                 FailureKind::Mismatch,
                 format!(
