@@ -135,7 +135,7 @@ pub fn build_package(
         zip.write_all(bytes).map_err(|e| write_err(&e))?;
     }
     let cursor = zip.finish().map_err(|e| write_err(&e))?;
-    crate::image_io::write_atomically(out_zip, &cursor.into_inner()).map_err(|e| write_err(&e))
+    super::run::write_public(out_zip, &cursor.into_inner()).map_err(|e| write_err(&e))
 }
 
 #[cfg(test)]

@@ -93,7 +93,7 @@ pub fn grade_batch(
     bar.finish_and_clear();
     let write = |file: &str, text: String| {
         let path = out.join(file);
-        crate::image_io::write_atomically(&path, text.as_bytes()).map_err(|e| GradeError::Output {
+        super::run::write_public(&path, text.as_bytes()).map_err(|e| GradeError::Output {
             path,
             message: e.to_string(),
         })
@@ -195,7 +195,12 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
             } else {
                 format!("{}-{}%", i * 10, i * 10 + 10)
             };
-            let _ = writeln!(md, "| {label} | {count} {} |", "#".repeat(*count));
+            let bar = if *count > 0 {
+                format!(" {}", "#".repeat(*count))
+            } else {
+                String::new()
+            };
+            let _ = writeln!(md, "| {label} | {count}{bar} |");
         }
         // Checks that lost points, and the vectors failed most often.
         let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();

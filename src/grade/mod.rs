@@ -38,6 +38,7 @@ pub use inputs::{
 pub use rubric::{Group, GroupKind, Rubric, RubricError, Visibility};
 pub use run::{
     CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, Format, GradeError, GradeReport,
-    ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_reports,
+    ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,
+    write_reports,
 };
 pub use standin::{StandinCodeChecker, StandinImageChecker};

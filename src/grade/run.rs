@@ -49,7 +49,9 @@ pub struct ImageResult {
     pub file: String,
     /// The built-in scene it must show.
     pub scene: String,
-    /// What the comparison said.
+    /// What the comparison said: `"verdict": "pass" | "fail" | "unusable"`, with `"reason"` for
+    /// unusable input.
+    #[serde(flatten)]
     pub verdict: ImageVerdict,
     /// The comparison's figures.
     pub metrics: serde_json::Value,
@@ -348,6 +350,10 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
             format!("{file} could not be compared and scores 0: {why}."),
         ),
     };
+    if let Some(p) = &outcome.heatmap {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = std::fs::set_permissions(p, std::fs::Permissions::from_mode(0o644));
+    }
     let heatmap = outcome.heatmap.as_ref().map(|p| {
         p.strip_prefix(out_dir)
             .unwrap_or(p)
@@ -547,6 +553,15 @@ impl Format {
     }
 }
 
+/// Writes `bytes` to `path` atomically, readable by everyone (`0644`: reports are read by other
+/// users, such as a web server or Gradescope's harness).
+pub fn write_public(path: &Path, bytes: &[u8]) -> Result<(), crate::image_io::ImageError> {
+    use std::os::unix::fs::PermissionsExt;
+    crate::image_io::write_atomically(path, bytes)?;
+    let _ = std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o644));
+    Ok(())
+}
+
 /// Writes `report` in each of `formats` into `out_dir` (each file atomically).
 pub fn write_reports(
     report: &GradeReport,
@@ -561,11 +576,9 @@ pub fn write_reports(
             Format::Markdown => report::markdown::render(report),
         };
         let path = out_dir.join(f.file_name());
-        crate::image_io::write_atomically(&path, text.as_bytes()).map_err(|e| {
-            GradeError::Output {
-                path: path.clone(),
-                message: e.to_string(),
-            }
+        write_public(&path, text.as_bytes()).map_err(|e| GradeError::Output {
+            path: path.clone(),
+            message: e.to_string(),
         })?;
     }
     Ok(())

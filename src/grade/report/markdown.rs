@@ -75,15 +75,14 @@ pub fn render(report: &GradeReport) -> String {
         if let Some(f) = smallest_failure(&c.failures) {
             let _ = writeln!(
                 md,
-                "\nThe smallest failing case is `{}`{}: {}. To run it yourself, save this as \
-                 `repro.py` in your submission folder and run `python3 repro.py`:\n\n```python\n{}```",
+                "\nTo run the smallest failing case, `{}`{}, yourself: save this as `repro.py` in \
+                 your submission folder and run `python3 repro.py`.\n\n```python\n{}```",
                 f.id,
                 if f.tags.is_empty() {
                     String::new()
                 } else {
                     format!(" ({})", f.tags.join(", "))
                 },
-                f.message,
                 f.repro
             );
             if c.failures.len() > 1 {
@@ -117,4 +116,38 @@ pub fn render(report: &GradeReport) -> String {
         }
     }
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::grade::run::fakes::{FakeCode, all_pass, counts};
+    use crate::grade::{Rubric, grade, rubric::WEEK04_RUBRIC};
+
+    #[test]
+    fn hidden_groups_keep_their_details_out_of_the_feedback_but_not_out_of_results_json() {
+        let text = WEEK04_RUBRIC.replacen(
+            "points = 30\nvisibility = \"visible\"",
+            "points = 30\nvisibility = \"hidden\"",
+            1,
+        );
+        let rubric = Rubric::from_toml(&text, "hidden.toml").unwrap();
+        let sub = tempfile::tempdir().unwrap();
+        let out = tempfile::tempdir().unwrap();
+        let code = FakeCode::new(counts(2, 1), counts(2, 1));
+        let report = grade(sub.path(), &rubric, &code, &all_pass(), out.path()).unwrap();
+        let md = super::render(&report);
+        assert!(
+            md.contains("| Sphere intersection | hidden | shown later |"),
+            "{md}"
+        );
+        assert!(!md.contains("## Sphere intersection"), "{md}");
+        assert!(
+            md.contains("## Quad constructor and intersection: 15 / 30"),
+            "{md}"
+        );
+        let gs = crate::grade::report::gradescope::value(&report);
+        assert_eq!(gs["tests"][0]["visibility"], "hidden");
+        assert_eq!(gs["tests"][1]["visibility"], "visible");
+        assert_eq!(gs["score"], 15.0 + 15.0 + 40.0);
+    }
 }
