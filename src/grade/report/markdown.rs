@@ -4,7 +4,6 @@
 
 use std::fmt::Write;
 
-use crate::grade::inputs::ImageVerdict;
 use crate::grade::rubric::Visibility;
 use crate::grade::{CheckResult, CheckStatus, GradeReport, smallest_failure};
 
@@ -93,14 +92,12 @@ pub fn render(report: &GradeReport) -> String {
             }
         }
         if let Some(img) = &c.image {
-            if let Some(h) = &img.heatmap {
-                if img.verdict != ImageVerdict::Pass {
-                    let _ = writeln!(
-                        md,
-                        "\nWhere your image differs from the reference (red):\n\n![difference heatmap for {}]({})",
-                        img.file, h
-                    );
-                }
+            if img.heatmap.is_some() {
+                let _ = writeln!(
+                    md,
+                    "\nRed in the heatmap of {} below marks where it differs from the reference.",
+                    img.file
+                );
             }
         }
     }
@@ -113,6 +110,19 @@ pub fn render(report: &GradeReport) -> String {
         md.push_str("\n## Passed\n\n");
         for c in shown {
             let _ = writeln!(md, "- {}: {}", c.name, c.message);
+        }
+    }
+    let heatmaps: Vec<(&str, &str)> = report
+        .checks
+        .iter()
+        .filter(|c| c.visibility == Visibility::Visible)
+        .filter_map(|c| c.image.as_ref())
+        .filter_map(|i| i.heatmap.as_deref().map(|h| (i.file.as_str(), h)))
+        .collect();
+    if !heatmaps.is_empty() {
+        md.push_str("\n## Heatmaps\n\nYour images against the reference: grey where they agree, red where a pixel differs by more than the noise allows.\n");
+        for (file, h) in heatmaps {
+            let _ = writeln!(md, "\n![{file} against the reference]({h})");
         }
     }
     md
