@@ -676,4 +676,49 @@ mod tests {
         );
         assert!(r.contains("# expected: a hit at t = 4.0"), "{r}");
     }
+
+    fn honest() -> PathBuf {
+        crate::grade::bench::fixtures_dir().join("honest")
+    }
+
+    #[test]
+    fn the_honest_fixture_passes_every_vector_in_the_sandbox() {
+        let out =
+            StandinCodeChecker::default().check(&honest(), &[ShapeKind::Sphere, ShapeKind::Quad]);
+        assert_eq!(out.fatal, None, "{}", out.stderr_tail);
+        let suite = default_suite(0);
+        for kind in [ShapeKind::Sphere, ShapeKind::Quad] {
+            let n = suite
+                .iter()
+                .filter(|c| c.shape.kind() == kind && c.expect.class.is_definite())
+                .count();
+            let c = &out.per_group[&kind];
+            assert_eq!((c.definite_total, c.passed), (n, n), "{kind}");
+        }
+        assert!(out.failures.is_empty(), "{:?}", out.failures);
+        // SAFETY: geteuid has no preconditions.
+        if unsafe { libc::geteuid() } == 0 && out.sandbox["note"].is_null() {
+            assert_eq!(out.sandbox["uid"], 65534, "{}", out.sandbox);
+        }
+    }
+
+    #[test]
+    fn an_interpreter_the_drop_user_cannot_run_falls_back_and_says_so() {
+        // Python under /root (mode 0700) cannot be run by `nobody`.
+        let private = Path::new("/root/.pyenv/versions/3.11.7/bin/python3");
+        // SAFETY: geteuid has no preconditions.
+        if unsafe { libc::geteuid() } != 0 || !private.exists() {
+            eprintln!("skipped: needs root and a Python under /root");
+            return;
+        }
+        let checker = StandinCodeChecker {
+            python: Some(private.to_path_buf()),
+            ..Default::default()
+        };
+        let out = checker.check(&honest(), &[ShapeKind::Sphere]);
+        assert_eq!(out.fatal, None);
+        assert_eq!(out.per_group[&ShapeKind::Sphere].passed, 2);
+        let note = out.sandbox["note"].as_str().unwrap_or("");
+        assert!(note.contains("cannot run"), "{}", out.sandbox);
+    }
 }

@@ -250,6 +250,14 @@ mod tests {
             ),
             v => panic!("{v:?}"),
         }
+        let junk = dir.path().join("junk.png");
+        std::fs::write(&junk, b"not a png").unwrap();
+        match checker.check(&junk, "week04-quad", &heat).verdict {
+            ImageVerdict::Unusable(m) => {
+                assert!(m.starts_with("junk.png: not a readable PNG"), "{m}")
+            }
+            v => panic!("{v:?}"),
+        }
         let o = checker.check(&dir.path().join("nope.png"), "week04-quad", &heat);
         assert_eq!(
             o.verdict,
