@@ -45,7 +45,7 @@ fn batch() -> &'static Batch {
                 "--out",
                 "out",
                 "--case-timeout-ms",
-                "500",
+                "1000",
             ],
         );
         Batch {
