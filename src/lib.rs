@@ -14,10 +14,13 @@
 //! - [`golden`]: the golden EXRs of the built-in scenes (mean and per-sample variance at 4096 spp),
 //!   embedded in the library, and their pixel comparison.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
+//! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
+//!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
 #![warn(missing_docs)]
 
 pub mod geometry;
 pub mod golden;
+pub mod grade;
 pub mod image_io;
 pub mod oracle;
 pub mod render;
