@@ -12,8 +12,11 @@
 //!   any number of threads.
 //! - [`image_io`]: PNG and OpenEXR, written atomically.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
+//! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
+//!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
 #![warn(missing_docs)]
 
+pub mod candidate;
 pub mod geometry;
 pub mod image_io;
 pub mod oracle;
