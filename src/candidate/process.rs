@@ -82,7 +82,7 @@ impl Default for RunOptions {
             timeout: Duration::from_secs(2),
             hello_timeout: Duration::from_secs(10),
             max_timeouts_per_group: 3,
-            max_crashes_per_group: 10,
+            max_crashes_per_group: 50,
             limits: Limits::default(),
         }
     }

@@ -6,6 +6,7 @@ use std::time::Duration;
 use anyhow::Context;
 use rtoracle::candidate::fuzz::{FuzzOptions, fuzz};
 use rtoracle::candidate::{RunOptions, Session};
+use rtoracle::oracle::vectors::ShapeKind;
 
 /// `rtoracle fuzz`.
 #[derive(Debug, clap::Args)]
@@ -46,7 +47,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(e) = &session.hello().error {
         eprintln!("rtoracle: the submission cannot be imported: {e}");
     }
+    let kinds: Vec<ShapeKind> = ShapeKind::ALL
+        .into_iter()
+        .filter(|&k| session.hello().supports(k))
+        .collect();
+    if kinds.is_empty() {
+        anyhow::bail!("the candidate supports none of sphere, quad, triangle");
+    }
     let fuzz_options = FuzzOptions {
+        kinds,
         cases: args.cases,
         seed: args.seed,
         time,
