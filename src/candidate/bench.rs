@@ -90,10 +90,16 @@ pub fn run() -> Result<String, HarnessError> {
 
     let rows = [
         ("in-process Rust reference (baseline)", d_ref),
-        ("Python echo adapter, answers miss (protocol ceiling)", d_echo),
+        (
+            "Python echo adapter, answers miss (protocol ceiling)",
+            d_echo,
+        ),
         ("course adapter + honest Python submission", d_py),
     ];
-    out.push_str(&format!("{:<56} {:>10} {:>14}\n", "candidate", "seconds", "vectors/s"));
+    out.push_str(&format!(
+        "{:<56} {:>10} {:>14}\n",
+        "candidate", "seconds", "vectors/s"
+    ));
     for (name, d) in rows {
         out.push_str(&format!(
             "{:<56} {:>10.3} {:>14.0}\n",

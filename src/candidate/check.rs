@@ -124,7 +124,8 @@ pub fn judge_answer(case: &Case, answer: &super::protocol::Answer) -> Verdict {
             if let Some(te) = expect.t {
                 let tol = expect.t_tol.unwrap_or(1e-9 * te.abs().max(1.0));
                 // Written so that a NaN t fails.
-                if !((t - te).abs() <= tol) {
+                let close = (t - te).abs() <= tol;
+                if !close {
                     return fail(
                         FailureKind::Mismatch,
                         format!("t = {t:?}, expected {te:?} (tolerance {tol:.3e})"),
@@ -135,12 +136,11 @@ pub fn judge_answer(case: &Case, answer: &super::protocol::Answer) -> Verdict {
                 let off = (0..3)
                     .map(|k| (n[k] - ne[k]).abs())
                     .fold(0.0f64, |a, b| if b.is_nan() { f64::NAN } else { a.max(b) });
-                if !(off <= NORMAL_TOL) {
+                let close = off <= NORMAL_TOL;
+                if !close {
                     return fail(
                         FailureKind::Mismatch,
-                        format!(
-                            "normal = {n:?}, expected {ne:?} (the unit normal facing the ray)"
-                        ),
+                        format!("normal = {n:?}, expected {ne:?} (the unit normal facing the ray)"),
                     );
                 }
             }
@@ -177,7 +177,13 @@ mod tests {
         a.t = Some(4.0 + 3e-9);
         assert_eq!(judge_answer(&case, &a), Verdict::Pass);
         a.t = Some(4.0 + 5e-9);
-        assert!(matches!(judge_answer(&case, &a), Verdict::Fail { kind: FailureKind::Mismatch, .. }));
+        assert!(matches!(
+            judge_answer(&case, &a),
+            Verdict::Fail {
+                kind: FailureKind::Mismatch,
+                ..
+            }
+        ));
         a.t = Some(f64::NAN);
         assert!(matches!(judge_answer(&case, &a), Verdict::Fail { .. }));
         let mut a = good.clone();
@@ -190,17 +196,26 @@ mod tests {
         assert!(matches!(judge_answer(&case, &a), Verdict::Fail { .. }));
         assert!(matches!(
             judge_answer(&case, &Answer::miss()),
-            Verdict::Fail { kind: FailureKind::Mismatch, .. }
+            Verdict::Fail {
+                kind: FailureKind::Mismatch,
+                ..
+            }
         ));
         assert!(matches!(
             judge_answer(&case, &Answer::error("ZeroDivisionError", "x")),
-            Verdict::Fail { kind: FailureKind::Error, .. }
+            Verdict::Fail {
+                kind: FailureKind::Error,
+                ..
+            }
         ));
         let mut a = good.clone();
         a.normal = None;
         assert!(matches!(
             judge_answer(&case, &a),
-            Verdict::Fail { kind: FailureKind::Protocol, .. }
+            Verdict::Fail {
+                kind: FailureKind::Protocol,
+                ..
+            }
         ));
     }
 
@@ -212,14 +227,26 @@ mod tests {
             answer: good.clone(),
             junk: vec!["debug".into()],
         };
-        assert!(matches!(judge(&case, &junk), Verdict::Fail { kind: FailureKind::Protocol, .. }));
+        assert!(matches!(
+            judge(&case, &junk),
+            Verdict::Fail {
+                kind: FailureKind::Protocol,
+                ..
+            }
+        ));
         assert!(matches!(
             judge(&case, &Outcome::Timeout { junk: vec![] }),
-            Verdict::Fail { kind: FailureKind::Timeout, .. }
+            Verdict::Fail {
+                kind: FailureKind::Timeout,
+                ..
+            }
         ));
         let mut amb = case.clone();
         amb.expect.class = Class::Ambiguous;
-        assert_eq!(judge(&amb, &Outcome::Timeout { junk: vec![] }), Verdict::NotScored);
+        assert_eq!(
+            judge(&amb, &Outcome::Timeout { junk: vec![] }),
+            Verdict::NotScored
+        );
         let mut miss = case.clone();
         miss.expect.class = Class::Miss;
         assert_eq!(judge_answer(&miss, &Answer::miss()), Verdict::Pass);

@@ -12,6 +12,9 @@ use super::process::{HarnessError, Outcome};
 use super::report::python_repro;
 use crate::oracle::vectors::{Case, ShapeKind};
 
+/// A candidate as the fuzzer sees it: a batch of cases in, one outcome per case out.
+pub type RunBatch<'a> = dyn FnMut(&[Case]) -> Result<Vec<Outcome>, HarnessError> + 'a;
+
 /// What a fuzz run does.
 #[derive(Clone, Debug)]
 pub struct FuzzOptions {
@@ -94,7 +97,7 @@ impl FuzzReport {
 
 /// Runs the fuzzer with `run` as the candidate (a batch of cases in, one outcome per case out).
 pub fn fuzz(
-    run: &mut dyn FnMut(&[Case]) -> Result<Vec<Outcome>, HarnessError>,
+    run: &mut RunBatch<'_>,
     options: &FuzzOptions,
 ) -> Result<FuzzReport, HarnessError> {
     let start = Instant::now();
@@ -132,8 +135,8 @@ pub fn fuzz(
     }
     for (case, kind) in found {
         // Timeouts and deaths cost a restart per try: keep them as found.
-        let keep = kind == FailureKind::Timeout
-            || (kind == FailureKind::Error && !is_raised(&case, run));
+        let keep =
+            kind == FailureKind::Timeout || (kind == FailureKind::Error && !is_raised(&case, run));
         let minimal = if keep {
             case.clone()
         } else {
@@ -173,7 +176,7 @@ pub fn fuzz(
 /// Whether an `error` failure is a raised error (cheap to shrink) rather than a dead process.
 fn is_raised(
     case: &Case,
-    run: &mut dyn FnMut(&[Case]) -> Result<Vec<Outcome>, HarnessError>,
+    run: &mut RunBatch<'_>,
 ) -> bool {
     matches!(
         run(std::slice::from_ref(case)).ok().as_deref(),

@@ -22,11 +22,12 @@ const MARGIN: f64 = 1e-7;
 /// module docs.
 pub fn oracle_expect(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Option<Expect> {
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if !finite(&shape.numbers())
-        || !finite(&ray.origin)
-        || !finite(&ray.direction)
-        || !(interval[0].is_finite() && interval[1].is_finite() && interval[0] < interval[1])
-    {
+    let usable = finite(&shape.numbers())
+        && finite(&ray.origin)
+        && finite(&ray.direction)
+        && finite(&interval)
+        && interval[0] < interval[1];
+    if !usable {
         return None;
     }
     let d = glam::DVec3::from(ray.direction);
@@ -58,7 +59,11 @@ pub fn oracle_expect(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Op
             }
         }
         ShapeSpec::Triangle { a, b, c } => {
-            let (a, b, c) = (glam::DVec3::from(a), glam::DVec3::from(b), glam::DVec3::from(c));
+            let (a, b, c) = (
+                glam::DVec3::from(a),
+                glam::DVec3::from(b),
+                glam::DVec3::from(c),
+            );
             let n = (b - a).cross(c - a);
             if n.length() == 0.0 {
                 return None;
@@ -189,7 +194,11 @@ impl CaseGen {
 
     fn nonzero_int_vec(&mut self, m: i64) -> [f64; 3] {
         loop {
-            let v = [self.int(-m, m) as f64, self.int(-m, m) as f64, self.int(-m, m) as f64];
+            let v = [
+                self.int(-m, m) as f64,
+                self.int(-m, m) as f64,
+                self.int(-m, m) as f64,
+            ];
             if v != [0.0; 3] {
                 return v;
             }
@@ -269,7 +278,11 @@ impl CaseGen {
                 let (origin, direction) = if self.chance(12) {
                     tags.push("parallel".to_string());
                     let a = self.int(-2, 2) as f64;
-                    let b = if a == 0.0 { 1.0 } else { self.int(-2, 2) as f64 };
+                    let b = if a == 0.0 {
+                        1.0
+                    } else {
+                        self.int(-2, 2) as f64
+                    };
                     let d = add(mul(u, a), mul(v, b));
                     let off = [-2.0, -1.0, 1.0, 2.0][self.below(4) as usize];
                     // Off the plane by `off` normals, above a point of the quad.
@@ -360,7 +373,10 @@ mod tests {
         let hits = a.iter().filter(|c| c.expect.class == Class::Hit).count();
         assert!((150..450).contains(&hits), "{hits} hits of 600");
         for tag in ["negative-radius", "inside", "behind", "parallel"] {
-            assert!(a.iter().any(|c| c.expect.tags.iter().any(|t| t == tag)), "{tag}");
+            assert!(
+                a.iter().any(|c| c.expect.tags.iter().any(|t| t == tag)),
+                "{tag}"
+            );
         }
         // A parallel ray off the plane is a definite miss.
         assert!(

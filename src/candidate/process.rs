@@ -8,7 +8,9 @@
 //! dumps, and `SIGKILL` when the harness thread that started it dies (Linux).
 //!
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
-//! takes them while the session reads answers. The timeout of a case runs from the answer to the
+//! takes them while the session reads answers. Candidates may batch their answers; after the
+//! first crash or timeout the session asks for one flush per answer (`"sync": true`) and runs
+//! the cases again from the one it was waiting for, so blame always lands on the right case. The timeout of a case runs from the answer to the
 //! previous case (or from the hello), so a candidate that is merely busy on earlier cases is
 //! never charged for them.
 
@@ -412,7 +414,10 @@ impl Proc {
             loop {
                 match err.read(&mut buf) {
                     Ok(0) => break,
-                    Ok(n) => stderr.lock().unwrap_or_else(|e| e.into_inner()).push(&buf[..n]),
+                    Ok(n) => stderr
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push(&buf[..n]),
                     Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
                     Err(_) => break,
                 }
@@ -558,6 +563,7 @@ pub struct Session {
     exhausted: BTreeMap<ShapeKind, String>,
     restarts: u32,
     broken: Option<String>,
+    sync: bool,
 }
 
 impl Session {
@@ -580,6 +586,7 @@ impl Session {
             exhausted: BTreeMap::new(),
             restarts: 0,
             broken: None,
+            sync: false,
         };
         match session.launch()? {
             Ok(hello) => session.hello = hello,
@@ -732,9 +739,16 @@ impl Session {
                 }
             }
             let proc = self.proc.as_ref().expect("a running candidate");
-            let mut bytes = Vec::with_capacity(pending.len() * 200);
+            let mut bytes = Vec::with_capacity(pending.len() * 210);
             for &i in &pending {
-                bytes.extend_from_slice(lines[i].as_deref().unwrap_or("").as_bytes());
+                let line = lines[i].as_deref().unwrap_or("");
+                if self.sync {
+                    // `{"sync":true,` + the rest of the request.
+                    bytes.extend_from_slice(b"{\"sync\":true,");
+                    bytes.extend_from_slice(&line.as_bytes()[1..]);
+                } else {
+                    bytes.extend_from_slice(line.as_bytes());
+                }
             }
             proc.send(bytes);
             self.collect(cases, &pending, &mut outcomes);
@@ -746,6 +760,12 @@ impl Session {
     }
 
     /// Reads the answers to `pending`, in order, until all are in or the process is lost.
+    ///
+    /// A candidate may batch its answers unless asked to flush each (`"sync": true`). So the
+    /// first death or timeout records nothing: the answers it had not written died with it
+    /// and the real culprit may be a later case. The session switches to sync mode and the
+    /// cases are run again from the one it was waiting for; from then on the case waited for
+    /// is the one blamed.
     fn collect(&mut self, cases: &[Case], pending: &[usize], outcomes: &mut [Option<Outcome>]) {
         let timeout = self.options.timeout;
         let mut last = Instant::now();
@@ -778,6 +798,10 @@ impl Session {
                         let mut proc = self.proc.take().expect("a running candidate");
                         let status = proc.exit_status();
                         let _ = proc.kill();
+                        if !self.sync {
+                            self.sync = true;
+                            return;
+                        }
                         let message = format!(
                             "the candidate died on this case: {}",
                             describe_status(status)
@@ -789,6 +813,10 @@ impl Session {
                     Err(RecvTimeoutError::Timeout) => {
                         let proc = self.proc.take().expect("a running candidate");
                         let _ = proc.kill();
+                        if !self.sync {
+                            self.sync = true;
+                            return;
+                        }
                         outcomes[i] = Some(Outcome::Timeout { junk });
                         self.count(CountKind::Timeout, case.shape.kind());
                         return;
@@ -814,9 +842,9 @@ impl Session {
         let n = map.entry(kind).or_insert(0);
         *n += 1;
         if *n >= max {
-            self.exhausted.entry(kind).or_insert_with(|| {
-                format!("not run after {max} {noun} in the {kind} group")
-            });
+            self.exhausted
+                .entry(kind)
+                .or_insert_with(|| format!("not run after {max} {noun} in the {kind} group"));
         }
     }
 }

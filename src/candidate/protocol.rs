@@ -146,12 +146,7 @@ impl Answer {
     pub fn from_record(record: Option<crate::geometry::HitRecord>) -> Self {
         match record {
             None => Answer::miss(),
-            Some(h) => Answer::hit(
-                h.t,
-                h.point.to_array(),
-                h.normal.to_array(),
-                h.front_face,
-            ),
+            Some(h) => Answer::hit(h.t, h.point.to_array(), h.normal.to_array(), h.front_face),
         }
     }
 
@@ -185,12 +180,38 @@ impl Answer {
     }
 }
 
-/// An answer line: the id and the answer.
+/// An answer line: the id and the answer (fields spelled out: `flatten` is slow).
 #[derive(Debug, Deserialize)]
 struct AnswerLine {
     id: String,
-    #[serde(flatten)]
-    answer: Answer,
+    #[serde(default)]
+    hit: Option<bool>,
+    #[serde(default, with = "opt_num")]
+    t: Option<f64>,
+    #[serde(default, with = "opt_num3")]
+    point: Option<[f64; 3]>,
+    #[serde(default, with = "opt_num3")]
+    normal: Option<[f64; 3]>,
+    #[serde(default)]
+    front_face: Option<bool>,
+    #[serde(default)]
+    error: Option<CandidateError>,
+}
+
+impl AnswerLine {
+    fn split(self) -> (String, Answer) {
+        (
+            self.id,
+            Answer {
+                hit: self.hit,
+                t: self.t,
+                point: self.point,
+                normal: self.normal,
+                front_face: self.front_face,
+                error: self.error,
+            },
+        )
+    }
 }
 
 /// What one stdout line turned out to be.
@@ -214,18 +235,20 @@ pub enum ParsedLine {
 pub fn parse_answer_line(line: &str) -> ParsedLine {
     let trimmed = line.trim_end_matches(['\r', '\n']);
     if let Ok(a) = serde_json::from_str::<AnswerLine>(trimmed) {
+        let (id, answer) = a.split();
         return ParsedLine::Answer {
-            id: a.id,
-            answer: a.answer,
+            id,
+            answer,
             junk: String::new(),
         };
     }
     if let Some(pos) = trimmed.find("{\"id\"") {
         if pos > 0 {
             if let Ok(a) = serde_json::from_str::<AnswerLine>(&trimmed[pos..]) {
+                let (id, answer) = a.split();
                 return ParsedLine::Answer {
-                    id: a.id,
-                    answer: a.answer,
+                    id,
+                    answer,
                     junk: trimmed[..pos].to_string(),
                 };
             }
@@ -278,7 +301,8 @@ mod tests {
 
     #[test]
     fn answers_parse_with_and_without_junk() {
-        let line = r#"{"id":"v1","hit":true,"t":4.0,"point":[0,0,1],"normal":[0,0,1],"front_face":true}"#;
+        let line =
+            r#"{"id":"v1","hit":true,"t":4.0,"point":[0,0,1],"normal":[0,0,1],"front_face":true}"#;
         match parse_answer_line(line) {
             ParsedLine::Answer { id, answer, junk } => {
                 assert_eq!(id, "v1");
@@ -297,7 +321,9 @@ mod tests {
             ParsedLine::Junk("hello world".into())
         );
         // Non-finite numbers as strings.
-        match parse_answer_line(r#"{"id":"x","hit":true,"t":"nan","normal":[0,0,1],"front_face":false}"#) {
+        match parse_answer_line(
+            r#"{"id":"x","hit":true,"t":"nan","normal":[0,0,1],"front_face":false}"#,
+        ) {
             ParsedLine::Answer { answer, .. } => assert!(answer.t.unwrap().is_nan()),
             other => panic!("{other:?}"),
         }
@@ -323,7 +349,11 @@ mod tests {
         assert!(h.supports(ShapeKind::Sphere) && !h.supports(ShapeKind::Quad));
         assert!(Hello::parse(r#"{"id":"x","hit":false}"#).is_none());
         assert!(Hello::parse("junk").is_none());
-        assert!(Hello::parse(r#"{"name":"c"}"#).unwrap().supports(ShapeKind::Triangle));
+        assert!(
+            Hello::parse(r#"{"name":"c"}"#)
+                .unwrap()
+                .supports(ShapeKind::Triangle)
+        );
     }
 
     #[test]
@@ -331,6 +361,9 @@ mod tests {
         let case = crate::oracle::default_suite(0).remove(0);
         let line = Request::for_case(&case).to_line();
         assert!(line.starts_with("{\"id\":\"sphere-basic-0000\",\"op\":\"intersect\""));
-        assert!(line.contains("\"interval\":[1e-6,1.7976931348623157e+308]"), "{line}");
+        assert!(
+            line.contains("\"interval\":[1e-6,1.7976931348623157e+308]"),
+            "{line}"
+        );
     }
 }

@@ -127,8 +127,10 @@ pub struct RunInfo {
 pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> CheckReport {
     assert_eq!(cases.len(), outcomes.len(), "one outcome per case");
     let mut counts = Counts::default();
-    let mut by_shape: BTreeMap<ShapeKind, Counts> =
-        ShapeKind::ALL.iter().map(|&k| (k, Counts::default())).collect();
+    let mut by_shape: BTreeMap<ShapeKind, Counts> = ShapeKind::ALL
+        .iter()
+        .map(|&k| (k, Counts::default()))
+        .collect();
     let mut failures = Vec::new();
     for (case, outcome) in cases.iter().zip(outcomes) {
         let verdict = judge(case, outcome);
@@ -227,16 +229,19 @@ impl CheckReport {
         }
         if !self.failures.is_empty() {
             let shown = self.failures.len().min(max_failures);
-            let _ = writeln!(
-                s,
-                "\nfirst {shown} of {} failures:",
-                self.failures.len()
-            );
+            let _ = writeln!(s, "\nfirst {shown} of {} failures:", self.failures.len());
             // Wrong answers first, vectors not run last.
             let mut order: Vec<&Failure> = self.failures.iter().collect();
             order.sort_by_key(|f| f.kind == FailureKind::NotRun);
             for f in order.into_iter().take(max_failures) {
-                let _ = writeln!(s, "\n[{}] {} ({}): {}", f.kind.name(), f.id, f.shape, f.message);
+                let _ = writeln!(
+                    s,
+                    "\n[{}] {} ({}): {}",
+                    f.kind.name(),
+                    f.id,
+                    f.shape,
+                    f.message
+                );
                 if !f.tags.is_empty() {
                     let _ = writeln!(s, "  tags: {}", f.tags.join(", "));
                 }
@@ -249,7 +254,14 @@ impl CheckReport {
         let tail = self.stderr_tail.trim_end();
         if !tail.is_empty() {
             let _ = writeln!(s, "\nend of the candidate's stderr:");
-            for line in tail.lines().rev().take(20).collect::<Vec<_>>().into_iter().rev() {
+            for line in tail
+                .lines()
+                .rev()
+                .take(20)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+            {
                 let _ = writeln!(s, "    {line}");
             }
         }
@@ -262,7 +274,11 @@ fn py(x: f64) -> String {
     if x.is_nan() {
         "float('nan')".into()
     } else if x.is_infinite() {
-        if x > 0.0 { "float('inf')".into() } else { "float('-inf')".into() }
+        if x > 0.0 {
+            "float('inf')".into()
+        } else {
+            "float('-inf')".into()
+        }
     } else {
         format!("{x:?}")
     }
@@ -276,12 +292,14 @@ fn py3(v: [f64; 3]) -> String {
 /// the course's constructor, calls `intersect` and prints what it got and what it should get.
 pub fn python_repro(case: &Case) -> String {
     let (class_name, ctor) = match case.shape {
-        ShapeSpec::Sphere { center, radius } => {
-            ("Sphere", format!("Sphere({}, {}, None)", py3(center), py(radius)))
-        }
-        ShapeSpec::Quad { q, u, v } => {
-            ("Quad", format!("Quad({}, {}, {}, None)", py3(q), py3(u), py3(v)))
-        }
+        ShapeSpec::Sphere { center, radius } => (
+            "Sphere",
+            format!("Sphere({}, {}, None)", py3(center), py(radius)),
+        ),
+        ShapeSpec::Quad { q, u, v } => (
+            "Quad",
+            format!("Quad({}, {}, {}, None)", py3(q), py3(u), py3(v)),
+        ),
         ShapeSpec::Triangle { a, b, c } => (
             "Triangle",
             format!("Triangle({}, {}, {})", py3(a), py3(b), py3(c)),
@@ -299,10 +317,18 @@ pub fn python_repro(case: &Case) -> String {
                 }
             }
             if let Some(n) = e.normal {
-                s.push_str(&format!(", normal ({}, {}, {})", py(n[0]), py(n[1]), py(n[2])));
+                s.push_str(&format!(
+                    ", normal ({}, {}, {})",
+                    py(n[0]),
+                    py(n[1]),
+                    py(n[2])
+                ));
             }
             if let Some(f) = e.front_face {
-                s.push_str(&format!(", front_face {}", if f { "True" } else { "False" }));
+                s.push_str(&format!(
+                    ", front_face {}",
+                    if f { "True" } else { "False" }
+                ));
             }
             s
         }
@@ -356,7 +382,15 @@ mod tests {
         assert_eq!(report.by_shape[&ShapeKind::Quad].not_run, 1);
         assert_eq!(report.failures.len(), 2);
         let json: serde_json::Value = serde_json::from_str(&report.to_json()).unwrap();
-        for key in ["total", "passed", "failed", "errors", "timeouts", "not_run", "ambiguous"] {
+        for key in [
+            "total",
+            "passed",
+            "failed",
+            "errors",
+            "timeouts",
+            "not_run",
+            "ambiguous",
+        ] {
             assert!(json[key].is_u64(), "{key}");
             assert!(json["by_shape"]["triangle"][key].is_u64(), "{key}");
         }

@@ -147,7 +147,12 @@ mod tests {
         assert_eq!(report.by_shape[&ShapeKind::Sphere].passed, 1);
         assert_eq!(report.by_shape[&ShapeKind::Quad].errors, 2);
         assert_eq!(report.by_shape[&ShapeKind::Triangle].not_run, 1);
-        assert!(report.failures.iter().any(|f| f.message.contains("quads are not done")));
+        assert!(
+            report
+                .failures
+                .iter()
+                .any(|f| f.message.contains("quads are not done"))
+        );
         assert!(check_candidate(&mut Reference, &suite).passed());
     }
 }

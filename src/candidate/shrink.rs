@@ -166,14 +166,19 @@ mod tests {
     fn a_failure_that_depends_on_the_radius_shrinks_to_small_numbers() {
         // "Candidate" that fails every hit on a sphere of radius > 1: the minimal case keeps
         // a radius just above 1 and simple coordinates.
-        let case = crate::candidate::generate::random_cases(3, 0, 200, &[crate::oracle::vectors::ShapeKind::Sphere])
-            .into_iter()
-            .find(|c| {
-                c.expect.class == Class::Hit
-                    && matches!(c.shape, ShapeSpec::Sphere { radius, .. } if radius > 2.0)
-                    && c.ray.origin.iter().any(|x| x.fract() != 0.0)
-            })
-            .expect("a hit on a big sphere");
+        let case = crate::candidate::generate::random_cases(
+            3,
+            0,
+            200,
+            &[crate::oracle::vectors::ShapeKind::Sphere],
+        )
+        .into_iter()
+        .find(|c| {
+            c.expect.class == Class::Hit
+                && matches!(c.shape, ShapeSpec::Sphere { radius, .. } if radius > 2.0)
+                && c.ray.origin.iter().any(|x| x.fract() != 0.0)
+        })
+        .expect("a hit on a big sphere");
         let mut fails = |cases: &[Case]| {
             cases
                 .iter()

@@ -79,5 +79,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         report.to_text(args.show)
     };
     println!("{}", text.trim_end());
-    Ok(ExitCode::from(if report.passed() { 0 } else { super::FAILED }))
+    Ok(ExitCode::from(if report.passed() {
+        0
+    } else {
+        super::FAILED
+    }))
 }

@@ -11,9 +11,7 @@ use std::time::{Duration, Instant};
 
 use rtoracle::candidate::bench::assemble_fixture;
 use rtoracle::candidate::generate::random_cases;
-use rtoracle::candidate::{
-    CandidateCommand, CheckReport, FailureKind, RunOptions, check_command,
-};
+use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
 use rtoracle::oracle::vectors::{Case, ShapeKind};
 
 use crate::common::*;
@@ -116,17 +114,29 @@ fn each_bug_is_caught_in_its_own_shape_group_only() {
         assert!(bad.passed < bad.total, "{variant}: {kind} group all passed");
         let other = if kind == Sphere { Quad } else { Sphere };
         let good = group(&r, other);
-        assert_eq!(good.passed, good.total, "{variant}: {other} group should pass");
+        assert_eq!(
+            good.passed, good.total,
+            "{variant}: {other} group should pass"
+        );
         assert!(
-            r.failures.iter().all(|f| f.shape == kind && f.kind == failure),
+            r.failures
+                .iter()
+                .all(|f| f.shape == kind && f.kind == failure),
             "{variant}: {:?}",
-            r.failures.iter().map(|f| (f.shape, f.kind)).collect::<Vec<_>>()
+            r.failures
+                .iter()
+                .map(|f| (f.shape, f.kind))
+                .collect::<Vec<_>>()
         );
     }
     // Specific evidence for two bugs: the parallel test and the negative radius.
     let r = check("bug_no_parallel_test", RunOptions::default());
-    assert!(r.failures.iter().all(|f| f.tags.iter().any(|t| t == "parallel")
-        && f.message.contains("ZeroDivisionError")));
+    assert!(
+        r.failures
+            .iter()
+            .all(|f| f.tags.iter().any(|t| t == "parallel")
+                && f.message.contains("ZeroDivisionError"))
+    );
     let r = check("bug_abs_radius_normal", RunOptions::default());
     assert!(
         r.failures
@@ -168,10 +178,15 @@ fn a_submission_that_kills_itself_is_restarted_and_the_run_goes_on() {
         return;
     }
     let r = check("hostile_kill_self", RunOptions::default());
-    // It kills itself on its 100th sphere; every restart counts afresh.
-    let spheres = cases().iter().filter(|c| c.shape.kind() == ShapeKind::Sphere).count();
-    assert_eq!(r.restarts as usize, spheres / 100, "{}", r.restarts);
-    assert_eq!(r.counts.errors as u32, r.restarts);
+    // It kills itself on its 100th sphere; every restart counts afresh. The first death
+    // loses the batched answers and switches the session to one flush per answer, so each
+    // later death is blamed on the case that caused it: one error per 100 spheres.
+    let spheres = cases()
+        .iter()
+        .filter(|c| c.shape.kind() == ShapeKind::Sphere)
+        .count();
+    assert_eq!(r.counts.errors, spheres / 100, "{}", r.to_text(2));
+    assert_eq!(r.restarts as usize, r.counts.errors + 1);
     assert!(
         r.failures.iter().all(|f| f.kind == FailureKind::Error
             && f.shape == ShapeKind::Sphere
@@ -179,7 +194,10 @@ fn a_submission_that_kills_itself_is_restarted_and_the_run_goes_on() {
         "{:?}",
         r.failures.iter().map(|f| &f.message).collect::<Vec<_>>()
     );
-    assert_eq!(group(&r, ShapeKind::Quad).passed, group(&r, ShapeKind::Quad).total);
+    assert_eq!(
+        group(&r, ShapeKind::Quad).passed,
+        group(&r, ShapeKind::Quad).total
+    );
     let s = group(&r, ShapeKind::Sphere);
     assert_eq!(s.passed + s.errors, s.total);
 }
@@ -204,7 +222,10 @@ fn stray_prints_are_protocol_errors_of_their_cases_only() {
     assert!(r.failures.iter().all(|f| f.kind == FailureKind::Protocol
         && f.message.contains("debug: root =")
         && f.actual.as_ref().is_some_and(|a| a.hit == Some(true))));
-    assert_eq!(group(&r, ShapeKind::Quad).passed, group(&r, ShapeKind::Quad).total);
+    assert_eq!(
+        group(&r, ShapeKind::Quad).passed,
+        group(&r, ShapeKind::Quad).total
+    );
 }
 
 #[test]
@@ -230,9 +251,18 @@ fn an_import_that_hangs_costs_the_hello_timeout_once() {
     }
     let start = Instant::now();
     let r = check("hostile_import_hangs", fast());
-    assert!(start.elapsed() < Duration::from_secs(5), "{:?}", start.elapsed());
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        start.elapsed()
+    );
     assert_eq!(r.counts.errors, r.counts.total);
-    assert!(r.start_failure.as_deref().unwrap().contains("no hello answer within 1.5 s"));
+    assert!(
+        r.start_failure
+            .as_deref()
+            .unwrap()
+            .contains("no hello answer within 1.5 s")
+    );
 }
 
 #[test]
@@ -255,7 +285,10 @@ fn a_forked_child_is_killed_with_its_group() {
     std::thread::sleep(Duration::from_millis(100));
     let state = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
     let state = state.rsplit(')').next().unwrap_or("").trim_start();
-    assert!(state.is_empty() || state.starts_with('Z'), "child {pid}: {state}");
+    assert!(
+        state.is_empty() || state.starts_with('Z'),
+        "child {pid}: {state}"
+    );
 }
 
 #[test]
@@ -289,25 +322,55 @@ fn check_cli_exit_codes_json_and_text() {
     let h = honest.path().to_str().unwrap();
     let b = buggy.path().to_str().unwrap();
 
-    let out = run_in(tmp.path(), &["check", "--python-course", h, "--vectors", &vectors, "--json"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run_in(
+        tmp.path(),
+        &[
+            "check",
+            "--python-course",
+            h,
+            "--vectors",
+            &vectors,
+            "--json",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["total"], 300);
     assert_eq!(json["passed"], 300);
     assert_eq!(json["failures"].as_array().unwrap().len(), 0);
 
-    let out = run_in(tmp.path(), &["check", "--python-course", b, "--vectors", &vectors, "--json"]);
+    let out = run_in(
+        tmp.path(),
+        &[
+            "check",
+            "--python-course",
+            b,
+            "--vectors",
+            &vectors,
+            "--json",
+        ],
+    );
     assert_eq!(out.status.code(), Some(1));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(json["by_shape"]["sphere"]["failed"].as_u64().unwrap() > 0);
     assert_eq!(json["by_shape"]["quad"]["failed"], 0);
     let f = &json["failures"][0];
-    for key in ["id", "shape", "tags", "kind", "expected", "actual", "message", "repro"] {
+    for key in [
+        "id", "shape", "tags", "kind", "expected", "actual", "message", "repro",
+    ] {
         assert!(!f[key].is_null(), "{key}");
     }
     assert_eq!(f["kind"], "mismatch");
 
-    let out = run_in(tmp.path(), &["check", "--python-course", b, "--vectors", &vectors]);
+    let out = run_in(
+        tmp.path(),
+        &["check", "--python-course", b, "--vectors", &vectors],
+    );
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("verdict: FAIL") && text.contains("from RT_object import Sphere"));
@@ -315,7 +378,12 @@ fn check_cli_exit_codes_json_and_text() {
     // suite: the built-in suite has definite sphere and quad vectors; triangles (a stub in the
     // course) are not run and do not fail the verdict.
     let out = run_in(tmp.path(), &["check", "--python-course", h]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
 }
 
 #[test]
@@ -332,11 +400,18 @@ fn a_repro_snippet_reproduces_the_failure_in_python() {
         .current_dir(dir.path())
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // The snippet prints the candidate's (wrong) t, which the report also recorded.
     let printed = String::from_utf8_lossy(&out.stdout);
     let t = f.actual.as_ref().unwrap().t.unwrap();
-    assert!(printed.starts_with(&format!("({t:?}, ")), "{printed} vs {t}");
+    assert!(
+        printed.starts_with(&format!("({t:?}, ")),
+        "{printed} vs {t}"
+    );
 }
 
 #[test]
@@ -345,12 +420,18 @@ fn bad_inputs_and_broken_adapters_exit_2_with_one_line() {
     let out = run_in(tmp.path(), &["check", "--python-course", "no/such/dir"]);
     assert_bad_input(&out, "no/such/dir");
     std::fs::write(tmp.path().join("bad.jsonl"), "{\"id\": 3}\n").unwrap();
-    let out = run_in(tmp.path(), &["check", "--adapter", "cat", "--vectors", "bad.jsonl"]);
+    let out = run_in(
+        tmp.path(),
+        &["check", "--adapter", "cat", "--vectors", "bad.jsonl"],
+    );
     assert_bad_input(&out, "bad.jsonl:1");
     let out = run_in(tmp.path(), &["check", "--adapter", "/no/such/program"]);
     assert_bad_input(&out, "/no/such/program");
     // Speaks no protocol: prints junk and exits.
-    let out = run_in(tmp.path(), &["check", "--adapter", "sh -c 'echo hello there'"]);
+    let out = run_in(
+        tmp.path(),
+        &["check", "--adapter", "sh -c 'echo hello there'"],
+    );
     assert_bad_input(&out, "did not answer the hello");
     let out = run_in(tmp.path(), &["check"]);
     assert_eq!(out.status.code(), Some(2));
@@ -365,19 +446,84 @@ fn fuzz_finds_shrinks_and_prints_a_reproduction() {
     let buggy = assemble_fixture("bug_w_is_unit_normal").unwrap();
     let out = run_in(
         tmp.path(),
-        &["fuzz", "--python-course", buggy.path().to_str().unwrap(), "--cases", "2000", "--seed", "3"],
+        &[
+            "fuzz",
+            "--python-course",
+            buggy.path().to_str().unwrap(),
+            "--cases",
+            "2000",
+            "--seed",
+            "3",
+        ],
     );
-    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("[mismatch]") && text.contains("(quad)"), "{text}");
+    assert!(
+        text.contains("[mismatch]") && text.contains("(quad)"),
+        "{text}"
+    );
     assert!(text.contains("from RT_object import Quad"), "{text}");
     assert!(!text.contains("(sphere)"), "{text}");
 
     let honest = assemble_fixture("honest_full_quadratic").unwrap();
     let out = run_in(
         tmp.path(),
-        &["fuzz", "--python-course", honest.path().to_str().unwrap(), "--cases", "2000"],
+        &[
+            "fuzz",
+            "--python-course",
+            honest.path().to_str().unwrap(),
+            "--cases",
+            "2000",
+        ],
     );
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     assert!(String::from_utf8_lossy(&out.stdout).contains("0 failed"));
+}
+
+#[test]
+fn blame_lands_on_the_right_case_even_when_the_adapter_batches_its_answers() {
+    if !python_ok() {
+        return;
+    }
+    // Misses only, so every answer of the adapter is right except on the three marked cases.
+    let misses: Vec<Case> = cases()
+        .iter()
+        .filter(|c| c.expect.class == rtoracle::oracle::vectors::Class::Miss)
+        .take(400)
+        .cloned()
+        .collect();
+    let (die, hang, junk) = (&misses[150].id, &misses[250].id, &misses[300].id);
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/adapters/batching_misser.py");
+    let command = CandidateCommand::adapter(&format!(
+        "python3 -I {} {die} {hang} {junk}",
+        script.display()
+    ))
+    .unwrap();
+    let r = check_command(command, &misses, fast()).unwrap();
+    let blamed: Vec<(&str, FailureKind)> =
+        r.failures.iter().map(|f| (f.id.as_str(), f.kind)).collect();
+    assert_eq!(
+        blamed,
+        [
+            (die.as_str(), FailureKind::Error),
+            (hang.as_str(), FailureKind::Timeout),
+            (junk.as_str(), FailureKind::Protocol),
+        ],
+        "{}",
+        r.to_text(5)
+    );
+    assert_eq!(r.counts.passed, 397);
+    assert!(r.failures[2].message.contains("junk line"));
+    assert!(r.failures[0].message.contains("exited with code 3"));
 }
