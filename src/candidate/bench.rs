@@ -36,7 +36,8 @@ pub fn assemble_fixture(variant: &str) -> std::io::Result<tempfile::TempDir> {
     Ok(dir)
 }
 
-/// A Python adapter that answers every request with a miss: the cost of the protocol alone.
+/// A Python adapter that answers every request with a miss, flushing each answer: the cost of
+/// the protocol alone for an adapter that does not batch.
 pub const ECHO_ADAPTER: &str = r#"import json, sys
 out = sys.stdout
 stdin = sys.stdin.buffer
@@ -48,6 +49,29 @@ for line in stdin:
 
 fn rate(n: usize, d: Duration) -> f64 {
     n as f64 / d.as_secs_f64()
+}
+
+/// CPU seconds used so far by this process and its reaped children.
+fn cpu_seconds() -> f64 {
+    let mut total = 0.0;
+    for who in [libc::RUSAGE_SELF, libc::RUSAGE_CHILDREN] {
+        // SAFETY: getrusage fills the struct it is given.
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        if unsafe { libc::getrusage(who, &mut u) } == 0 {
+            for t in [u.ru_utime, u.ru_stime] {
+                total += t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+            }
+        }
+    }
+    total
+}
+
+/// Wall time and CPU time (harness and candidate) of `f`.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration, f64) {
+    let c = cpu_seconds();
+    let t = Instant::now();
+    let out = f();
+    (out, t.elapsed(), cpu_seconds() - c)
 }
 
 /// Runs the benchmark and returns its report (or why it could not run).
@@ -64,9 +88,7 @@ pub fn run() -> Result<String, HarnessError> {
         cases.len()
     ));
 
-    let t = Instant::now();
-    let report = check_candidate(&mut Reference, &cases);
-    let d_ref = t.elapsed();
+    let (report, d_ref, c_ref) = timed(|| check_candidate(&mut Reference, &cases));
     assert!(report.passed(), "the reference passes its own cases");
 
     let tmp = tempfile::tempdir().map_err(io("temporary folder"))?;
@@ -74,44 +96,45 @@ pub fn run() -> Result<String, HarnessError> {
     std::fs::write(&echo, ECHO_ADAPTER).map_err(io("writing the echo adapter"))?;
     let python = std::env::var("RTORACLE_PYTHON").unwrap_or_else(|_| "python3".into());
     let cmd = CandidateCommand::adapter(&format!("{python} -I {}", echo.display()))?;
-    let t = Instant::now();
-    let _ = super::check_command(cmd, &cases, RunOptions::default())?;
-    let d_echo = t.elapsed();
+    let (r, d_echo, c_echo) = timed(|| super::check_command(cmd, &cases, RunOptions::default()));
+    r?;
 
     let honest = assemble_fixture("honest_reference").map_err(io("assembling the fixture"))?;
-    let t = Instant::now();
-    let report = super::check_command(
-        CandidateCommand::python_course(honest.path())?,
-        &cases,
-        RunOptions::default(),
-    )?;
-    let d_py = t.elapsed();
-    let py_ok = report.passed();
+    let cmd = CandidateCommand::python_course(honest.path())?;
+    let (report, d_py, c_py) = timed(|| super::check_command(cmd, &cases, RunOptions::default()));
+    let py_ok = report?.passed();
 
     let rows = [
-        ("in-process Rust reference (baseline)", d_ref),
-        (
-            "Python echo adapter, answers miss (protocol ceiling)",
-            d_echo,
-        ),
-        ("course adapter + honest Python submission", d_py),
+        ("in-process Rust reference (baseline)", d_ref, c_ref),
+        ("Python echo adapter, one flush per answer", d_echo, c_echo),
+        ("course adapter + honest Python submission", d_py, c_py),
     ];
     out.push_str(&format!(
-        "{:<56} {:>10} {:>14}\n",
-        "candidate", "seconds", "vectors/s"
+        "{:<44} {:>8} {:>11} {:>8} {:>13}\n",
+        "candidate", "wall s", "vectors/s", "CPU s", "vectors/CPU-s"
     ));
-    for (name, d) in rows {
+    for (name, d, c) in rows {
         out.push_str(&format!(
-            "{:<56} {:>10.3} {:>14.0}\n",
+            "{:<44} {:>8.3} {:>11.0} {:>8.3} {:>13.0}\n",
             name,
             d.as_secs_f64(),
-            rate(cases.len(), d)
+            rate(cases.len(), d),
+            c,
+            cases.len() as f64 / c.max(1e-9)
         ));
     }
     out.push_str(&format!(
-        "course adapter / echo adapter time: {:.2}x; course adapter passed: {}\n",
+        "course adapter / echo adapter wall time: {:.2}x; course adapter passed: {}\n",
         d_py.as_secs_f64() / d_echo.as_secs_f64(),
         py_ok
+    ));
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    out.push_str(&format!(
+        "load average during the run: {} (CPU s = harness + candidate processes)\n",
+        load.split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
     ));
 
     let suite = crate::oracle::default_suite(0);

@@ -96,10 +96,7 @@ impl FuzzReport {
 }
 
 /// Runs the fuzzer with `run` as the candidate (a batch of cases in, one outcome per case out).
-pub fn fuzz(
-    run: &mut RunBatch<'_>,
-    options: &FuzzOptions,
-) -> Result<FuzzReport, HarnessError> {
+pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport, HarnessError> {
     let start = Instant::now();
     let mut report = FuzzReport {
         cases_run: 0,
@@ -174,10 +171,7 @@ pub fn fuzz(
 }
 
 /// Whether an `error` failure is a raised error (cheap to shrink) rather than a dead process.
-fn is_raised(
-    case: &Case,
-    run: &mut RunBatch<'_>,
-) -> bool {
+fn is_raised(case: &Case, run: &mut RunBatch<'_>) -> bool {
     matches!(
         run(std::slice::from_ref(case)).ok().as_deref(),
         Some([Outcome::Answered { answer, .. }]) if answer.error.is_some()

@@ -45,13 +45,18 @@ pub fn oracle_expect(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Op
                 tags.push("negative-radius".to_string());
             }
         }
-        ShapeSpec::Quad { u, v, .. } => {
+        ShapeSpec::Quad { q, u, v } => {
             let n = glam::DVec3::from(u).cross(glam::DVec3::from(v));
             if n.length() == 0.0 {
                 return None;
             }
             let nd = n.normalize().dot(d);
             if nd == 0.0 {
+                // A parallel ray in the plane is degenerate (`any`); off the plane, a miss.
+                let off = n.dot(glam::DVec3::from(ray.origin) - glam::DVec3::from(q));
+                if off.abs() <= 1e-9 * n.length() * (1.0 + glam::DVec3::from(ray.origin).length()) {
+                    return None;
+                }
                 tags.push("parallel".to_string());
             } else if nd.abs() < 1e-6 * dlen || nd.abs() < 1e-7 {
                 // Near parallel: honest variants (near_zero or == 0) disagree.
@@ -406,6 +411,22 @@ mod tests {
         assert!(oracle_expect(&s, &down, [1e-6, 4.0]).is_none());
         let e = oracle_expect(&s, &down, [1e-6, 4.5]).unwrap();
         assert_eq!((e.class, e.t), (Class::Hit, Some(4.0)));
+        // A ray exactly parallel to a quad: in its plane degenerate, off it a miss.
+        let q = ShapeSpec::Quad {
+            q: [0.0; 3],
+            u: [1.0, 0.0, 0.0],
+            v: [0.0, 1.0, 0.0],
+        };
+        let along = |z: f64| RaySpec {
+            origin: [-1.0, 0.5, z],
+            direction: [1.0, 0.0, 0.0],
+        };
+        assert!(oracle_expect(&q, &along(0.0), [1e-6, f64::MAX]).is_none());
+        let e = oracle_expect(&q, &along(0.5), [1e-6, f64::MAX]).unwrap();
+        assert_eq!(
+            (e.class, e.tags),
+            (Class::Miss, vec!["parallel".to_string()])
+        );
         // Quad edge.
         let q = ShapeSpec::Quad {
             q: [0.0; 3],

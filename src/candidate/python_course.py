@@ -37,7 +37,9 @@ def vec(v):
 
 
 def error_json(exc):
-    tb = traceback.format_exc()
+    # Leave out the adapter's own frame: the traceback starts in the submission.
+    tb = exc.__traceback__
+    tb = "".join(traceback.format_exception(type(exc), exc, tb.tb_next if tb else None))
     if len(tb) > TB_LIMIT:
         tb = "..." + tb[-TB_LIMIT:]
     return json.dumps(

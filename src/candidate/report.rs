@@ -227,13 +227,31 @@ impl CheckReport {
         if self.restarts > 0 {
             let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
         }
-        if !self.failures.is_empty() {
-            let shown = self.failures.len().min(max_failures);
-            let _ = writeln!(s, "\nfirst {shown} of {} failures:", self.failures.len());
-            // Wrong answers first, vectors not run last.
-            let mut order: Vec<&Failure> = self.failures.iter().collect();
-            order.sort_by_key(|f| f.kind == FailureKind::NotRun);
-            for f in order.into_iter().take(max_failures) {
+        // Vectors not run: one line per reason.
+        let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();
+        for f in self
+            .failures
+            .iter()
+            .filter(|f| f.kind == FailureKind::NotRun)
+        {
+            *reasons.entry(f.message.as_str()).or_default() += 1;
+        }
+        for (reason, n) in reasons {
+            let _ = writeln!(s, "not run: {n} vectors: {reason}");
+        }
+        let shown: Vec<&Failure> = self
+            .failures
+            .iter()
+            .filter(|f| f.kind != FailureKind::NotRun)
+            .collect();
+        if !shown.is_empty() {
+            let _ = writeln!(
+                s,
+                "\nfirst {} of {} failures:",
+                shown.len().min(max_failures),
+                shown.len()
+            );
+            for f in shown.into_iter().take(max_failures) {
                 let _ = writeln!(
                     s,
                     "\n[{}] {} ({}): {}",

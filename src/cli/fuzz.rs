@@ -28,6 +28,10 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Also write the minimal failing cases to this vector file (JSON lines), for
+    /// `rtoracle check --vectors`.
+    #[arg(long, value_name = "FILE")]
+    save: Option<std::path::PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -62,6 +66,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..FuzzOptions::default()
     };
     let report = fuzz(&mut |cases| session.run(cases), &fuzz_options).context("fuzz")?;
+    if let Some(path) = &args.save {
+        let text: String = report
+            .failures
+            .iter()
+            .map(|f| f.minimal.to_json_line() + "\n")
+            .collect();
+        rtoracle::image_io::write_atomically(path, text.as_bytes())?;
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

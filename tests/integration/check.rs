@@ -527,3 +527,49 @@ fn blame_lands_on_the_right_case_even_when_the_adapter_batches_its_answers() {
     assert!(r.failures[2].message.contains("junk line"));
     assert!(r.failures[0].message.contains("exited with code 3"));
 }
+
+#[test]
+fn the_c_example_adapter_passes_the_sphere_vectors() {
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let tmp = tempfile::tempdir().unwrap();
+    let exe = tmp.path().join("sphere_adapter");
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/sphere_adapter.c");
+    let built = std::process::Command::new(&cc)
+        .args(["-O2", "-o"])
+        .arg(&exe)
+        .arg(&source)
+        .arg("-lm")
+        .status();
+    if !built.map(|s| s.success()).unwrap_or(false) {
+        eprintln!("skipped: no working C compiler ({cc})");
+        return;
+    }
+    let vectors = write_vectors(tmp.path(), &cases()[..600]);
+    let out = run_in(
+        tmp.path(),
+        &[
+            "check",
+            "--adapter",
+            "./sphere_adapter",
+            "--vectors",
+            &vectors,
+            "--json",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let sphere = &json["by_shape"]["sphere"];
+    assert!(sphere["total"].as_u64().unwrap() > 200);
+    assert_eq!(sphere["passed"], sphere["total"]);
+    // It declares spheres only: the quads are not run, which does not fail the verdict.
+    assert_eq!(
+        json["by_shape"]["quad"]["not_run"],
+        json["by_shape"]["quad"]["total"]
+    );
+    assert_eq!(json["candidate"], "c-sphere-adapter");
+}
