@@ -55,10 +55,14 @@ impl Counts {
         }
     }
 
-    /// Whether no definite vector failed, raised an error or timed out (vectors not run, e.g.
-    /// of a shape the candidate does not implement, do not count against it).
+    /// Whether no definite vector failed, raised an error or timed out, and at least one
+    /// passed if there were any (vectors not run, e.g. of a shape the candidate does not
+    /// implement, do not count against it, but a candidate that runs nothing does not pass).
     pub fn all_passed(&self) -> bool {
-        self.failed == 0 && self.errors == 0 && self.timeouts == 0
+        self.failed == 0
+            && self.errors == 0
+            && self.timeouts == 0
+            && (self.total == 0 || self.passed > 0)
     }
 }
 
@@ -389,6 +393,17 @@ mod tests {
             .collect();
         let report = build_report(&cases, &outcomes, RunInfo::default());
         assert!(report.passed(), "{}", report.to_text(5));
+        let none_run: Vec<Outcome> = cases
+            .iter()
+            .map(|_| Outcome::NotRun {
+                reason: "unsupported".into(),
+            })
+            .collect();
+        let report = build_report(&cases, &none_run, RunInfo::default());
+        assert!(
+            !report.passed(),
+            "a candidate that runs nothing does not pass"
+        );
         outcomes[1] = Outcome::Timeout { junk: vec![] };
         outcomes[2] = Outcome::NotRun { reason: "r".into() };
         let report = build_report(&cases, &outcomes, RunInfo::default());
