@@ -5,7 +5,8 @@
 //! (`setsid`), with a cleared environment (`PATH`, `LANG`, `LC_ALL`, `HOME` and `TMPDIR` set to
 //! the working folder, `PYTHONIOENCODING=utf-8`, `PYTHONDONTWRITEBYTECODE=1`,
 //! `PYTHONHASHSEED=0`), limits on CPU time, address space, open files and file size, no core
-//! dumps, and `SIGKILL` when the harness thread that started it dies (Linux).
+//! dumps, a new network namespace without any interface up where the harness may create one,
+//! and `SIGKILL` when the harness thread that started it dies (Linux).
 //!
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
 //! takes them while the session reads answers. Candidates may batch their answers; after the
@@ -50,6 +51,9 @@ pub struct Limits {
     pub open_files: u64,
     /// Largest file the candidate may write, in bytes.
     pub file_size_bytes: u64,
+    /// Run the candidate in a new, empty network namespace (Linux, when the harness is
+    /// allowed to create one: as root or with `CAP_SYS_ADMIN`; silently skipped otherwise).
+    pub isolate_network: bool,
 }
 
 impl Default for Limits {
@@ -59,6 +63,7 @@ impl Default for Limits {
             memory_bytes: 2 << 30,
             open_files: 64,
             file_size_bytes: 64 << 20,
+            isolate_network: true,
         }
     }
 }
@@ -373,7 +378,13 @@ impl Proc {
                     return Err(std::io::Error::last_os_error());
                 }
                 #[cfg(target_os = "linux")]
-                libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL as libc::c_ulong);
+                {
+                    libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL as libc::c_ulong);
+                    if limits.isolate_network {
+                        // No network: fails without privileges, which is fine.
+                        libc::unshare(libc::CLONE_NEWNET);
+                    }
+                }
                 let set = |resource, value: u64| {
                     let lim = libc::rlimit {
                         rlim_cur: value as libc::rlim_t,

@@ -573,3 +573,28 @@ fn the_c_example_adapter_passes_the_sphere_vectors() {
     );
     assert_eq!(json["candidate"], "c-sphere-adapter");
 }
+
+#[test]
+fn the_candidate_gets_no_network_when_the_platform_allows_it() {
+    let allowed = std::process::Command::new("unshare")
+        .args(["-n", "true"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !allowed {
+        eprintln!("skipped: this user cannot create network namespaces");
+        return;
+    }
+    let mine = std::fs::read_link("/proc/self/ns/net").unwrap();
+    // An "adapter" that reports its network namespace on stderr, then speaks no protocol.
+    let command = CandidateCommand::adapter("sh -c 'readlink /proc/self/ns/net >&2'").unwrap();
+    let err = match rtoracle::candidate::Session::start(command, fast()) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("it does not answer the hello"),
+    };
+    assert!(err.contains("net:["), "{err}");
+    assert!(
+        !err.contains(&mine.display().to_string()),
+        "{err} vs {mine:?}"
+    );
+}
