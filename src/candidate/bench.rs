@@ -55,7 +55,10 @@ fn rate(n: usize, d: Duration) -> f64 {
 /// candidates).
 fn cpu_seconds() -> [f64; 2] {
     let mut total = [0.0; 2];
-    for (k, who) in [libc::RUSAGE_SELF, libc::RUSAGE_CHILDREN].into_iter().enumerate() {
+    for (k, who) in [libc::RUSAGE_SELF, libc::RUSAGE_CHILDREN]
+        .into_iter()
+        .enumerate()
+    {
         // SAFETY: getrusage fills the struct it is given.
         let mut u: libc::rusage = unsafe { std::mem::zeroed() };
         if unsafe { libc::getrusage(who, &mut u) } == 0 {

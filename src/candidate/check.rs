@@ -66,6 +66,13 @@ fn fail(kind: FailureKind, message: impl Into<String>) -> Verdict {
     }
 }
 
+fn with_junk(mut message: String, junk: &[String]) -> String {
+    if !junk.is_empty() {
+        message.push_str(&format!("; it printed {:?}", junk.join("\n")));
+    }
+    message
+}
+
 /// Judges `outcome` for `case`.
 pub fn judge(case: &Case, outcome: &Outcome) -> Verdict {
     if !case.expect.class.is_definite() {
@@ -73,8 +80,13 @@ pub fn judge(case: &Case, outcome: &Outcome) -> Verdict {
     }
     match outcome {
         Outcome::NotRun { reason } => fail(FailureKind::NotRun, reason.clone()),
-        Outcome::Timeout { .. } => fail(FailureKind::Timeout, "no answer within the timeout"),
-        Outcome::Died { message, .. } => fail(FailureKind::Error, message.clone()),
+        Outcome::Timeout { junk } => fail(
+            FailureKind::Timeout,
+            with_junk("no answer within the timeout".into(), junk),
+        ),
+        Outcome::Died { message, junk } => {
+            fail(FailureKind::Error, with_junk(message.clone(), junk))
+        }
         Outcome::Answered { answer, junk } => {
             if !junk.is_empty() {
                 return fail(

@@ -21,7 +21,7 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -418,7 +418,8 @@ impl Proc {
                 }
             }
         });
-        let (ltx, lrx) = mpsc::channel();
+        // Bounded: a candidate that floods stdout is slowed down, not buffered without end.
+        let (ltx, lrx) = mpsc::sync_channel(4096);
         std::thread::spawn(move || read_lines(stdout, ltx));
         let stderr_done = std::thread::spawn(move || {
             let mut buf = [0u8; 8192];
@@ -490,7 +491,7 @@ impl Drop for Proc {
     }
 }
 
-fn read_lines(stdout: ChildStdout, tx: Sender<Line>) {
+fn read_lines(stdout: ChildStdout, tx: SyncSender<Line>) {
     let mut reader = BufReader::with_capacity(1 << 16, stdout);
     let mut line: Vec<u8> = Vec::new();
     loop {
@@ -551,6 +552,18 @@ fn describe_status(status: Option<ExitStatus>) -> String {
             }
             _ => format!("its process ended ({s})"),
         },
+    }
+}
+
+/// Most stray lines quoted for one case; the rest are counted.
+const MAX_JUNK_LINES: usize = 8;
+
+/// Records a stray line, keeping memory bounded however much a candidate prints.
+fn push_junk(junk: &mut Vec<String>, line: &str) {
+    if junk.len() < MAX_JUNK_LINES {
+        junk.push(quote(line));
+    } else if junk.len() == MAX_JUNK_LINES {
+        junk.push("(more lines not shown)".into());
     }
 }
 
@@ -652,13 +665,19 @@ impl Session {
         let mut junk = Vec::new();
         loop {
             let left = deadline.saturating_duration_since(Instant::now());
-            match proc.lines.recv_timeout(left) {
+            // Checked here too: a candidate printing without pause always has a line ready.
+            let next = if left.is_zero() {
+                Err(RecvTimeoutError::Timeout)
+            } else {
+                proc.lines.recv_timeout(left)
+            };
+            match next {
                 Ok(Line::Text(line)) => {
                     if let Some(hello) = Hello::parse(&line) {
                         self.proc = Some(proc);
                         return Ok(Ok(hello));
                     }
-                    junk.push(quote(&line));
+                    push_junk(&mut junk, &line);
                 }
                 Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
                     let mut proc = proc;
@@ -786,7 +805,12 @@ impl Session {
             loop {
                 let proc = self.proc.as_mut().expect("a running candidate");
                 let left = (last + timeout).saturating_duration_since(Instant::now());
-                match proc.lines.recv_timeout(left) {
+                let next = if left.is_zero() {
+                    Err(RecvTimeoutError::Timeout)
+                } else {
+                    proc.lines.recv_timeout(left)
+                };
+                match next {
                     Ok(Line::Text(line)) => match parse_answer_line(&line) {
                         ParsedLine::Answer {
                             id,
@@ -794,16 +818,16 @@ impl Session {
                             junk: prefix,
                         } if id == case.id => {
                             if !prefix.is_empty() {
-                                junk.push(quote(&prefix));
+                                push_junk(&mut junk, &prefix);
                             }
                             outcomes[i] = Some(Outcome::Answered { answer, junk });
                             last = Instant::now();
                             break;
                         }
                         ParsedLine::Answer { id, .. } => {
-                            junk.push(quote(&format!("an answer for id {id:?}: {line}")));
+                            push_junk(&mut junk, &format!("an answer for id {id:?}: {line}"));
                         }
-                        ParsedLine::Junk(text) => junk.push(quote(&text)),
+                        ParsedLine::Junk(text) => push_junk(&mut junk, &text),
                     },
                     Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
                         let mut proc = self.proc.take().expect("a running candidate");
@@ -877,6 +901,17 @@ mod tests {
         );
         assert_eq!(split_words("  a   \"\" b ").unwrap(), ["a", "", "b"]);
         assert!(split_words("a 'b").is_none());
+    }
+
+    #[test]
+    fn stray_output_is_quoted_briefly_and_bounded() {
+        let mut junk = Vec::new();
+        for _ in 0..1000 {
+            push_junk(&mut junk, &"x".repeat(10_000));
+        }
+        assert_eq!(junk.len(), MAX_JUNK_LINES + 1);
+        assert_eq!(junk[0].len(), JUNK_QUOTE + 3);
+        assert_eq!(junk[MAX_JUNK_LINES], "(more lines not shown)");
     }
 
     #[test]

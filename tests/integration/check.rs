@@ -433,6 +433,20 @@ fn bad_inputs_and_broken_adapters_exit_2_with_one_line() {
         &["check", "--adapter", "sh -c 'echo hello there'"],
     );
     assert_bad_input(&out, "did not answer the hello");
+    // Floods stdout with junk and never answers: bounded memory, one line, exit 2.
+    let start = Instant::now();
+    let out = run_in(
+        tmp.path(),
+        &[
+            "check",
+            "--adapter",
+            "yes junk",
+            "--hello-timeout-ms",
+            "500",
+        ],
+    );
+    assert_bad_input(&out, "no hello answer within 0.5 s");
+    assert!(start.elapsed() < Duration::from_secs(10));
     let out = run_in(tmp.path(), &["check"]);
     assert_eq!(out.status.code(), Some(2));
 }
@@ -596,5 +610,48 @@ fn the_candidate_gets_no_network_when_the_platform_allows_it() {
     assert!(
         !err.contains(&mine.display().to_string()),
         "{err} vs {mine:?}"
+    );
+}
+
+#[test]
+fn a_candidate_flooding_stdout_times_out_with_bounded_memory() {
+    let tmp = tempfile::tempdir().unwrap();
+    let vectors = write_vectors(tmp.path(), &cases()[..50]);
+    // Answers the hello, then prints junk without end.
+    let adapter = r#"sh -c 'read l; echo "{\"name\":\"flood\"}"; yes junk'"#;
+    let start = Instant::now();
+    let out = run_in(
+        tmp.path(),
+        &[
+            "check",
+            "--adapter",
+            adapter,
+            "--vectors",
+            &vectors,
+            "--timeout-ms",
+            "300",
+            "--json",
+        ],
+    );
+    assert!(
+        start.elapsed() < Duration::from_secs(15),
+        "{:?}",
+        start.elapsed()
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for group in ["sphere", "quad"] {
+        assert_eq!(json["by_shape"][group]["timeouts"], 3, "{group}");
+    }
+    let first = &json["failures"][0];
+    assert_eq!(first["kind"], "timeout");
+    assert!(
+        first["message"].as_str().unwrap().contains("junk\\njunk"),
+        "{first}"
     );
 }
