@@ -1,9 +1,11 @@
 //! `rtoracle fuzz`: differential fuzzing of a candidate with shrinking.
 
+use std::io::IsTerminal;
 use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rtoracle::candidate::fuzz::{FuzzOptions, fuzz};
 use rtoracle::candidate::{RunOptions, Session};
 use rtoracle::oracle::vectors::ShapeKind;
@@ -65,7 +67,30 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         time,
         ..FuzzOptions::default()
     };
-    let report = fuzz(&mut |cases| session.run(cases), &fuzz_options).context("fuzz")?;
+    // Progress on stderr when it is a terminal: cases run (shrinking included).
+    let progress = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(
+            Some(fuzz_options.cases as u64),
+            ProgressDrawTarget::stderr(),
+        );
+        bar.set_style(
+            ProgressStyle::with_template("fuzzing {bar:40} {pos}/{len} cases, {elapsed}")
+                .expect("a valid progress template"),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let report = fuzz(
+        &mut |cases| {
+            let outcomes = session.run(cases);
+            progress.inc(cases.len() as u64);
+            outcomes
+        },
+        &fuzz_options,
+    )
+    .context("fuzz")?;
+    progress.finish_and_clear();
     if let Some(path) = &args.save {
         let text: String = report
             .failures
