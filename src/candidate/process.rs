@@ -576,6 +576,11 @@ fn quote(s: &str) -> String {
 }
 
 /// A candidate process and its bookkeeping, restarted as needed.
+///
+/// Start and use a session on a thread that outlives it: on Linux the child gets `SIGKILL`
+/// when the thread that spawned it exits (`PR_SET_PDEATHSIG`), which is what kills it when the
+/// harness dies; restarts spawn from the thread calling [`Session::run`]. Dropping the session
+/// kills the whole process group.
 pub struct Session {
     command: CandidateCommand,
     options: RunOptions,
