@@ -10,7 +10,7 @@
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
 //! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
 //!   [`generate::oracle_expect`], shrinking, the fuzz driver.
-//! - [`bench`]: throughput of the harness against baselines measured in the same run.
+//! - [`bench`](mod@bench): throughput of the harness against baselines measured in the same run.
 
 pub mod bench;
 pub mod check;
