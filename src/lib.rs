@@ -16,8 +16,11 @@
 //! - [`oracle`]: the vector format and the exact intersection oracle.
 //! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
 //!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
+//! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
+//!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
 #![warn(missing_docs)]
 
+pub mod candidate;
 pub mod geometry;
 pub mod golden;
 pub mod grade;

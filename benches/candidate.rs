@@ -1,0 +1,11 @@
+//! `cargo bench --bench candidate`: throughput of candidate checking against baselines.
+
+fn main() {
+    match rtoracle::candidate::bench::run() {
+        Ok(text) => print!("{text}"),
+        Err(e) => {
+            eprintln!("bench candidate: {e}");
+            std::process::exit(2);
+        }
+    }
+}

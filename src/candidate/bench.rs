@@ -1,0 +1,176 @@
+//! Throughput of candidate checking, with baselines measured in the same run:
+//! the in-process Rust reference through the same judging code, and a trivial Python adapter
+//! that answers "miss" to everything (the protocol's ceiling), against the course adapter on
+//! the honest fixture. Also the wall time of the default suite, and of a submission that hangs
+//! on every miss with the default 2 s timeout.
+//!
+//! Run with `cargo bench --bench candidate` (needs python3 and this crate's test fixtures).
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use super::generate::random_cases;
+use super::process::{CandidateCommand, HarnessError, RunOptions};
+use super::rust::{Reference, check_candidate};
+use crate::oracle::vectors::ShapeKind;
+
+/// The Python fixtures of this crate (`tests/fixtures/python`), as seen at build time.
+pub fn fixture_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/python")
+}
+
+/// A submission folder for the fixture `variant` (the common modules plus the variant's
+/// `RT_object.py`) in a new temporary folder.
+pub fn assemble_fixture(variant: &str) -> std::io::Result<tempfile::TempDir> {
+    let root = fixture_root();
+    let dir = tempfile::Builder::new()
+        .prefix(&format!("rtoracle-fixture-{variant}-"))
+        .tempdir()?;
+    for name in ["RT_utility.py", "RT_ray.py", "RT_material.py"] {
+        std::fs::copy(root.join("common").join(name), dir.path().join(name))?;
+    }
+    std::fs::copy(
+        root.join("variants").join(variant).join("RT_object.py"),
+        dir.path().join("RT_object.py"),
+    )?;
+    Ok(dir)
+}
+
+/// A Python adapter that answers every request with a miss, flushing each answer: the cost of
+/// the protocol alone for an adapter that does not batch.
+pub const ECHO_ADAPTER: &str = r#"import json, sys
+out = sys.stdout
+stdin = sys.stdin.buffer
+stdin.readline()
+out.write('{"name":"echo","protocol":1}\n'); out.flush()
+for line in stdin:
+    out.write('{"id":' + json.dumps(json.loads(line)["id"]) + ',"hit":false}\n'); out.flush()
+"#;
+
+fn rate(n: usize, d: Duration) -> f64 {
+    n as f64 / d.as_secs_f64()
+}
+
+/// CPU seconds used so far by this process (the harness) and by its reaped children (the
+/// candidates).
+fn cpu_seconds() -> [f64; 2] {
+    let mut total = [0.0; 2];
+    for (k, who) in [libc::RUSAGE_SELF, libc::RUSAGE_CHILDREN]
+        .into_iter()
+        .enumerate()
+    {
+        // SAFETY: getrusage fills the struct it is given.
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        if unsafe { libc::getrusage(who, &mut u) } == 0 {
+            for t in [u.ru_utime, u.ru_stime] {
+                total[k] += t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+            }
+        }
+    }
+    total
+}
+
+/// Wall time and CPU time (harness, candidate) of `f`.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration, [f64; 2]) {
+    let c = cpu_seconds();
+    let t = Instant::now();
+    let out = f();
+    let d = cpu_seconds();
+    (out, t.elapsed(), [d[0] - c[0], d[1] - c[1]])
+}
+
+/// Runs the benchmark and returns its report (or why it could not run).
+pub fn run() -> Result<String, HarnessError> {
+    let io = |context: &str| {
+        let context = context.to_string();
+        move |source| HarnessError::Io { context, source }
+    };
+    let mut out = String::new();
+    let n = 20_000;
+    let cases = random_cases(11, 0, n, &[ShapeKind::Sphere, ShapeKind::Quad]);
+    out.push_str(&format!(
+        "{} definite random cases (spheres and quads), one process each, 2-core machine\n\n",
+        cases.len()
+    ));
+
+    let (report, d_ref, c_ref) = timed(|| check_candidate(&mut Reference, &cases));
+    assert!(report.passed(), "the reference passes its own cases");
+
+    let tmp = tempfile::tempdir().map_err(io("temporary folder"))?;
+    let echo = tmp.path().join("echo.py");
+    std::fs::write(&echo, ECHO_ADAPTER).map_err(io("writing the echo adapter"))?;
+    let python = std::env::var("RTORACLE_PYTHON").unwrap_or_else(|_| "python3".into());
+    let cmd = CandidateCommand::adapter(&format!("{python} -I {}", echo.display()))?;
+    let (r, d_echo, c_echo) = timed(|| super::check_command(cmd, &cases, RunOptions::default()));
+    r?;
+
+    let honest = assemble_fixture("honest_reference").map_err(io("assembling the fixture"))?;
+    let cmd = CandidateCommand::python_course(honest.path())?;
+    let (report, d_py, c_py) = timed(|| super::check_command(cmd, &cases, RunOptions::default()));
+    let py_ok = report?.passed();
+
+    let rows = [
+        ("in-process Rust reference (baseline)", d_ref, c_ref),
+        ("Python echo adapter, one flush per answer", d_echo, c_echo),
+        ("course adapter + honest Python submission", d_py, c_py),
+    ];
+    out.push_str(&format!(
+        "{:<44} {:>7} {:>10} {:>9} {:>9} {:>13}\n",
+        "candidate", "wall s", "vectors/s", "harness", "candidate", "idle-2-core/s"
+    ));
+    for (name, d, c) in rows {
+        // With the harness and the candidate on their own cores, the slower one sets the pace.
+        out.push_str(&format!(
+            "{:<44} {:>7.3} {:>10.0} {:>8.3}s {:>8.3}s {:>13.0}\n",
+            name,
+            d.as_secs_f64(),
+            rate(cases.len(), d),
+            c[0],
+            c[1],
+            cases.len() as f64 / c[0].max(c[1]).max(1e-9)
+        ));
+    }
+    out.push_str(&format!(
+        "course adapter / echo adapter wall time: {:.2}x; course adapter passed: {}\n",
+        d_py.as_secs_f64() / d_echo.as_secs_f64(),
+        py_ok
+    ));
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    out.push_str(&format!(
+        "load average during the run: {}; harness and candidate columns are CPU seconds;\n\
+         idle-2-core/s = vectors / max(harness, candidate CPU), the rate with a core each\n",
+        load.split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
+    ));
+
+    let suite = crate::oracle::default_suite(0);
+    let t = Instant::now();
+    let report = super::check_command(
+        CandidateCommand::python_course(honest.path())?,
+        &suite,
+        RunOptions::default(),
+    )?;
+    out.push_str(&format!(
+        "\ndefault suite ({} vectors) through the course adapter, start to report: {:.3} s (passed: {})\n",
+        suite.len(),
+        t.elapsed().as_secs_f64(),
+        report.passed()
+    ));
+
+    let hang = assemble_fixture("hostile_hang_on_miss").map_err(io("assembling the fixture"))?;
+    let t = Instant::now();
+    let report = super::check_command(
+        CandidateCommand::python_course(hang.path())?,
+        &suite,
+        RunOptions::default(),
+    )?;
+    out.push_str(&format!(
+        "default suite, submission hanging on every miss, 2 s timeout: {:.1} s ({} timeouts, {} not run)\n",
+        t.elapsed().as_secs_f64(),
+        report.counts.timeouts,
+        report.counts.not_run
+    ));
+    Ok(out)
+}

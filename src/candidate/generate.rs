@@ -1,0 +1,442 @@
+//! Random cases for fuzzing and for the fixtures' tests: small integers and dyadic fractions,
+//! aimed so that about half hit, with negative radii, rays from inside, primitives behind the
+//! origin, finite intervals and rays exactly parallel to a quad.
+//!
+//! Classification goes through one function, [`oracle_expect`]. Until the exact oracle
+//! (`rtoracle::oracle` generators and classification) is merged it is a *stand-in*: the
+//! reference tracer's answer, accepted as definite only when every perturbation of the inputs
+//! by a relative 1e-7 gives the same decision (so the case is far from any tangent, edge,
+//! interval end or grazing angle), and `None` otherwise. Swap its body for the exact oracle.
+
+use rand_core::Rng;
+use rand_pcg::Pcg64;
+
+use crate::geometry::{Interval, Shape};
+use crate::oracle::vectors::{Case, Class, Expect, RaySpec, ShapeKind, ShapeSpec};
+
+/// Relative size of the perturbations [`oracle_expect`] uses.
+const MARGIN: f64 = 1e-7;
+
+/// The expected answer for a case when it is definite, `None` when it is not (degenerate,
+/// non-finite, or too close to a decision boundary). Stand-in for the exact oracle: see the
+/// module docs.
+pub fn oracle_expect(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Option<Expect> {
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    let usable = finite(&shape.numbers())
+        && finite(&ray.origin)
+        && finite(&ray.direction)
+        && finite(&interval)
+        && interval[0] < interval[1];
+    if !usable {
+        return None;
+    }
+    let d = glam::DVec3::from(ray.direction);
+    let dlen = d.length();
+    if dlen == 0.0 {
+        return None;
+    }
+    let mut tags = Vec::new();
+    match *shape {
+        ShapeSpec::Sphere { radius, .. } => {
+            if radius == 0.0 {
+                return None;
+            }
+            if radius < 0.0 {
+                tags.push("negative-radius".to_string());
+            }
+        }
+        ShapeSpec::Quad { q, u, v } => {
+            let n = glam::DVec3::from(u).cross(glam::DVec3::from(v));
+            if n.length() == 0.0 {
+                return None;
+            }
+            let nd = n.normalize().dot(d);
+            if nd == 0.0 {
+                // A parallel ray in the plane is degenerate (`any`); off the plane, a miss.
+                let off = n.dot(glam::DVec3::from(ray.origin) - glam::DVec3::from(q));
+                if off.abs() <= 1e-9 * n.length() * (1.0 + glam::DVec3::from(ray.origin).length()) {
+                    return None;
+                }
+                tags.push("parallel".to_string());
+            } else if nd.abs() < 1e-6 * dlen || nd.abs() < 1e-7 {
+                // Near parallel: honest variants (near_zero or == 0) disagree.
+                return None;
+            }
+        }
+        ShapeSpec::Triangle { a, b, c } => {
+            let (a, b, c) = (
+                glam::DVec3::from(a),
+                glam::DVec3::from(b),
+                glam::DVec3::from(c),
+            );
+            let n = (b - a).cross(c - a);
+            if n.length() == 0.0 {
+                return None;
+            }
+            if n.normalize().dot(d).abs() < 1e-6 * dlen {
+                return None;
+            }
+        }
+    }
+    let answer = |s: &ShapeSpec, r: &RaySpec, i: [f64; 2]| {
+        s.object().intersect(&r.ray(), Interval::new(i[0], i[1]))
+    };
+    let base = answer(shape, ray, interval);
+    // Perturb every input by a relative MARGIN in both directions.
+    let scale = shape
+        .numbers()
+        .iter()
+        .chain(&ray.origin)
+        .fold(1.0f64, |m, x| m.max(x.abs()));
+    let mut agree = true;
+    let mut check = |s: &ShapeSpec, r: &RaySpec, i: [f64; 2]| {
+        if answer(s, r, i).is_some() != base.is_some() {
+            agree = false;
+        }
+    };
+    for k in 0..3 {
+        for sign in [-1.0, 1.0] {
+            let mut r = *ray;
+            r.origin[k] += sign * MARGIN * scale;
+            check(shape, &r, interval);
+            let mut r = *ray;
+            r.direction[k] += sign * MARGIN * dlen;
+            check(shape, &r, interval);
+        }
+    }
+    for sign in [-1.0, 1.0] {
+        for end in 0..2 {
+            let mut i = interval;
+            if i[end].abs() < 1e300 {
+                i[end] += sign * MARGIN * i[end].abs().max(1.0);
+                check(shape, ray, i);
+            }
+        }
+        let s = match *shape {
+            ShapeSpec::Sphere { center, radius } => ShapeSpec::Sphere {
+                center,
+                radius: radius * (1.0 + sign * MARGIN),
+            },
+            ShapeSpec::Quad { q, u, v } => ShapeSpec::Quad {
+                q,
+                u: u.map(|x| x * (1.0 + sign * MARGIN)),
+                v: v.map(|x| x * (1.0 + sign * MARGIN)),
+            },
+            ShapeSpec::Triangle { a, b, c } => ShapeSpec::Triangle {
+                a: a.map(|x| x + sign * MARGIN * scale),
+                b,
+                c: c.map(|x| x - sign * MARGIN * scale),
+            },
+        };
+        check(&s, ray, interval);
+    }
+    if !agree {
+        return None;
+    }
+    Some(match base {
+        None => Expect {
+            class: Class::Miss,
+            tags,
+            t: None,
+            t_tol: None,
+            point: None,
+            normal: None,
+            front_face: None,
+        },
+        Some(h) => Expect {
+            class: Class::Hit,
+            tags,
+            t: Some(h.t),
+            t_tol: Some(1e-9 * h.t.abs().max(1.0)),
+            point: Some(h.point.to_array()),
+            normal: Some(h.normal.to_array()),
+            front_face: Some(h.front_face),
+        },
+    })
+}
+
+/// A seeded stream of random inputs.
+pub struct CaseGen {
+    rng: Pcg64,
+}
+
+impl CaseGen {
+    /// The generator for `seed` (and a `stream`, so rounds of a fuzz run differ).
+    pub fn new(seed: u64, stream: u64) -> Self {
+        CaseGen {
+            rng: Pcg64::new(
+                0xcafe_f00d_d15e_a5e5_u128 ^ ((seed as u128) << 64),
+                stream as u128,
+            ),
+        }
+    }
+
+    fn below(&mut self, n: u64) -> u64 {
+        self.rng.next_u64() % n
+    }
+
+    fn int(&mut self, lo: i64, hi: i64) -> i64 {
+        lo + self.below((hi - lo + 1) as u64) as i64
+    }
+
+    fn chance(&mut self, percent: u64) -> bool {
+        self.below(100) < percent
+    }
+
+    /// A dyadic number in `[lo, hi]` with `bits` fractional bits.
+    fn dyadic(&mut self, lo: f64, hi: f64, bits: u32) -> f64 {
+        let s = (1u64 << bits) as f64;
+        self.int((lo * s).ceil() as i64, (hi * s).floor() as i64) as f64 / s
+    }
+
+    fn vec(&mut self, lo: f64, hi: f64, bits: u32) -> [f64; 3] {
+        [
+            self.dyadic(lo, hi, bits),
+            self.dyadic(lo, hi, bits),
+            self.dyadic(lo, hi, bits),
+        ]
+    }
+
+    fn nonzero_int_vec(&mut self, m: i64) -> [f64; 3] {
+        loop {
+            let v = [
+                self.int(-m, m) as f64,
+                self.int(-m, m) as f64,
+                self.int(-m, m) as f64,
+            ];
+            if v != [0.0; 3] {
+                return v;
+            }
+        }
+    }
+
+    fn interval(&mut self) -> [f64; 2] {
+        match self.below(10) {
+            0 => [self.dyadic(0.0, 4.0, 2), f64::MAX],
+            1 => {
+                let a = self.dyadic(0.0, 4.0, 2);
+                [a, a + self.dyadic(0.25, 8.0, 2)]
+            }
+            _ => [1e-6, f64::MAX],
+        }
+    }
+
+    /// Scales a direction by a random power of two or small integer (never normalised).
+    fn scale_dir(&mut self, d: [f64; 3]) -> [f64; 3] {
+        let k = [0.25, 0.5, 1.0, 1.0, 2.0, 3.0][self.below(6) as usize];
+        d.map(|x| x * k)
+    }
+
+    /// Random inputs for a `kind` primitive, with the generator's tags.
+    pub fn inputs(&mut self, kind: ShapeKind) -> (ShapeSpec, RaySpec, [f64; 2], Vec<String>) {
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let add = |a: [f64; 3], b: [f64; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+        let mul = |a: [f64; 3], k: f64| a.map(|x| x * k);
+        let mut tags = Vec::new();
+        let interval = self.interval();
+        match kind {
+            ShapeKind::Sphere => {
+                let center = self.vec(-8.0, 8.0, 2);
+                let r = self.dyadic(0.5, 6.0, 2);
+                let radius = if self.chance(20) { -r } else { r };
+                let (origin, direction) = match self.below(6) {
+                    0 => {
+                        tags.push("inside".to_string());
+                        let o = add(center, self.vec(-r / 2.0, r / 2.0, 3));
+                        (o, self.nonzero_int_vec(3))
+                    }
+                    k => {
+                        let o = self.vec(-20.0, 20.0, 1);
+                        let target = add(center, self.vec(-1.2 * r, 1.2 * r, 2));
+                        let mut d = sub(target, o);
+                        if k == 1 {
+                            tags.push("behind".to_string());
+                            d = mul(d, -1.0);
+                        }
+                        (o, d)
+                    }
+                };
+                let direction = self.scale_dir(direction);
+                (
+                    ShapeSpec::Sphere { center, radius },
+                    RaySpec { origin, direction },
+                    interval,
+                    tags,
+                )
+            }
+            ShapeKind::Quad => {
+                let q = self.vec(-8.0, 8.0, 1);
+                let (u, v) = loop {
+                    let (u, v) = if self.chance(30) {
+                        let a = self.int(1, 4) as f64;
+                        let b = self.int(1, 4) as f64;
+                        ([a, 0.0, 0.0], [0.0, b, 0.0])
+                    } else {
+                        (self.nonzero_int_vec(4), self.nonzero_int_vec(4))
+                    };
+                    let n = glam::DVec3::from(u).cross(glam::DVec3::from(v));
+                    if n != glam::DVec3::ZERO {
+                        break (u, v);
+                    }
+                };
+                let n = glam::DVec3::from(u).cross(glam::DVec3::from(v)).to_array();
+                let (origin, direction) = if self.chance(12) {
+                    tags.push("parallel".to_string());
+                    let a = self.int(-2, 2) as f64;
+                    let b = if a == 0.0 {
+                        1.0
+                    } else {
+                        self.int(-2, 2) as f64
+                    };
+                    let d = add(mul(u, a), mul(v, b));
+                    let off = [-2.0, -1.0, 1.0, 2.0][self.below(4) as usize];
+                    // Off the plane by `off` normals, above a point of the quad.
+                    let o = add(q, mul(n, off));
+                    let o = add(o, add(mul(u, self.dyadic(0.0, 1.0, 2)), mul(v, 0.5)));
+                    (o, d)
+                } else {
+                    let a = self.dyadic(-0.25, 1.25, 3);
+                    let b = self.dyadic(-0.25, 1.25, 3);
+                    let p = add(q, add(mul(u, a), mul(v, b)));
+                    let o = self.vec(-20.0, 20.0, 1);
+                    let mut d = sub(p, o);
+                    if self.chance(15) {
+                        tags.push("behind".to_string());
+                        d = mul(d, -1.0);
+                    }
+                    (o, d)
+                };
+                let direction = self.scale_dir(direction);
+                (
+                    ShapeSpec::Quad { q, u, v },
+                    RaySpec { origin, direction },
+                    interval,
+                    tags,
+                )
+            }
+            ShapeKind::Triangle => {
+                let a = self.vec(-8.0, 8.0, 1);
+                let b = add(a, self.nonzero_int_vec(5));
+                let c = add(a, self.nonzero_int_vec(5));
+                let w1 = self.dyadic(-0.3, 1.0, 3);
+                let w2 = self.dyadic(-0.3, 1.0, 3);
+                let p = add(a, add(mul(sub(b, a), w1), mul(sub(c, a), w2)));
+                let o = self.vec(-20.0, 20.0, 1);
+                let direction = self.scale_dir(sub(p, o));
+                (
+                    ShapeSpec::Triangle { a, b, c },
+                    RaySpec {
+                        origin: o,
+                        direction,
+                    },
+                    interval,
+                    tags,
+                )
+            }
+        }
+    }
+}
+
+/// `n` definite random cases of the given kinds (round-robin), deterministic for `seed` and
+/// `stream`; ids are `fuzz-<kind>-<stream>-<n>`.
+pub fn random_cases(seed: u64, stream: u64, n: usize, kinds: &[ShapeKind]) -> Vec<Case> {
+    let mut g = CaseGen::new(seed, stream);
+    let mut cases = Vec::with_capacity(n);
+    let mut attempts = 0usize;
+    while cases.len() < n && attempts < 20 * n + 100 {
+        let kind = kinds[attempts % kinds.len()];
+        attempts += 1;
+        let (shape, ray, interval, gen_tags) = g.inputs(kind);
+        if let Some(mut expect) = oracle_expect(&shape, &ray, interval) {
+            for t in gen_tags {
+                if !expect.tags.contains(&t) {
+                    expect.tags.push(t);
+                }
+            }
+            cases.push(Case {
+                id: format!("fuzz-{}-{stream}-{:05}", kind.name(), cases.len()),
+                shape,
+                ray,
+                interval,
+                expect,
+            });
+        }
+    }
+    cases
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cases_are_deterministic_mixed_and_mostly_definite() {
+        let kinds = ShapeKind::ALL;
+        let a = random_cases(7, 0, 600, &kinds);
+        assert_eq!(a, random_cases(7, 0, 600, &kinds));
+        assert_eq!(a.len(), 600);
+        let hits = a.iter().filter(|c| c.expect.class == Class::Hit).count();
+        assert!((150..450).contains(&hits), "{hits} hits of 600");
+        for tag in ["negative-radius", "inside", "behind", "parallel"] {
+            assert!(
+                a.iter().any(|c| c.expect.tags.iter().any(|t| t == tag)),
+                "{tag}"
+            );
+        }
+        // A parallel ray off the plane is a definite miss.
+        assert!(
+            a.iter()
+                .filter(|c| c.expect.tags.iter().any(|t| t == "parallel"))
+                .all(|c| c.expect.class == Class::Miss)
+        );
+    }
+
+    #[test]
+    fn boundary_cases_are_not_definite() {
+        // Tangent: the ray grazes the unit sphere at x = 1.
+        let s = ShapeSpec::Sphere {
+            center: [0.0; 3],
+            radius: 1.0,
+        };
+        let tangent = RaySpec {
+            origin: [1.0, 0.0, 5.0],
+            direction: [0.0, 0.0, -1.0],
+        };
+        assert!(oracle_expect(&s, &tangent, [1e-6, f64::MAX]).is_none());
+        // Hit exactly at t_max = 4.
+        let down = RaySpec {
+            origin: [0.0, 0.0, 5.0],
+            direction: [0.0, 0.0, -1.0],
+        };
+        assert!(oracle_expect(&s, &down, [1e-6, 4.0]).is_none());
+        let e = oracle_expect(&s, &down, [1e-6, 4.5]).unwrap();
+        assert_eq!((e.class, e.t), (Class::Hit, Some(4.0)));
+        // A ray exactly parallel to a quad: in its plane degenerate, off it a miss.
+        let q = ShapeSpec::Quad {
+            q: [0.0; 3],
+            u: [1.0, 0.0, 0.0],
+            v: [0.0, 1.0, 0.0],
+        };
+        let along = |z: f64| RaySpec {
+            origin: [-1.0, 0.5, z],
+            direction: [1.0, 0.0, 0.0],
+        };
+        assert!(oracle_expect(&q, &along(0.0), [1e-6, f64::MAX]).is_none());
+        let e = oracle_expect(&q, &along(0.5), [1e-6, f64::MAX]).unwrap();
+        assert_eq!(
+            (e.class, e.tags),
+            (Class::Miss, vec!["parallel".to_string()])
+        );
+        // Quad edge.
+        let q = ShapeSpec::Quad {
+            q: [0.0; 3],
+            u: [1.0, 0.0, 0.0],
+            v: [0.0, 1.0, 0.0],
+        };
+        let edge = RaySpec {
+            origin: [1.0, 0.5, 1.0],
+            direction: [0.0, 0.0, -1.0],
+        };
+        assert!(oracle_expect(&q, &edge, [1e-6, f64::MAX]).is_none());
+    }
+}

@@ -1,0 +1,442 @@
+//! The check report: counts overall and per shape group, every failure with a reproduction, the
+//! candidate's import error and the end of its stderr; JSON (serde) and text renderings.
+//!
+//! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
+//! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
+//! `errors` counts raised errors, dead processes and protocol errors. `ambiguous` counts the
+//! `ambiguous` and `any` vectors, which are run and reported but never scored.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use super::check::{FailureKind, Verdict, judge};
+use super::process::Outcome;
+use super::protocol::{Answer, CandidateError};
+use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
+
+/// Counts of one group (or of the whole run).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counts {
+    /// Definite vectors.
+    pub total: usize,
+    /// Definite vectors answered right.
+    pub passed: usize,
+    /// Wrong answers.
+    pub failed: usize,
+    /// Errors raised, processes dead, protocol errors.
+    pub errors: usize,
+    /// Timeouts.
+    pub timeouts: usize,
+    /// Definite vectors not run.
+    pub not_run: usize,
+    /// `ambiguous` and `any` vectors (not scored).
+    pub ambiguous: usize,
+}
+
+impl Counts {
+    fn add(&mut self, verdict: &Verdict) {
+        match verdict {
+            Verdict::NotScored => self.ambiguous += 1,
+            Verdict::Pass => {
+                self.total += 1;
+                self.passed += 1;
+            }
+            Verdict::Fail { kind, .. } => {
+                self.total += 1;
+                match kind {
+                    FailureKind::Mismatch => self.failed += 1,
+                    FailureKind::Error | FailureKind::Protocol => self.errors += 1,
+                    FailureKind::Timeout => self.timeouts += 1,
+                    FailureKind::NotRun => self.not_run += 1,
+                }
+            }
+        }
+    }
+
+    /// Whether no definite vector failed, raised an error or timed out, and at least one
+    /// passed if there were any (vectors not run, e.g. of a shape the candidate does not
+    /// implement, do not count against it, but a candidate that runs nothing does not pass).
+    pub fn all_passed(&self) -> bool {
+        self.failed == 0
+            && self.errors == 0
+            && self.timeouts == 0
+            && (self.total == 0 || self.passed > 0)
+    }
+}
+
+/// One definite vector that did not pass.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    /// The vector's id.
+    pub id: String,
+    /// Its shape group.
+    pub shape: ShapeKind,
+    /// Its tags.
+    pub tags: Vec<String>,
+    /// What kind of failure.
+    pub kind: FailureKind,
+    /// The oracle's answer.
+    pub expected: Expect,
+    /// The candidate's answer, when it gave one.
+    pub actual: Option<Answer>,
+    /// One line saying what went wrong.
+    pub message: String,
+    /// A Python snippet that reproduces the case against the course's API.
+    pub repro: String,
+    /// The request line, for reproducing it with any adapter.
+    pub request: String,
+}
+
+/// The result of checking a candidate against a suite.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CheckReport {
+    /// The candidate's name (from its hello).
+    pub candidate: String,
+    /// Counts over all shapes.
+    #[serde(flatten)]
+    pub counts: Counts,
+    /// Counts per shape group (all three groups are always present).
+    pub by_shape: BTreeMap<ShapeKind, Counts>,
+    /// Every definite vector that did not pass, in suite order.
+    pub failures: Vec<Failure>,
+    /// The error that kept the candidate from answering anything (a submission that cannot be
+    /// imported), also reported on every case.
+    pub import_error: Option<CandidateError>,
+    /// Why the candidate could not be started at all, if so.
+    pub start_failure: Option<String>,
+    /// The last 4 KB the candidate wrote to stderr.
+    pub stderr_tail: String,
+    /// How many times the candidate's process was restarted.
+    pub restarts: u32,
+}
+
+/// Extra facts about a run for [`build_report`].
+#[derive(Clone, Debug, Default)]
+pub struct RunInfo {
+    /// The candidate's name.
+    pub candidate: String,
+    /// Its import error, if any.
+    pub import_error: Option<CandidateError>,
+    /// Why it could not start, if so.
+    pub start_failure: Option<String>,
+    /// The end of its stderr.
+    pub stderr_tail: String,
+    /// Restarts.
+    pub restarts: u32,
+}
+
+/// Judges every outcome and builds the report.
+pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> CheckReport {
+    assert_eq!(cases.len(), outcomes.len(), "one outcome per case");
+    let mut counts = Counts::default();
+    let mut by_shape: BTreeMap<ShapeKind, Counts> = ShapeKind::ALL
+        .iter()
+        .map(|&k| (k, Counts::default()))
+        .collect();
+    let mut failures = Vec::new();
+    for (case, outcome) in cases.iter().zip(outcomes) {
+        let verdict = judge(case, outcome);
+        counts.add(&verdict);
+        by_shape
+            .get_mut(&case.shape.kind())
+            .expect("every kind")
+            .add(&verdict);
+        if let Verdict::Fail { kind, message } = verdict {
+            let actual = match outcome {
+                Outcome::Answered { answer, .. } => Some(answer.clone()),
+                _ => None,
+            };
+            failures.push(Failure {
+                id: case.id.clone(),
+                shape: case.shape.kind(),
+                tags: case.expect.tags.clone(),
+                kind,
+                expected: case.expect.clone(),
+                actual,
+                message,
+                repro: python_repro(case),
+                request: super::protocol::Request::for_case(case).to_line(),
+            });
+        }
+    }
+    CheckReport {
+        candidate: info.candidate,
+        counts,
+        by_shape,
+        failures,
+        import_error: info.import_error,
+        start_failure: info.start_failure,
+        stderr_tail: info.stderr_tail,
+        restarts: info.restarts,
+    }
+}
+
+impl CheckReport {
+    /// Whether no definite vector failed, raised an error or timed out (exit code 0); see
+    /// [`Counts::all_passed`].
+    pub fn passed(&self) -> bool {
+        self.counts.all_passed()
+    }
+
+    /// The report as one JSON object.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a report always serialises")
+    }
+
+    /// A summary table and the first `max_failures` failures with their reproductions.
+    pub fn to_text(&self, max_failures: usize) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "candidate: {}", self.candidate);
+        if let Some(e) = &self.import_error {
+            let _ = writeln!(s, "the submission could not be imported: {e}");
+            if !e.traceback.is_empty() {
+                for line in e.traceback.trim_end().lines() {
+                    let _ = writeln!(s, "    {line}");
+                }
+            }
+        }
+        if let Some(f) = &self.start_failure {
+            let _ = writeln!(s, "the candidate could not be started: {f}");
+        }
+        let _ = writeln!(
+            s,
+            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10}",
+            "shape", "total", "passed", "failed", "errors", "timeouts", "not_run", "ambiguous"
+        );
+        let row = |s: &mut String, name: &str, c: &Counts| {
+            let _ = writeln!(
+                s,
+                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10}",
+                name, c.total, c.passed, c.failed, c.errors, c.timeouts, c.not_run, c.ambiguous
+            );
+        };
+        for (kind, c) in &self.by_shape {
+            row(&mut s, kind.name(), c);
+        }
+        row(&mut s, "all", &self.counts);
+        let _ = writeln!(
+            s,
+            "\nverdict: {} ({} of {} definite vectors passed{})",
+            if self.passed() { "PASS" } else { "FAIL" },
+            self.counts.passed,
+            self.counts.total,
+            if self.counts.not_run > 0 {
+                format!(", {} not run", self.counts.not_run)
+            } else {
+                String::new()
+            }
+        );
+        if self.restarts > 0 {
+            let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
+        }
+        // Vectors not run: one line per reason.
+        let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();
+        for f in self
+            .failures
+            .iter()
+            .filter(|f| f.kind == FailureKind::NotRun)
+        {
+            *reasons.entry(f.message.as_str()).or_default() += 1;
+        }
+        for (reason, n) in reasons {
+            let _ = writeln!(s, "not run: {n} vectors: {reason}");
+        }
+        let shown: Vec<&Failure> = self
+            .failures
+            .iter()
+            .filter(|f| f.kind != FailureKind::NotRun)
+            .collect();
+        if !shown.is_empty() {
+            let _ = writeln!(
+                s,
+                "\nfirst {} of {} failures:",
+                shown.len().min(max_failures),
+                shown.len()
+            );
+            for f in shown.into_iter().take(max_failures) {
+                let _ = writeln!(
+                    s,
+                    "\n[{}] {} ({}): {}",
+                    f.kind.name(),
+                    f.id,
+                    f.shape,
+                    f.message
+                );
+                if !f.tags.is_empty() {
+                    let _ = writeln!(s, "  tags: {}", f.tags.join(", "));
+                }
+                let _ = writeln!(s, "  reproduce (run in the submission folder):");
+                for line in f.repro.lines() {
+                    let _ = writeln!(s, "    {line}");
+                }
+            }
+        }
+        let tail = self.stderr_tail.trim_end();
+        if !tail.is_empty() {
+            let _ = writeln!(s, "\nend of the candidate's stderr:");
+            for line in tail
+                .lines()
+                .rev()
+                .take(20)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+            {
+                let _ = writeln!(s, "    {line}");
+            }
+        }
+        s
+    }
+}
+
+/// A float as a Python literal that reads back to the same bits.
+fn py(x: f64) -> String {
+    if x.is_nan() {
+        "float('nan')".into()
+    } else if x.is_infinite() {
+        if x > 0.0 {
+            "float('inf')".into()
+        } else {
+            "float('-inf')".into()
+        }
+    } else {
+        format!("{x:?}")
+    }
+}
+
+fn py3(v: [f64; 3]) -> String {
+    format!("Vec3({}, {}, {})", py(v[0]), py(v[1]), py(v[2]))
+}
+
+/// A Python snippet that reproduces `case` against the course's API: builds the object with
+/// the course's constructor, calls `intersect` and prints what it got and what it should get.
+pub fn python_repro(case: &Case) -> String {
+    let (class_name, ctor) = match case.shape {
+        ShapeSpec::Sphere { center, radius } => (
+            "Sphere",
+            format!("Sphere({}, {}, None)", py3(center), py(radius)),
+        ),
+        ShapeSpec::Quad { q, u, v } => (
+            "Quad",
+            format!("Quad({}, {}, {}, None)", py3(q), py3(u), py3(v)),
+        ),
+        ShapeSpec::Triangle { a, b, c } => (
+            "Triangle",
+            format!("Triangle({}, {}, {})", py3(a), py3(b), py3(c)),
+        ),
+    };
+    let e = &case.expect;
+    let expected = match e.class {
+        Class::Miss => "a miss (None)".to_string(),
+        Class::Hit => {
+            let mut s = String::from("a hit");
+            if let Some(t) = e.t {
+                s.push_str(&format!(" at t = {}", py(t)));
+                if let Some(tol) = e.t_tol {
+                    s.push_str(&format!(" (+- {tol:.1e})"));
+                }
+            }
+            if let Some(n) = e.normal {
+                s.push_str(&format!(
+                    ", normal ({}, {}, {})",
+                    py(n[0]),
+                    py(n[1]),
+                    py(n[2])
+                ));
+            }
+            if let Some(f) = e.front_face {
+                s.push_str(&format!(
+                    ", front_face {}",
+                    if f { "True" } else { "False" }
+                ));
+            }
+            s
+        }
+        Class::Ambiguous => "ambiguous (not scored)".to_string(),
+        Class::Any => "anything (not scored)".to_string(),
+    };
+    format!(
+        "from RT_utility import Vec3, Interval\n\
+         from RT_ray import Ray\n\
+         from RT_object import {class_name}\n\
+         obj = {ctor}\n\
+         ray = Ray({}, {})\n\
+         hit = obj.intersect(ray, Interval({}, {}))\n\
+         print(None if hit is None else (hit.getT(), hit.getNormal().e, hit.front_face))\n\
+         # expected: {expected}\n",
+        py3(case.ray.origin),
+        py3(case.ray.direction),
+        py(case.interval[0]),
+        py(case.interval[1]),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_add_up_per_group_and_overall() {
+        let cases = crate::oracle::default_suite(0);
+        let mut outcomes: Vec<Outcome> = cases
+            .iter()
+            .map(|c| Outcome::Answered {
+                answer: Answer::from_record(crate::geometry::Shape::intersect(
+                    &c.shape.object(),
+                    &c.ray.ray(),
+                    c.interval(),
+                )),
+                junk: vec![],
+            })
+            .collect();
+        let report = build_report(&cases, &outcomes, RunInfo::default());
+        assert!(report.passed(), "{}", report.to_text(5));
+        let none_run: Vec<Outcome> = cases
+            .iter()
+            .map(|_| Outcome::NotRun {
+                reason: "unsupported".into(),
+            })
+            .collect();
+        let report = build_report(&cases, &none_run, RunInfo::default());
+        assert!(
+            !report.passed(),
+            "a candidate that runs nothing does not pass"
+        );
+        outcomes[1] = Outcome::Timeout { junk: vec![] };
+        outcomes[2] = Outcome::NotRun { reason: "r".into() };
+        let report = build_report(&cases, &outcomes, RunInfo::default());
+        assert!(!report.passed());
+        let c = report.counts;
+        assert!(!c.all_passed());
+        assert_eq!((c.total, c.passed, c.timeouts, c.not_run), (5, 3, 1, 1));
+        assert_eq!(report.by_shape[&ShapeKind::Sphere].timeouts, 1);
+        assert_eq!(report.by_shape[&ShapeKind::Quad].not_run, 1);
+        assert_eq!(report.failures.len(), 2);
+        let json: serde_json::Value = serde_json::from_str(&report.to_json()).unwrap();
+        for key in [
+            "total",
+            "passed",
+            "failed",
+            "errors",
+            "timeouts",
+            "not_run",
+            "ambiguous",
+        ] {
+            assert!(json[key].is_u64(), "{key}");
+            assert!(json["by_shape"]["triangle"][key].is_u64(), "{key}");
+        }
+        assert_eq!(json["failures"][0]["kind"], "timeout");
+        assert_eq!(json["failures"][1]["kind"], "not_run");
+    }
+
+    #[test]
+    fn python_literals_read_back_exactly() {
+        assert_eq!(py(0.1), "0.1");
+        assert_eq!(py(4.0), "4.0");
+        assert_eq!(py(f64::MAX), "1.7976931348623157e308");
+        assert_eq!(py(1e-6), "1e-6");
+        assert_eq!(py(f64::NEG_INFINITY), "float('-inf')");
+    }
+}
