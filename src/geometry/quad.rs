@@ -45,23 +45,44 @@ impl Quad {
     /// The course's decision, with `(t, alpha, beta)` of a hit.
     #[inline]
     fn solve(&self, ray: &Ray, interval: Interval) -> Option<(f64, f64, f64)> {
+        self.solve_from(ray, self.plane_offset(ray.origin), interval)
+    }
+
+    /// `d - normal . origin`: the numerator of the plane's `t` for rays from `origin`, which the
+    /// renderer's fixed-origin fast path computes once per render.
+    #[inline(always)]
+    pub(crate) fn plane_offset(&self, origin: DVec3) -> f64 {
+        self.d - self.normal.dot(origin)
+    }
+
+    /// The course's decision given `offset = self.plane_offset(ray.origin)`. [`Shape::hit_t`] and
+    /// the fast path both call it, so they agree bit for bit.
+    #[inline(always)]
+    pub(crate) fn solve_from(
+        &self,
+        ray: &Ray,
+        offset: f64,
+        interval: Interval,
+    ) -> Option<(f64, f64, f64)> {
         let denom = self.normal.dot(ray.direction);
         // `!(|denom| >= eps)` also rejects a NaN normal (degenerate quad) and NaN input.
         if !(denom.abs() >= PARALLEL_EPSILON) {
             return None;
         }
-        let t = (self.d - self.normal.dot(ray.origin)) / denom;
+        let t = offset / denom;
         if !interval.contains(t) {
             return None;
         }
         let planar = ray.at(t) - self.q;
         let alpha = self.w.dot(planar.cross(self.v));
-        let beta = self.w.dot(self.u.cross(planar));
-        if (0.0..=1.0).contains(&alpha) && (0.0..=1.0).contains(&beta) {
-            Some((t, alpha, beta))
-        } else {
-            None
+        if !(0.0..=1.0).contains(&alpha) {
+            return None;
         }
+        let beta = self.w.dot(self.u.cross(planar));
+        if !(0.0..=1.0).contains(&beta) {
+            return None;
+        }
+        Some((t, alpha, beta))
     }
 }
 

@@ -30,25 +30,8 @@ impl Sphere {
     pub fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
         let d = ray.direction;
         let f = ray.origin - self.center;
-        let a = d.dot(d);
-        let half_b = f.dot(d);
         let r2 = self.radius * self.radius;
-        let perpendicular = f - d * (half_b / a);
-        let disc = a * (r2 - perpendicular.dot(perpendicular));
-        // `!(disc >= 0)` also rejects NaN.
-        if !(disc >= 0.0) {
-            return None;
-        }
-        let c = f.dot(f) - r2;
-        let q = -(half_b + disc.sqrt().copysign(half_b));
-        if q == 0.0 {
-            // Tangent with the origin on the tangent point's plane: a double root at -b'/a.
-            let t = -half_b / a;
-            return Some((t, t));
-        }
-        let t0 = c / q;
-        let t1 = q / a;
-        Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) })
+        roots_of(f, d, d.dot(d), r2, || f.dot(f) - r2)
     }
 
     /// The spherical surface coordinates `(u, v)` in `[0, 1]` of a point whose outward unit
@@ -65,14 +48,51 @@ impl Sphere {
     /// The root the course takes: the near one if the interval surrounds it, else the far one.
     #[inline]
     fn pick_root(&self, ray: &Ray, interval: Interval) -> Option<f64> {
-        let (near, far) = self.roots(ray)?;
-        if interval.surrounds(near) {
-            Some(near)
-        } else if interval.surrounds(far) {
-            Some(far)
-        } else {
-            None
-        }
+        pick_root(self.roots(ray)?, interval)
+    }
+}
+
+/// The roots of a sphere from the ray's parts: `f = origin - center`, the direction `d`,
+/// `a = d . d`, `r2 = radius^2` and `c()` computing `f . f - r2` (called only when the ray meets
+/// the sphere). [`Sphere::roots`] and the renderer's fixed-origin fast path (which precomputes `f`
+/// and `c` once per render and `a` once per ray) both call this, so they agree bit for bit.
+#[inline(always)]
+pub(crate) fn roots_of(
+    f: DVec3,
+    d: DVec3,
+    a: f64,
+    r2: f64,
+    c: impl FnOnce() -> f64,
+) -> Option<(f64, f64)> {
+    let half_b = f.dot(d);
+    let perpendicular = f - d * (half_b / a);
+    let disc = a * (r2 - perpendicular.dot(perpendicular));
+    // `!(disc >= 0)` also rejects NaN.
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let c = c();
+    let q = -(half_b + disc.sqrt().copysign(half_b));
+    if q == 0.0 {
+        // Tangent with the origin on the tangent point's plane: a double root at -b'/a.
+        let t = -half_b / a;
+        return Some((t, t));
+    }
+    let t0 = c / q;
+    let t1 = q / a;
+    Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) })
+}
+
+/// The root the course takes of `(near, far)`: the near one if the interval surrounds it, else
+/// the far one.
+#[inline(always)]
+pub(crate) fn pick_root((near, far): (f64, f64), interval: Interval) -> Option<f64> {
+    if interval.surrounds(near) {
+        Some(near)
+    } else if interval.surrounds(far) {
+        Some(far)
+    } else {
+        None
     }
 }
 

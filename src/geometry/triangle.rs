@@ -35,7 +35,35 @@ impl Triangle {
     /// The watertight decision with `(t, beta, gamma)`, the barycentric weights of `b` and `c`.
     #[inline]
     fn solve(&self, ray: &Ray, interval: Interval) -> Option<(f64, f64, f64)> {
-        let d = ray.direction;
+        let shear = Shear::of(ray.direction)?;
+        solve_sheared(
+            self.a - ray.origin,
+            self.b - ray.origin,
+            self.c - ray.origin,
+            &shear,
+            interval,
+        )
+    }
+}
+
+/// The per-ray part of the watertight test: the axis permutation that makes the direction's
+/// largest component z, and the shear that maps the direction onto +z. It depends only on the
+/// direction, so the renderer computes it once per ray for all triangles.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Shear {
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f64,
+    sy: f64,
+    sz: f64,
+}
+
+impl Shear {
+    /// The shear of direction `d`, or `None` when `d` has no usable largest component (zero or
+    /// not finite), in which case no triangle is hit.
+    #[inline]
+    pub(crate) fn of(d: DVec3) -> Option<Shear> {
         let ad = d.abs();
         // The axis along which the direction is largest becomes z.
         let kz = if ad.x > ad.y {
@@ -55,37 +83,59 @@ impl Triangle {
         if dz == 0.0 || !dz.is_finite() {
             return None;
         }
-        let sx = d[kx] / dz;
-        let sy = d[ky] / dz;
-        let sz = 1.0 / dz;
-
-        let a = self.a - ray.origin;
-        let b = self.b - ray.origin;
-        let c = self.c - ray.origin;
-        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
-
-        // Edge functions: U for edge bc, V for ca, W for ab.
-        let u = cx * by - cy * bx;
-        let v = ax * cy - ay * cx;
-        let w = bx * ay - by * ax;
-        let negative = u < 0.0 || v < 0.0 || w < 0.0;
-        let positive = u > 0.0 || v > 0.0 || w > 0.0;
-        if (negative && positive) || u.is_nan() || v.is_nan() || w.is_nan() {
-            return None;
-        }
-        let det = u + v + w;
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
-        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
-        let t = (u * az + v * bz + w * cz) / det;
-        if !interval.contains(t) {
-            return None;
-        }
-        Some((t, v / det, w / det))
+        Some(Shear {
+            kx,
+            ky,
+            kz,
+            sx: d[kx] / dz,
+            sy: d[ky] / dz,
+            sz: 1.0 / dz,
+        })
     }
+}
+
+/// The watertight decision for the vertices relative to the ray's origin (`a - origin`, ...)
+/// under the ray's `shear`. [`Triangle`]'s `intersect` and the renderer's fixed-origin fast path
+/// (which subtracts the origin once per render) both call it, so they agree bit for bit.
+#[inline(always)]
+pub(crate) fn solve_sheared(
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    shear: &Shear,
+    interval: Interval,
+) -> Option<(f64, f64, f64)> {
+    let Shear {
+        kx,
+        ky,
+        kz,
+        sx,
+        sy,
+        sz,
+    } = *shear;
+    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+
+    // Edge functions: U for edge bc, V for ca, W for ab.
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    let negative = u < 0.0 || v < 0.0 || w < 0.0;
+    let positive = u > 0.0 || v > 0.0 || w > 0.0;
+    if (negative && positive) || u.is_nan() || v.is_nan() || w.is_nan() {
+        return None;
+    }
+    let det = u + v + w;
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+    let t = (u * az + v * bz + w * cz) / det;
+    if !interval.contains(t) {
+        return None;
+    }
+    Some((t, v / det, w / det))
 }
 
 impl Shape for Triangle {
