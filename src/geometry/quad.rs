@@ -58,6 +58,8 @@ impl Quad {
     /// The course's decision given `offset = self.plane_offset(ray.origin)`. [`Shape::hit_t`] and
     /// the fast path both call it, so they agree bit for bit.
     #[inline(always)]
+    // `!(x >= y)` is meant: it is true for NaN too.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub(crate) fn solve_from(
         &self,
         ray: &Ray,

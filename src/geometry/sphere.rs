@@ -57,6 +57,8 @@ impl Sphere {
 /// the sphere). [`Sphere::roots`] and the renderer's fixed-origin fast path (which precomputes `f`
 /// and `c` once per render and `a` once per ray) both call this, so they agree bit for bit.
 #[inline(always)]
+// `!(x >= y)` is meant: it is true for NaN too.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub(crate) fn roots_of(
     f: DVec3,
     d: DVec3,

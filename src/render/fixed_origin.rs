@@ -248,7 +248,8 @@ mod tests {
         ] {
             let expected = scene.closest(&Ray::new(origin, d), Interval::CAMERA);
             assert_eq!(
-                fast.closest(d, Interval::CAMERA).map(|(t, i)| (t.to_bits(), i)),
+                fast.closest(d, Interval::CAMERA)
+                    .map(|(t, i)| (t.to_bits(), i)),
                 expected.map(|(t, i)| (t.to_bits(), i)),
                 "{d}"
             );

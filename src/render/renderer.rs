@@ -162,9 +162,7 @@ impl<T: Trace> Job<'_, T> {
                 } else {
                     (0.0, 0.0)
                 };
-                let ray = self
-                    .camera
-                    .ray_through(i as f64 + ox, j as f64 + oy, disk);
+                let ray = self.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
                 let colour = self.tracer.trace(&ray);
                 sum += colour;
                 if VARIANCE {
