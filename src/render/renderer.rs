@@ -143,6 +143,8 @@ impl<T: Trace> Job<'_, T> {
         for (i, mean) in means.iter_mut().enumerate() {
             let mut sampler = PixelSampler::new(self.seed, (j * width + i) as u64);
             let mut sum = DVec3::ZERO;
+            let mut lowest = DVec3::INFINITY;
+            let mut highest = DVec3::NEG_INFINITY;
             let mut running_mean = DVec3::ZERO;
             let mut m2 = DVec3::ZERO;
             for s in 0..self.spp {
@@ -165,13 +167,22 @@ impl<T: Trace> Job<'_, T> {
                 let ray = self.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
                 let colour = self.tracer.trace(&ray);
                 sum += colour;
+                lowest = lowest.min(colour);
+                highest = highest.max(colour);
                 if VARIANCE {
                     let delta = colour - running_mean;
                     running_mean += delta / (s + 1) as f64;
                     m2 += delta * (colour - running_mean);
                 }
             }
-            *mean = sum / self.spp as f64;
+            // The sum over the count, except when every sample saw the same colour: then that
+            // colour exactly (a sum of equal values over their count can be off by an ulp:
+            // (0.2 + 0.2 + 0.2) / 3 = 0.20000000000000004).
+            *mean = if lowest == highest {
+                lowest
+            } else {
+                sum / self.spp as f64
+            };
             if VARIANCE {
                 variances[i] = if self.spp > 1 {
                     m2 / (self.spp - 1) as f64
