@@ -30,20 +30,55 @@ const PREFILTER_MARGIN: f64 = 1e-12;
 const SANE_MIN: f64 = 1e-100;
 const SANE_MAX: f64 = 1e100;
 
+/// A sphere's origin-dependent constants.
+#[derive(Clone, Copy, Debug)]
+struct PreparedSphere {
+    /// `origin - center`.
+    f: DVec3,
+    /// `radius^2`.
+    r2: f64,
+    /// `f . f - r2`.
+    c: f64,
+    /// `f . f + r2`, the scale of the discriminant's rounding errors, or NaN where the
+    /// pre-filter is off (see [`PREFILTER_MARGIN`]).
+    scale: f64,
+}
+
+impl PreparedSphere {
+    fn new(sphere: &crate::geometry::Sphere, origin: DVec3) -> Self {
+        let f = origin - sphere.center;
+        let r2 = sphere.radius * sphere.radius;
+        let scale = f.dot(f) + r2;
+        Self {
+            f,
+            r2,
+            c: f.dot(f) - r2,
+            scale: if (SANE_MIN..SANE_MAX).contains(&scale) {
+                scale
+            } else {
+                f64::NAN
+            },
+        }
+    }
+
+    /// The sphere's hit along `d` within `within`, given `a = d . d` and
+    /// `a_margin = a * PREFILTER_MARGIN` (or NaN).
+    #[inline(always)]
+    fn hit_t(&self, d: DVec3, a: f64, a_margin: f64, within: Interval) -> Option<f64> {
+        let half_b = self.f.dot(d);
+        if half_b * half_b - a * self.c < -(a_margin * self.scale) {
+            // A sure miss: see the pre-filter's note above.
+            None
+        } else {
+            roots_of(self.f, d, a, self.r2, || self.c).and_then(|roots| pick_root(roots, within))
+        }
+    }
+}
+
 /// One object with its origin-dependent constants.
 #[derive(Clone, Copy, Debug)]
 enum Prepared {
-    Sphere {
-        /// `origin - center`.
-        f: DVec3,
-        /// `radius^2`.
-        r2: f64,
-        /// `f . f - r2`.
-        c: f64,
-        /// `f . f + r2`, the scale of the discriminant's rounding errors, or NaN where the
-        /// pre-filter is off (see [`FixedOrigin::closest`]).
-        scale: f64,
-    },
+    Sphere(PreparedSphere),
     Quad {
         quad: Quad,
         /// `quad.d - quad.normal . origin`.
@@ -59,11 +94,21 @@ enum Prepared {
     },
 }
 
+/// The objects, with the common cases of a scene of one kind stored without the enum, so the
+/// closest-hit loop over them has no branch on the kind (the course's scenes are all spheres or
+/// all quads). The order is kept either way.
+#[derive(Clone, Debug)]
+enum Layout {
+    Spheres(Vec<PreparedSphere>),
+    Quads(Vec<(Quad, f64)>),
+    Mixed(Vec<Prepared>),
+}
+
 /// A scene prepared for rays from one origin.
 #[derive(Clone, Debug)]
 pub(crate) struct FixedOrigin {
     origin: DVec3,
-    objects: Vec<Prepared>,
+    layout: Layout,
     has_triangles: bool,
 }
 
@@ -74,21 +119,7 @@ impl FixedOrigin {
             .objects
             .iter()
             .map(|o| match o.shape {
-                Object::Sphere(s) => {
-                    let f = origin - s.center;
-                    let r2 = s.radius * s.radius;
-                    let scale = f.dot(f) + r2;
-                    Prepared::Sphere {
-                        f,
-                        r2,
-                        c: f.dot(f) - r2,
-                        scale: if (SANE_MIN..SANE_MAX).contains(&scale) {
-                            scale
-                        } else {
-                            f64::NAN
-                        },
-                    }
-                }
+                Object::Sphere(s) => Prepared::Sphere(PreparedSphere::new(&s, origin)),
                 Object::Quad(quad) => Prepared::Quad {
                     quad,
                     offset: quad.plane_offset(origin),
@@ -104,9 +135,32 @@ impl FixedOrigin {
         let has_triangles = objects
             .iter()
             .any(|o| matches!(o, Prepared::Triangle { .. }));
+        let layout = if objects.iter().all(|o| matches!(o, Prepared::Sphere(_))) {
+            Layout::Spheres(
+                objects
+                    .iter()
+                    .filter_map(|o| match o {
+                        Prepared::Sphere(s) => Some(*s),
+                        _ => None,
+                    })
+                    .collect(),
+            )
+        } else if objects.iter().all(|o| matches!(o, Prepared::Quad { .. })) {
+            Layout::Quads(
+                objects
+                    .iter()
+                    .filter_map(|o| match o {
+                        Prepared::Quad { quad, offset } => Some((*quad, *offset)),
+                        _ => None,
+                    })
+                    .collect(),
+            )
+        } else {
+            Layout::Mixed(objects)
+        };
         Self {
             origin,
-            objects,
+            layout,
             has_triangles,
         }
     }
@@ -129,38 +183,52 @@ impl FixedOrigin {
         } else {
             f64::NAN
         };
-        let shear = if self.has_triangles {
-            Shear::of(d)
-        } else {
-            None
-        };
         let mut best = None;
         let mut closest = interval.max;
-        for (index, object) in self.objects.iter().enumerate() {
-            let within = Interval::new(interval.min, closest);
-            let t = match *object {
-                Prepared::Sphere { f, r2, c, scale } => {
-                    let half_b = f.dot(d);
-                    if half_b * half_b - a * c < -(a_margin * scale) {
-                        // A sure miss: see the pre-filter's note above.
-                        None
-                    } else {
-                        roots_of(f, d, a, r2, || c).and_then(|roots| pick_root(roots, within))
+        match &self.layout {
+            Layout::Spheres(spheres) => {
+                for (index, sphere) in spheres.iter().enumerate() {
+                    let within = Interval::new(interval.min, closest);
+                    if let Some(t) = sphere.hit_t(d, a, a_margin, within) {
+                        closest = t;
+                        best = Some((t, index));
                     }
                 }
-                Prepared::Quad { ref quad, offset } => {
-                    quad.solve_from(&ray, offset, within).map(|(t, _, _)| t)
-                }
-                Prepared::Triangle { a, b, c, usable } => match shear {
-                    Some(ref shear) if usable => {
-                        solve_sheared(a, b, c, shear, within).map(|(t, _, _)| t)
+            }
+            Layout::Quads(quads) => {
+                for (index, (quad, offset)) in quads.iter().enumerate() {
+                    let within = Interval::new(interval.min, closest);
+                    if let Some((t, _, _)) = quad.solve_from(&ray, *offset, within) {
+                        closest = t;
+                        best = Some((t, index));
                     }
-                    _ => None,
-                },
-            };
-            if let Some(t) = t {
-                closest = t;
-                best = Some((t, index));
+                }
+            }
+            Layout::Mixed(objects) => {
+                let shear = if self.has_triangles {
+                    Shear::of(d)
+                } else {
+                    None
+                };
+                for (index, object) in objects.iter().enumerate() {
+                    let within = Interval::new(interval.min, closest);
+                    let t = match *object {
+                        Prepared::Sphere(ref sphere) => sphere.hit_t(d, a, a_margin, within),
+                        Prepared::Quad { ref quad, offset } => {
+                            quad.solve_from(&ray, offset, within).map(|(t, _, _)| t)
+                        }
+                        Prepared::Triangle { a, b, c, usable } => match shear {
+                            Some(ref shear) if usable => {
+                                solve_sheared(a, b, c, shear, within).map(|(t, _, _)| t)
+                            }
+                            _ => None,
+                        },
+                    };
+                    if let Some(t) = t {
+                        closest = t;
+                        best = Some((t, index));
+                    }
+                }
             }
         }
         best
