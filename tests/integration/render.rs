@@ -481,7 +481,11 @@ fn thread_count_does_not_change_the_bytes() {
 
 /// Runs a render that must fail: exit 2, one line on stderr naming the problem, no panic, and
 /// no file left behind in the folder.
-fn assert_render_refused(files: &[(&str, &str)], args: &[&str], needle: &str) {
+fn assert_render_refused(
+    files: &[(&str, &str)],
+    args: &[&str],
+    needle: &str,
+) -> std::process::Output {
     let dir = tempfile::tempdir().unwrap();
     for (name, text) in files {
         std::fs::write(dir.path().join(name), text).unwrap();
@@ -490,6 +494,7 @@ fn assert_render_refused(files: &[(&str, &str)], args: &[&str], needle: &str) {
     let out = run_in(dir.path(), args);
     assert_bad_input(&out, needle);
     assert_eq!(files_in(dir.path()), before, "{args:?} left a file behind");
+    out
 }
 
 fn with_line(text: &str, find: &str, replace: &str) -> String {
