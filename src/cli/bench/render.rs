@@ -76,7 +76,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
     println!();
     println!("one thread (CPU time of the process):");
-    let one = time_scenes(1, args.runs)?;
+    let counts: Vec<usize> = if cores > 1 { vec![1, cores] } else { vec![1] };
+    let mut timings = time_scenes(&counts, args.runs)?.into_iter();
+    let one = timings.next().expect("one thread timed");
     for t in &one {
         print_row(t.name, Some((t.width, t.height)), t.rays(), t.cpu);
     }
@@ -126,7 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     println!();
     if cores > 1 {
         println!("all {cores} threads (wall clock):");
-        let all = time_scenes(cores, args.runs)?;
+        let all = timings.next().expect("all threads timed");
         let (_, _, wall_all) = totals(&all);
         print_row("both", None, rays, wall_all);
         let speedup = wall1.as_secs_f64() / wall_all.as_secs_f64();
@@ -172,40 +174,54 @@ fn totals(timings: &[Timing]) -> (f64, Duration, Duration) {
     )
 }
 
-/// Renders each scene `runs` times on a pool of `threads` and keeps the best times.
-fn time_scenes(threads: usize, runs: u32) -> anyhow::Result<Vec<Timing>> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the worker threads")?;
-    let mut timings = Vec::new();
+/// Renders each scene `runs` times on a pool of each of the `threads` counts and keeps the best
+/// times per count. The counts take turns within each run, so a burst of load elsewhere on the
+/// machine hits them alike.
+fn time_scenes(threads: &[usize], runs: u32) -> anyhow::Result<Vec<Vec<Timing>>> {
+    let pools = threads
+        .iter()
+        .map(|&n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .context("cannot start the worker threads")
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut prepared = Vec::new();
     for name in SCENES {
         let description = rtoracle::scene::builtin(name)?;
-        let camera = description.camera(None);
-        let scene = description.scene();
-        let options = RenderOptions {
-            samples_per_pixel: SPP,
-            ..Default::default()
-        };
-        let mut best_cpu = Duration::MAX;
-        let mut best_wall = Duration::MAX;
-        let mut film = None;
-        for _ in 0..runs {
-            let (cpu, wall) = (process_cpu_time(), Instant::now());
-            let rendered = pool.install(|| render(&scene, &camera, &options))?;
-            best_wall = best_wall.min(wall.elapsed());
-            best_cpu = best_cpu.min(process_cpu_time().saturating_sub(cpu));
-            film = Some(rendered);
+        prepared.push((name, description.camera(None), description.scene()));
+    }
+    let options = RenderOptions {
+        samples_per_pixel: SPP,
+        ..Default::default()
+    };
+    let mut timings: Vec<Vec<Timing>> = threads
+        .iter()
+        .map(|_| {
+            prepared
+                .iter()
+                .map(|(name, camera, _)| Timing {
+                    name,
+                    width: camera.width,
+                    height: camera.height,
+                    cpu: Duration::MAX,
+                    wall: Duration::MAX,
+                    checksum: 0,
+                })
+                .collect()
+        })
+        .collect();
+    for _ in 0..runs {
+        for (pool, per_scene) in pools.iter().zip(&mut timings) {
+            for ((_, camera, scene), timing) in prepared.iter().zip(per_scene.iter_mut()) {
+                let (cpu, wall) = (process_cpu_time(), Instant::now());
+                let film = pool.install(|| render(scene, camera, &options))?;
+                timing.wall = timing.wall.min(wall.elapsed());
+                timing.cpu = timing.cpu.min(process_cpu_time().saturating_sub(cpu));
+                timing.checksum = checksum(&film);
+            }
         }
-        let film = film.expect("at least one run");
-        timings.push(Timing {
-            name,
-            width: film.width,
-            height: film.height,
-            cpu: best_cpu,
-            wall: best_wall,
-            checksum: checksum(&film),
-        });
     }
     Ok(timings)
 }
