@@ -137,6 +137,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             wall1.as_secs_f64(),
             verdict(speedup >= GOAL_SPEEDUP)
         );
+        let (_, cpu_all, _) = totals(&all);
+        println!(
+            "  CPU time on {cores} threads: {:.4} s, {:.2}x one thread's (the extra work of running in parallel)",
+            cpu_all.as_secs_f64(),
+            cpu_all.as_secs_f64() / cpu1.as_secs_f64()
+        );
+        if let Some(load) = load_average().filter(|&l| l > 0.5) {
+            if load > cores as f64 - 1.0 {
+                println!(
+                    "  note: the machine is busy (load average {load:.2} on {cores} cores): the wall-clock speedup measures the other programs too"
+                );
+            }
+        }
         let identical = all.iter().zip(&one).all(|(a, b)| a.checksum == b.checksum);
         println!(
             "  same film as on one thread: {}",
