@@ -1,9 +1,93 @@
-use std::process::ExitCode;
+//! `rtoracle bench <area>`: speed and memory figures, each against a baseline measured in the
+//! same run.
+//!
+//! Each area has its own module under `src/cli/bench/` with a clap `Args` and a `run`, one
+//! variant in [`Area`] and one arm in [`run`]. The helpers below (CPU time, a child's peak
+//! memory, the machine's load) are shared by all of them.
 
-/// `rtoracle bench` (to be written).
+mod render;
+
+use std::process::{Command, ExitCode};
+use std::time::Duration;
+
+use anyhow::Context;
+
+/// `rtoracle bench <AREA>`
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(subcommand)]
+    area: Area,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("'bench' is not implemented yet")
+/// What to measure.
+#[derive(Debug, clap::Subcommand)]
+enum Area {
+    /// The reference tracer: primary rays per second on one thread against a plain C loop
+    /// doing the same work, the speedup on all threads, and peak memory per pixel.
+    Render(render::Args),
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    match args.area {
+        Area::Render(args) => render::run(args),
+    }
+}
+
+/// CPU time used so far by this process, all threads together. Unlike the wall clock it does
+/// not count the time other programs hold the cores, so it stays steady on a busy machine.
+pub(crate) fn process_cpu_time() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant Linux and the BSDs
+    // define.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return Duration::ZERO;
+    }
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+}
+
+/// The one-minute load average, when the system says (`/proc/loadavg`).
+pub(crate) fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// Runs `command` to completion and returns its exit status and its peak resident set size in
+/// bytes, from `wait4`'s resource usage of that one child (`ru_maxrss`, kilobytes on Linux).
+pub(crate) fn run_measuring_peak_rss(
+    command: &mut Command,
+) -> anyhow::Result<(std::process::ExitStatus, u64)> {
+    let child = command
+        .spawn()
+        .with_context(|| format!("cannot start {command:?}"))?;
+    let pid = child.id() as libc::pid_t;
+    let mut status: libc::c_int = 0;
+    // SAFETY: zeroed memory is a valid `rusage` (plain integers and timevals).
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `pid` is our own child, not yet waited for; `status` and `usage` are valid and
+    // writable. `wait4` reaps it, so `child` is not waited for again (dropping it does not wait).
+    let rc = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    if rc != pid {
+        anyhow::bail!(
+            "cannot wait for {command:?}: {}",
+            std::io::Error::last_os_error()
+        );
+    }
+    drop(child);
+    use std::os::unix::process::ExitStatusExt;
+    let kib = u64::try_from(usage.ru_maxrss).unwrap_or(0);
+    // Linux reports kilobytes; macOS reports bytes.
+    let bytes = if cfg!(target_os = "macos") {
+        kib
+    } else {
+        kib * 1024
+    };
+    Ok((std::process::ExitStatus::from_raw(status), bytes))
 }

@@ -15,18 +15,21 @@ pub struct Args {
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's, 20 for the course scenes).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     spp: Option<i64>,
     /// Seed of the per-pixel random streams.
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
     /// Image width in pixels (the height follows the scene's aspect ratio).
-    #[arg(long, value_name = "W")]
+    #[arg(long, value_name = "W", allow_negative_numbers = true)]
     width: Option<i64>,
     /// Worker threads (default: all cores). The image is the same for any count.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
 }
+
+/// The largest image `render` makes: 100 million pixels (2.4 GB of film).
+const MAX_PIXELS: usize = 100_000_000;
 
 /// Loads a built-in scene by name, or a scene file when the argument ends in `.toml` or names an
 /// existing file.
@@ -66,6 +69,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     rtoracle::image_io::check_writable(&output)?;
 
     let camera = description.camera(width);
+    if camera.width.saturating_mul(camera.height) > MAX_PIXELS {
+        anyhow::bail!(
+            "{name}: a {}x{} image is too large (at most {MAX_PIXELS} pixels)",
+            camera.width,
+            camera.height
+        );
+    }
     let scene = description.scene();
     let options = RenderOptions {
         samples_per_pixel: spp,

@@ -17,7 +17,9 @@ pub use interval::Interval;
 pub use quad::{PARALLEL_EPSILON, Quad};
 pub use ray::Ray;
 pub use sphere::Sphere;
+pub(crate) use sphere::{pick_root, roots_of};
 pub use triangle::Triangle;
+pub(crate) use triangle::{Shear, solve_sheared};
 
 /// The `f64` 3-vector used everywhere (re-exported from glam).
 pub use glam::DVec3;

@@ -10,7 +10,8 @@ pub struct Film {
     pub height: usize,
     /// Samples per pixel the film was rendered with.
     pub samples_per_pixel: u32,
-    /// Mean linear RGB per pixel: the sum of the samples divided by their number.
+    /// Mean linear RGB per pixel: the sum of the samples divided by their number, or, when all
+    /// the samples are equal, that value exactly.
     pub mean: Vec<DVec3>,
     /// Per-sample variance per pixel and channel (Welford's update, divided by `n - 1`).
     pub variance: Option<Vec<DVec3>>,

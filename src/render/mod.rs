@@ -2,6 +2,7 @@
 //! parallel into a film whose bytes do not depend on the number of threads.
 
 mod film;
+mod fixed_origin;
 mod integrator;
 mod renderer;
 mod sampler;

@@ -40,12 +40,14 @@ use crate::geometry::{Quad, Sphere, Triangle};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file could not be read.
-    #[error("{path}: cannot read the scene file: {source}")]
+    // The reason is in the message, not a `#[source]`, so a report of the whole chain (anyhow's
+    // `{:#}`) does not say it twice.
+    #[error("{path}: cannot read the scene file: {error}")]
     Read {
         /// The file.
         path: String,
         /// Why.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file is not valid TOML or does not follow the schema.
     #[error("{path}: malformed scene file: {message}")]
@@ -196,9 +198,9 @@ impl SceneDescription {
     /// Reads and validates a TOML scene file.
     pub fn from_file(path: &Path) -> Result<Self, SceneError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        let text = std::fs::read_to_string(path).map_err(|error| SceneError::Read {
             path: name.clone(),
-            source,
+            error,
         })?;
         Self::from_toml(&text, &name)
     }

@@ -8,6 +8,8 @@ mod object;
 
 pub use builtin::{BUILTIN_SCENES, BuiltinScene, builtin, builtin_names};
 pub use camera::{Camera, CameraSettings};
-pub use file::{ImageSettings, MaterialEntry, ObjectEntry, SceneDescription, SceneError};
+pub use file::{
+    ImageSettings, MaterialEntry, MaterialKind, ObjectEntry, SceneDescription, SceneError,
+};
 pub use material::Material;
 pub use object::{Object, Scene, SceneObject};
