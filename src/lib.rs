@@ -12,8 +12,11 @@
 //!   any number of threads.
 //! - [`image_io`]: PNG and OpenEXR, written atomically.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
+//! - [`compare`]: the noise-aware image comparison against goldens, with its diagnosis of
+//!   common mistakes, heatmaps and reports.
 #![warn(missing_docs)]
 
+pub mod compare;
 pub mod geometry;
 pub mod image_io;
 pub mod oracle;
