@@ -72,8 +72,12 @@ pub fn run() -> String {
             .map(|(a, b)| (*a as i32 - *b as i32).unsigned_abs() as u64)
             .sum::<u64>()
     });
-    let compare = time(runs, || compare_image(&honest, &golden, &options).expect("compares"));
-    let failing = time(5, || compare_image(&shifted, &golden, &options).expect("compares"));
+    let compare = time(runs, || {
+        compare_image(&honest, &golden, &options).expect("compares")
+    });
+    let failing = time(5, || {
+        compare_image(&shifted, &golden, &options).expect("compares")
+    });
     let load_golden = time(runs, || {
         Golden::from_cache_bytes(&std::fs::read(&golden_path).expect("reads"), None)
             .expect("decodes")

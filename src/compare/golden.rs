@@ -99,8 +99,8 @@ impl Golden {
                         }
                         let j = (ny * w + nx) as usize;
                         for c in 0..3 {
-                            let v = (self.mean[j][c] - mu[c]).abs()
-                                + 3.0 * self.variance[j][c].sqrt();
+                            let v =
+                                (self.mean[j][c] - mu[c]).abs() + 3.0 * self.variance[j][c].sqrt();
                             b[c] = b[c].max(v);
                         }
                     }
@@ -133,9 +133,9 @@ impl Golden {
             path: path.to_path_buf(),
             message,
         };
-        let variance = image.variance.ok_or_else(|| {
-            bad("has no 'variance' layer, so it cannot serve as a golden".into())
-        })?;
+        let variance = image
+            .variance
+            .ok_or_else(|| bad("has no 'variance' layer, so it cannot serve as a golden".into()))?;
         let attribute = |name: &str| {
             image
                 .attributes
@@ -143,12 +143,14 @@ impl Golden {
                 .find(|(k, _)| k == name)
                 .map(|(_, v)| v.clone())
         };
-        let spp = attribute("rtoracle.spp")
-            .ok_or_else(|| bad("has no 'rtoracle.spp' attribute (the golden's samples per pixel)".into()))?;
-        let spp: u32 = spp
-            .trim()
-            .parse()
-            .map_err(|_| bad(format!("its 'rtoracle.spp' attribute '{spp}' is not a count")))?;
+        let spp = attribute("rtoracle.spp").ok_or_else(|| {
+            bad("has no 'rtoracle.spp' attribute (the golden's samples per pixel)".into())
+        })?;
+        let spp: u32 = spp.trim().parse().map_err(|_| {
+            bad(format!(
+                "its 'rtoracle.spp' attribute '{spp}' is not a count"
+            ))
+        })?;
         let widen = |v: Vec<[f32; 3]>| -> Vec<[f64; 3]> {
             v.into_iter().map(|p| p.map(f64::from)).collect()
         };
@@ -227,7 +229,11 @@ impl Golden {
     pub fn to_cache_bytes(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(32 + self.mean.len() * 24);
         out.extend_from_slice(CACHE_MAGIC);
-        for v in [self.width as u32, self.height as u32, self.samples_per_pixel] {
+        for v in [
+            self.width as u32,
+            self.height as u32,
+            self.samples_per_pixel,
+        ] {
             out.extend_from_slice(&v.to_le_bytes());
         }
         for layer in [&self.mean, &self.variance] {
@@ -273,7 +279,11 @@ const CACHE_MAGIC: &[u8] = b"rtoracle golden cache v1\n";
 /// The folder goldens are cached in: `$RTORACLE_CACHE_DIR`, else `$XDG_CACHE_HOME/rtoracle`,
 /// else `~/.cache/rtoracle`.
 pub fn cache_dir() -> Option<PathBuf> {
-    let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
     env("RTORACLE_CACHE_DIR")
         .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("rtoracle")))
         .or_else(|| env("HOME").map(|d| d.join(".cache").join("rtoracle")))
@@ -292,7 +302,13 @@ pub fn cache_path(dir: &Path, name: &str, description: &SceneDescription, spp: u
     let hex: String = digest[..8].iter().map(|b| format!("{b:02x}")).collect();
     let safe: String = name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     dir.join(format!("golden-{safe}-{spp}spp-{hex}.bin"))
 }
@@ -302,7 +318,8 @@ pub fn cache_path(dir: &Path, name: &str, description: &SceneDescription, spp: u
 ///
 /// This is the single place to swap in goldens embedded in the binary.
 pub fn golden_for_scene(name: &str, candidate_spp: u32) -> Result<Golden, CompareError> {
-    let description = crate::scene::builtin(name).map_err(|e| CompareError::Golden(e.to_string()))?;
+    let description =
+        crate::scene::builtin(name).map_err(|e| CompareError::Golden(e.to_string()))?;
     let spp = golden_spp(candidate_spp);
     let cached = cache_dir().map(|d| cache_path(&d, name, &description, spp));
     if let Some(path) = &cached {
@@ -350,7 +367,10 @@ mod tests {
                 assert!((a[c] - b[c]).abs() <= a[c] * 1e-7);
             }
         }
-        assert_eq!((back.width, back.height, back.samples_per_pixel), (2, 1, 16));
+        assert_eq!(
+            (back.width, back.height, back.samples_per_pixel),
+            (2, 1, 16)
+        );
         let mut bytes = g.to_cache_bytes();
         bytes.pop();
         assert!(Golden::from_cache_bytes(&bytes, None).is_err());

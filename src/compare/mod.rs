@@ -92,7 +92,8 @@ impl CandidateImage {
             if f.metadata().map(|m| m.is_dir()).unwrap_or(false) {
                 return Err(bad("is a folder, not an image".into()));
             }
-            f.read(&mut head).map_err(|e| bad(format!("cannot read: {e}")))?
+            f.read(&mut head)
+                .map_err(|e| bad(format!("cannot read: {e}")))?
         };
         if n >= 8 && head == *b"\x89PNG\r\n\x1a\n" {
             let img = crate::image_io::read_png(path)?;

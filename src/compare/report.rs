@@ -74,7 +74,9 @@ fn side_by_side(
 }
 
 fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
@@ -100,7 +102,11 @@ fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
         alpha = c.alpha
     );
     if let Some(d) = &c.diagnosis {
-        let _ = writeln!(h, "<h2>Diagnosis</h2><p><b>{}</b></p>", html_escape(&d.summary));
+        let _ = writeln!(
+            h,
+            "<h2>Diagnosis</h2><p><b>{}</b></p>",
+            html_escape(&d.summary)
+        );
     }
     h.push_str("<h2>Scales</h2><table><tr><th>scale</th><th>tests</th><th>smallest adjusted p</th><th>threshold</th><th>largest |z|</th><th>failing</th></tr>\n");
     for s in &c.scales {
@@ -144,10 +150,12 @@ pub fn write_report(
     golden: &Golden,
     encoding: Encoding,
 ) -> Result<(), CompareError> {
-    let io = |e: std::io::Error| CompareError::Image(ImageError::Io {
-        path: dir.to_path_buf(),
-        message: e.to_string(),
-    });
+    let io = |e: std::io::Error| {
+        CompareError::Image(ImageError::Io {
+            path: dir.to_path_buf(),
+            message: e.to_string(),
+        })
+    };
     let fresh = !dir.exists();
     let (target, staging): (PathBuf, Option<tempfile::TempDir>) = if fresh {
         let parent = match dir.parent() {

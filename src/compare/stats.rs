@@ -51,7 +51,9 @@ mod tests {
         // (X <= -1 is impossible); the bound must lie above it.
         let n = 20u32;
         let p = 0.3f64;
-        let choose = |n: u32, k: u32| -> f64 { (0..k).fold(1.0, |a, i| a * (n - i) as f64 / (i + 1) as f64) };
+        let choose = |n: u32, k: u32| -> f64 {
+            (0..k).fold(1.0, |a, i| a * (n - i) as f64 / (i + 1) as f64)
+        };
         let exact: f64 = (13..=n)
             .map(|k| choose(n, k) * p.powi(k as i32) * (1.0 - p).powi((n - k) as i32))
             .sum();

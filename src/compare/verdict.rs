@@ -14,6 +14,9 @@ const CHANNELS: [&str; 3] = ["R", "G", "B"];
 const HALF_EPSILON: f64 = 1.0 / 2048.0;
 /// Side of the cells failing regions are built from.
 const CELL: usize = 8;
+/// Regions never cross a block of this many cells a side (32 pixels), so a failing outline of
+/// an object gives boxes along it rather than one box around the whole object.
+const BLOCK: usize = 4;
 
 /// The intervals of linear values a candidate's pixels stand for, and the width of a code at a
 /// given linear value (to tell pixels whose noise shows through the quantisation).
@@ -32,7 +35,11 @@ impl Intervals {
                 let mut lo = Vec::with_capacity(data.len() / 3);
                 let mut hi = Vec::with_capacity(data.len() / 3);
                 for p in data.chunks_exact(3) {
-                    let t = [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize]];
+                    let t = [
+                        table[p[0] as usize],
+                        table[p[1] as usize],
+                        table[p[2] as usize],
+                    ];
                     lo.push(t.map(|x| x.0));
                     hi.push(t.map(|x| x.1));
                 }
@@ -247,8 +254,7 @@ pub fn evaluate(
                     global[c].add(above, below, variance, bound);
                     if s2 > 0.0 && hi - lo < 1.0 {
                         neff_num += s2;
-                        neff_den +=
-                            (mid - mu).powi(2) - (hi - lo).powi(2) / 12.0 - s2 / m;
+                        neff_den += (mid - mu).powi(2) - (hi - lo).powi(2) / 12.0 - s2 / m;
                         neff_count += 1;
                     }
                 }
@@ -257,6 +263,7 @@ pub fn evaluate(
         }
     }
 
+    let tiles8_counts: Vec<usize> = tiles8.iter().map(|s| s.count).collect();
     let mut scales = vec![ScaleResult {
         scale: SCALES[0].into(),
         tests: pixel_tests as usize,
@@ -283,6 +290,10 @@ pub fn evaluate(
                 let (x0, y0) = ((tile % tx) * size, (tile / tx) * size);
                 for yy in (y0..(y0 + size).min(height)).step_by(CELL) {
                     for xx in (x0..(x0 + size).min(width)).step_by(CELL) {
+                        // Only the cells whose pixels entered the sum (cells are 8x8 tiles).
+                        if tiles8_counts[((yy / 8) * t8x + xx / 8) * 3 + k % 3] == 0 {
+                            continue;
+                        }
                         mark(
                             &mut cells[(yy / CELL) * cx + xx / CELL],
                             Worst {
@@ -369,7 +380,8 @@ fn region(x: usize, y: usize, width: usize, height: usize, w: Worst) -> Region {
     }
 }
 
-/// Connected groups of failing cells (8-connected), as pixel boxes, worst first, at most 50.
+/// Connected groups of failing cells (8-connected within 32x32 blocks), as pixel boxes, worst
+/// first, at most 50.
 fn regions_of(
     cells: &[Option<Worst>],
     cx: usize,
@@ -404,7 +416,9 @@ fn regions_of(
                         continue;
                     }
                     let j = ny as usize * cx + nx as usize;
-                    if !seen[j] && cells[j].is_some() {
+                    let same_block =
+                        (nx as usize / BLOCK, ny as usize / BLOCK) == (x / BLOCK, y / BLOCK);
+                    if same_block && !seen[j] && cells[j].is_some() {
                         seen[j] = true;
                         stack.push(j);
                     }
@@ -471,15 +485,8 @@ mod tests {
     fn a_flat_golden_is_decided_exactly() {
         let (w, h) = (16, 16);
         let colour = [0.25, 0.5, 0.64];
-        let golden = Golden::new(
-            w,
-            h,
-            1024,
-            vec![colour; w * h],
-            vec![[0.0; 3]; w * h],
-            None,
-        )
-        .unwrap();
+        let golden =
+            Golden::new(w, h, 1024, vec![colour; w * h], vec![[0.0; 3]; w * h], None).unwrap();
         let codes: Vec<u8> = (0..w * h)
             .flat_map(|_| colour.map(|x| Encoding::Course.encode(x)))
             .collect();
@@ -509,8 +516,7 @@ mod tests {
     /// A linear candidate equal to the golden passes; off by 1% in red fails, darker.
     #[test]
     fn linear_candidates_use_half_float_intervals() {
-        let golden = Golden::new(4, 4, 4096, vec![[0.5; 3]; 16], vec![[0.0; 3]; 16], None)
-            .unwrap();
+        let golden = Golden::new(4, 4, 4096, vec![[0.5; 3]; 16], vec![[0.0; 3]; 16], None).unwrap();
         let same = CandidateImage::Linear {
             width: 4,
             height: 4,

@@ -1,4 +1,5 @@
 //! One integration-test binary with a module per area (as ripgrep does).
 
 mod common;
+mod compare;
 mod render;
