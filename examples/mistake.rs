@@ -29,6 +29,9 @@ fn main() -> anyhow::Result<()> {
     let spp = description.image.samples_per_pixel;
     let image = render_with_mistake(&description, mistake, spp, seed);
     rtoracle::image_io::write_png(std::path::Path::new(out), &image)?;
-    eprintln!("wrote {out}: {scene} with '{}', {spp} spp, seed {seed}", mistake.name());
+    eprintln!(
+        "wrote {out}: {scene} with '{}', {spp} spp, seed {seed}",
+        mistake.name()
+    );
     Ok(())
 }

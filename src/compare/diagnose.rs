@@ -1,6 +1,8 @@
 //! When an image fails: test the common mistakes as alternative hypotheses and name the one
 //! that explains the image.
 
+use rayon::prelude::*;
+
 use super::{
     CandidateImage, CompareOptions, Diagnosis, ENCODINGS, Encoding, Evaluation, Golden,
     HypothesisScore, evaluate,
@@ -73,6 +75,13 @@ fn bgr(c: &CandidateImage) -> CandidateImage {
     }
 }
 
+enum Try {
+    Encoding(Encoding),
+    FlipY,
+    Bgr,
+    Shift(i32),
+}
+
 /// Tries every hypothesis on a failed image and names the best one that explains at least half
 /// of the misfit.
 pub fn diagnose(
@@ -82,48 +91,58 @@ pub fn diagnose(
     base: &Evaluation,
 ) -> Diagnosis {
     let asked = options.encoding;
-    let mut scores: Vec<HypothesisScore> = Vec::new();
-    let mut score = |name: String, mistake: String, e: Evaluation| {
-        scores.push(HypothesisScore {
-            name,
-            mistake,
-            misfit_ratio: if base.misfit > 0.0 {
-                e.misfit / base.misfit
-            } else {
-                1.0
-            },
-            passes: e.passed,
-        });
-    };
+    let mut tries: Vec<Try> = Vec::new();
     if matches!(candidate, CandidateImage::Rgb8 { .. }) {
         for e in ENCODINGS.into_iter().filter(|&e| e != asked) {
-            score(
-                format!("encoding:{e}"),
-                encoding_mistake(e, asked),
-                evaluate(candidate, golden, e, options),
-            );
+            tries.push(Try::Encoding(e));
         }
     }
-    score(
-        "flip-y".into(),
-        "fits the golden upside down: rows written bottom to top (y flipped)".into(),
-        evaluate(&flip_y(candidate), golden, asked, options),
-    );
-    score(
-        "bgr".into(),
-        "fits the golden with red and blue swapped: channels written in BGR order".into(),
-        evaluate(&bgr(candidate), golden, asked, options),
-    );
-    score(
-        "shift:+0.5".into(),
-        "fits the golden shifted half a pixel right and down: samples jittered in [0, 1) instead of [-0.5, 0.5)".into(),
-        evaluate(candidate, &golden.half_pixel_shifted(1), asked, options),
-    );
-    score(
-        "shift:-0.5".into(),
-        "fits the golden shifted half a pixel left and up: a half-pixel camera shift (pixel00 without its half-pixel offset?)".into(),
-        evaluate(candidate, &golden.half_pixel_shifted(-1), asked, options),
-    );
+    tries.extend([Try::FlipY, Try::Bgr, Try::Shift(1), Try::Shift(-1)]);
+    // The hypotheses are independent: evaluate them in parallel (each is deterministic).
+    let mut scores: Vec<HypothesisScore> = tries
+        .par_iter()
+        .map(|t| {
+            let (name, mistake, e) = match *t {
+                Try::Encoding(e) => (
+                    format!("encoding:{e}"),
+                    encoding_mistake(e, asked),
+                    evaluate(candidate, golden, e, options),
+                ),
+                Try::FlipY => (
+                    "flip-y".to_string(),
+                    "fits the golden upside down: rows written bottom to top (y flipped)"
+                        .to_string(),
+                    evaluate(&flip_y(candidate), golden, asked, options),
+                ),
+                Try::Bgr => (
+                    "bgr".to_string(),
+                    "fits the golden with red and blue swapped: channels written in BGR order"
+                        .to_string(),
+                    evaluate(&bgr(candidate), golden, asked, options),
+                ),
+                Try::Shift(s) if s > 0 => (
+                    "shift:+0.5".to_string(),
+                    "fits the golden shifted half a pixel right and down: samples jittered in [0, 1) instead of [-0.5, 0.5)".to_string(),
+                    evaluate(candidate, &golden.half_pixel_shifted(1), asked, options),
+                ),
+                Try::Shift(_) => (
+                    "shift:-0.5".to_string(),
+                    "fits the golden shifted half a pixel left and up: a half-pixel camera shift (pixel00 without its half-pixel offset?)".to_string(),
+                    evaluate(candidate, &golden.half_pixel_shifted(-1), asked, options),
+                ),
+            };
+            HypothesisScore {
+                name,
+                mistake,
+                misfit_ratio: if base.misfit > 0.0 {
+                    e.misfit / base.misfit
+                } else {
+                    1.0
+                },
+                passes: e.passed,
+            }
+        })
+        .collect();
     scores.sort_by(|a, b| {
         b.passes
             .cmp(&a.passes)

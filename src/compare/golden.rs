@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use sha2::{Digest, Sha256};
 
 use super::CompareError;
+use crate::image_io::ExrImage;
 use crate::render::{Film, RenderOptions, render};
 use crate::scene::SceneDescription;
 
@@ -126,16 +127,20 @@ impl Golden {
         )
     }
 
-    /// A golden from an EXR with a `variance` layer; `M` comes from its `rtoracle.spp` attribute.
+    /// A golden from an EXR file with a `variance` layer; `M` comes from its `rtoracle.spp`
+    /// attribute. Errors name the file.
     pub fn from_exr(path: &Path) -> Result<Self, CompareError> {
         let image = crate::image_io::read_exr(path)?;
+        Golden::from_exr_image(image, path)
+    }
+
+    /// A golden from an EXR already read (for instance one embedded in the binary); `source`
+    /// names it in errors.
+    pub fn from_exr_image(image: ExrImage, source: &Path) -> Result<Self, CompareError> {
         let bad = |message: String| CompareError::Input {
-            path: path.to_path_buf(),
+            path: source.to_path_buf(),
             message,
         };
-        let variance = image
-            .variance
-            .ok_or_else(|| bad("has no 'variance' layer, so it cannot serve as a golden".into()))?;
         let attribute = |name: &str| {
             image
                 .attributes
@@ -151,6 +156,10 @@ impl Golden {
                 "its 'rtoracle.spp' attribute '{spp}' is not a count"
             ))
         })?;
+        let scene = attribute("rtoracle.scene");
+        let variance = image
+            .variance
+            .ok_or_else(|| bad("has no 'variance' layer, so it cannot serve as a golden".into()))?;
         let widen = |v: Vec<[f32; 3]>| -> Vec<[f64; 3]> {
             v.into_iter().map(|p| p.map(f64::from)).collect()
         };
@@ -160,7 +169,7 @@ impl Golden {
             spp,
             widen(image.mean),
             widen(variance),
-            attribute("rtoracle.scene"),
+            scene,
         )
         .map_err(|e| bad(e.to_string()))
     }
@@ -389,6 +398,30 @@ mod tests {
     fn wrong_sizes_and_nan_are_rejected() {
         assert!(Golden::new(2, 2, 16, vec![[0.0; 3]; 3], vec![[0.0; 3]; 4], None).is_err());
         assert!(Golden::new(1, 1, 16, vec![[f64::NAN; 3]], vec![[0.0; 3]], None).is_err());
+    }
+
+    #[test]
+    fn exr_goldens_need_variance_and_their_sample_count() {
+        let image = |variance: bool, spp: Option<&str>| ExrImage {
+            width: 1,
+            height: 1,
+            mean: vec![[0.5; 3]],
+            variance: variance.then(|| vec![[0.01; 3]]),
+            attributes: spp
+                .map(|s| vec![("rtoracle.spp".to_string(), s.to_string())])
+                .unwrap_or_default(),
+        };
+        let src = Path::new("g.exr");
+        let g = Golden::from_exr_image(image(true, Some("4096")), src).unwrap();
+        assert_eq!(g.samples_per_pixel, 4096);
+        for (img, needle) in [
+            (image(false, Some("4096")), "variance"),
+            (image(true, None), "rtoracle.spp"),
+            (image(true, Some("many")), "not a count"),
+        ] {
+            let e = Golden::from_exr_image(img, src).unwrap_err().to_string();
+            assert!(e.starts_with("g.exr: ") && e.contains(needle), "{e}");
+        }
     }
 
     #[test]

@@ -37,8 +37,10 @@ mod tests {
 
     #[test]
     fn bernstein_reduces_to_its_formula() {
-        // t = 1, V = 1, b = 0: 2 exp(-1/2).
-        assert!((bernstein_p(1.0, 1.0, 0.0) - 2.0 * (-0.5f64).exp()).abs() < 1e-15);
+        // t = 2, V = 1, b = 0: 2 exp(-2).
+        assert!((bernstein_p(2.0, 1.0, 0.0) - 2.0 * (-2.0f64).exp()).abs() < 1e-15);
+        // Capped at 1: t = 1, V = 1 gives 2 exp(-1/2) > 1.
+        assert_eq!(bernstein_p(1.0, 1.0, 0.0), 1.0);
         assert_eq!(bernstein_p(0.0, 0.0, 0.0), 1.0);
         assert_eq!(bernstein_p(1e-3, 0.0, 0.0), 0.0);
         // b = 3/2, V = 0, t = 1: 2 exp(-1).
