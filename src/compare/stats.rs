@@ -64,6 +64,38 @@ mod tests {
         assert!(bound < 0.1);
     }
 
+    /// The bound is valid where the comparison relies on it: simulated edge pixels (20 samples,
+    /// each one of two colours 0.8 apart, coverage 0.05 to 0.95) fall below a p of `a` no more
+    /// often than `a`, for several `a`, with the variance known exactly.
+    #[test]
+    fn bernstein_p_values_are_valid_for_simulated_edge_pixels() {
+        let mut rng = crate::render::PixelSampler::new(3, 5);
+        let n = 20;
+        let trials = 20_000;
+        for coverage in [0.05, 0.3, 0.5, 0.95] {
+            let variance = coverage * (1.0 - coverage) * 0.64 / n as f64;
+            let mut below = [0usize; 3];
+            for _ in 0..trials {
+                let hits = (0..n).filter(|_| rng.next_f64() < coverage).count();
+                let mean = 0.1 + 0.8 * hits as f64 / n as f64;
+                let t = (mean - (0.1 + 0.8 * coverage)).abs();
+                let p = bernstein_p(t, variance, 0.8 / n as f64);
+                for (k, a) in [0.2, 0.05, 0.01].into_iter().enumerate() {
+                    below[k] += usize::from(p < a);
+                }
+            }
+            for (k, a) in [0.2, 0.05, 0.01].into_iter().enumerate() {
+                let rate = below[k] as f64 / trials as f64;
+                // Allow 4 binomial standard errors of sampling noise above a.
+                let slack = 4.0 * (a * (1.0 - a) / trials as f64).sqrt();
+                assert!(
+                    rate <= a + slack,
+                    "coverage {coverage}: P(p < {a}) = {rate}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn sidak_matches_its_closed_form() {
         assert!((sidak(0.01, 2.0) - (1.0 - 0.99f64 * 0.99)).abs() < 1e-15);
