@@ -86,6 +86,7 @@ impl Golden {
 
     fn neighbourhood_bound(&self) -> Vec<[f64; 3]> {
         let (w, h) = (self.width as isize, self.height as isize);
+        let sd: Vec<[f64; 3]> = self.variance.iter().map(|v| v.map(f64::sqrt)).collect();
         let mut out = vec![[0.0; 3]; self.mean.len()];
         for y in 0..h {
             for x in 0..w {
@@ -100,8 +101,7 @@ impl Golden {
                         }
                         let j = (ny * w + nx) as usize;
                         for c in 0..3 {
-                            let v =
-                                (self.mean[j][c] - mu[c]).abs() + 3.0 * self.variance[j][c].sqrt();
+                            let v = (self.mean[j][c] - mu[c]).abs() + 3.0 * sd[j][c];
                             b[c] = b[c].max(v);
                         }
                     }
