@@ -425,6 +425,19 @@ mod tests {
     }
 
     #[test]
+    fn the_cache_key_follows_the_scene_and_the_sample_count() {
+        let dir = Path::new("/cache");
+        let d = crate::scene::builtin("week04-sphere").unwrap();
+        let a = cache_path(dir, "week04-sphere", &d, 4096);
+        assert_eq!(a, cache_path(dir, "week04-sphere", &d, 4096));
+        assert_ne!(a, cache_path(dir, "week04-sphere", &d, 8192));
+        let mut moved = d.clone();
+        moved.objects.pop();
+        assert_ne!(a, cache_path(dir, "week04-sphere", &moved, 4096));
+        assert!(a.starts_with(dir));
+    }
+
+    #[test]
     fn golden_spp_follows_the_rule() {
         assert_eq!(golden_spp(20), 4096);
         assert_eq!(golden_spp(100), 10_000);
