@@ -11,13 +11,19 @@
 //! - [`render`]: the course's integrator and a renderer that gives the same bytes for a seed on
 //!   any number of threads.
 //! - [`image_io`]: PNG and OpenEXR, written atomically.
+//! - [`golden`]: the golden EXRs of the built-in scenes (mean and per-sample variance at 4096 spp),
+//!   embedded in the library, and their pixel comparison.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
 //! - [`compare`]: the noise-aware image comparison against goldens, with its diagnosis of
 //!   common mistakes, heatmaps and reports.
+//! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
+//!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
 #![warn(missing_docs)]
 
 pub mod compare;
 pub mod geometry;
+pub mod golden;
+pub mod grade;
 pub mod image_io;
 pub mod oracle;
 pub mod render;

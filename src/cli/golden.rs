@@ -1,9 +1,110 @@
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
-/// `rtoracle golden` (to be written).
+use anyhow::Context;
+use rtoracle::golden::{
+    GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_file_name,
+};
+use rtoracle::image_io::{decode_exr, write_atomically};
+use rtoracle::scene::{builtin, builtin_names};
+
+/// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Verify instead of writing: regenerate each golden in memory and compare it with the file,
+    /// pixel by pixel within a small tolerance. Exit 0 when all are equal, 1 when one differs,
+    /// 2 when a file cannot be read.
+    #[arg(long)]
+    check: bool,
+    /// The folder of the goldens (created when writing).
+    #[arg(long, value_name = "DIR", default_value = "golden")]
+    dir: PathBuf,
+    /// Samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = GOLDEN_SPP as i64)]
+    spp: i64,
+    /// Only these built-in scenes (comma-separated; default: all of them).
+    #[arg(long, value_name = "A,B", value_delimiter = ',')]
+    scenes: Vec<String>,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("'golden' is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let spp = match args.spp {
+        n if n <= 0 => anyhow::bail!("--spp {n}: samples per pixel must be at least 1"),
+        n => u32::try_from(n).map_err(|_| anyhow::anyhow!("--spp {n}: too large"))?,
+    };
+    let scenes: Vec<String> = if args.scenes.is_empty() {
+        builtin_names().into_iter().map(String::from).collect()
+    } else {
+        args.scenes.clone()
+    };
+    for scene in &scenes {
+        builtin(scene).context("--scenes")?;
+    }
+    if args.check {
+        check(&args.dir, &scenes, spp)
+    } else {
+        write(&args.dir, &scenes, spp)
+    }
+}
+
+fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
+    if !dir.is_dir() {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
+    }
+    for scene in scenes {
+        let path = dir.join(golden_file_name(scene));
+        let start = Instant::now();
+        let bytes = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
+        write_atomically(&path, &bytes)?;
+        println!(
+            "wrote {} ({spp} spp, seed {GOLDEN_SEED}, {} bytes) in {:.1} s",
+            path.display(),
+            bytes.len(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn check(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
+    // Read every file before the long renders, so an unreadable one fails at once.
+    let mut committed = Vec::with_capacity(scenes.len());
+    for scene in scenes {
+        let path = dir.join(golden_file_name(scene));
+        let bytes = std::fs::read(&path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+        let image = decode_exr(&bytes, &path)?;
+        committed.push((path, bytes, image));
+    }
+    let mut all_equal = true;
+    for (scene, (path, bytes, expected)) in scenes.iter().zip(committed) {
+        let fresh = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
+        if fresh == bytes {
+            println!("{}: identical bytes", path.display());
+            continue;
+        }
+        let actual = decode_exr(&fresh, &path)?;
+        let diff = compare_goldens(&expected, &actual, &Tolerance::default());
+        let pixels = expected.width * expected.height;
+        if diff.is_match() {
+            println!(
+                "{}: equal within tolerance (the bytes differ)",
+                path.display()
+            );
+        } else {
+            all_equal = false;
+            println!(
+                "{}: differs from a fresh render: {}",
+                path.display(),
+                diff.summary(pixels)
+            );
+        }
+    }
+    Ok(if all_equal {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(super::FAILED)
+    })
 }

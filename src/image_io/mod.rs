@@ -3,7 +3,7 @@
 mod exr_file;
 mod png_file;
 
-pub use exr_file::{ExrImage, read_exr, write_exr};
+pub use exr_file::{ExrImage, decode_exr, encode_exr, read_exr, write_exr};
 pub use png_file::{Rgb8Image, read_png, write_png};
 
 use std::io::Write;
@@ -72,6 +72,14 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
     let mut tmp =
         tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(|e| ImageError::io(path, e))?;
     tmp.write_all(bytes).map_err(|e| ImageError::io(path, e))?;
+    // Temporary files are created private (0600); an output is an ordinary file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(|e| ImageError::io(path, e))?;
+    }
     tmp.persist(path)
         .map_err(|e| ImageError::io(path, e.error))?;
     Ok(())

@@ -2,4 +2,6 @@
 
 mod common;
 mod compare;
+mod golden;
+mod grade;
 mod render;

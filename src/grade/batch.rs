@@ -1,0 +1,262 @@
+//! Grading a folder of submissions: one report folder each, `gradebook.csv` and `summary.md`.
+//! Submissions are graded in parallel on rayon's current pool; one that breaks grading is a row
+//! marked `error` and never stops the batch.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::io::IsTerminal;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+use super::inputs::{CodeChecker, ImageChecker};
+use super::rubric::Rubric;
+use super::run::{Format, GradeError, GradeReport, grade_to_dir, round2};
+
+/// One submission of a batch.
+#[derive(Debug)]
+pub struct BatchEntry {
+    /// The sub-folder's name.
+    pub name: String,
+    /// Its report, or why grading it failed.
+    pub result: Result<GradeReport, String>,
+}
+
+/// The sub-folders of `dir` that are submissions: not hidden, sorted by name, without `skip`
+/// (the output folder, when it lies inside `dir`).
+pub fn submissions(dir: &Path, skip: Option<&Path>) -> Result<Vec<PathBuf>, GradeError> {
+    let entries =
+        std::fs::read_dir(dir).map_err(|_| GradeError::NoSubmission(dir.to_path_buf()))?;
+    let skip = skip.and_then(|p| p.canonicalize().ok());
+    let mut out: Vec<PathBuf> = entries
+        .flatten()
+        .filter(|e| e.file_type().map(|t| t.is_dir()).unwrap_or(false))
+        .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
+        .map(|e| e.path())
+        .filter(|p| skip.is_none() || p.canonicalize().ok() != skip)
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+/// Grades every submission in `dir` into `out/<name>/` and writes `out/gradebook.csv` and
+/// `out/summary.md`.
+pub fn grade_batch(
+    dir: &Path,
+    rubric: &Rubric,
+    code: &dyn CodeChecker,
+    images: &dyn ImageChecker,
+    out: &Path,
+    formats: &[Format],
+) -> Result<Vec<BatchEntry>, GradeError> {
+    if !dir.is_dir() {
+        return Err(GradeError::NoSubmission(dir.to_path_buf()));
+    }
+    std::fs::create_dir_all(out).map_err(|e| GradeError::Output {
+        path: out.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let subs = submissions(dir, Some(out))?;
+    let bar = if std::io::stderr().is_terminal() {
+        let bar =
+            ProgressBar::with_draw_target(Some(subs.len() as u64), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("grading {bar:40} {pos}/{len} submissions, {eta} left")
+                .expect("a valid progress template"),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let entries: Vec<BatchEntry> = subs
+        .par_iter()
+        .map(|sub| {
+            let name = sub
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_default();
+            let target = out.join(&name);
+            let result = catch_unwind(AssertUnwindSafe(|| {
+                grade_to_dir(sub, rubric, code, images, &target, formats)
+            }));
+            bar.inc(1);
+            let result = match result {
+                Ok(Ok(report)) => Ok(report),
+                Ok(Err(e)) => Err(e.to_string()),
+                Err(_) => Err("the grader panicked on this submission".to_string()),
+            };
+            BatchEntry { name, result }
+        })
+        .collect();
+    bar.finish_and_clear();
+    let write = |file: &str, text: String| {
+        let path = out.join(file);
+        super::run::write_public(&path, text.as_bytes()).map_err(|e| GradeError::Output {
+            path,
+            message: e.to_string(),
+        })
+    };
+    write("gradebook.csv", gradebook_csv(rubric, &entries))?;
+    write("summary.md", summary_md(rubric, &entries))?;
+    Ok(entries)
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// `gradebook.csv`: `submission,score,max_score`, one column per rubric group, then `status`.
+pub fn gradebook_csv(rubric: &Rubric, entries: &[BatchEntry]) -> String {
+    let mut csv = String::from("submission,score,max_score");
+    for g in &rubric.groups {
+        csv.push(',');
+        csv.push_str(&csv_field(&g.id));
+    }
+    csv.push_str(",status\n");
+    for e in entries {
+        csv.push_str(&csv_field(&e.name));
+        match &e.result {
+            Ok(r) => {
+                let groups: BTreeMap<String, f64> = r
+                    .group_scores()
+                    .into_iter()
+                    .map(|(g, s, _)| (g, s))
+                    .collect();
+                let _ = write!(csv, ",{},{}", r.score, r.max_score);
+                for g in &rubric.groups {
+                    let _ = write!(csv, ",{}", groups.get(&g.id).copied().unwrap_or(0.0));
+                }
+                csv.push_str(",ok\n");
+            }
+            Err(msg) => {
+                let _ = write!(csv, ",,{}", rubric.max_score());
+                for _ in &rubric.groups {
+                    csv.push(',');
+                }
+                let _ = writeln!(csv, ",{}", csv_field(&format!("error: {msg}")));
+            }
+        }
+    }
+    csv
+}
+
+/// `summary.md`: the score distribution and the most common failures.
+pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
+    let graded: Vec<&GradeReport> = entries
+        .iter()
+        .filter_map(|e| e.result.as_ref().ok())
+        .collect();
+    let max = rubric.max_score();
+    let mut md = format!(
+        "# Batch summary ({} rubric)\n\n{} submissions, {} graded, {} could not be graded.\n",
+        rubric.name,
+        entries.len(),
+        graded.len(),
+        entries.len() - graded.len()
+    );
+    if !graded.is_empty() {
+        let mut scores: Vec<f64> = graded.iter().map(|r| r.score).collect();
+        scores.sort_by(f64::total_cmp);
+        let n = scores.len();
+        let mean = scores.iter().sum::<f64>() / n as f64;
+        let median = if n % 2 == 1 {
+            scores[n / 2]
+        } else {
+            (scores[n / 2 - 1] + scores[n / 2]) / 2.0
+        };
+        let _ = writeln!(
+            md,
+            "\nScore out of {max}: mean {}, median {}, min {}, max {}.\n",
+            round2(mean),
+            round2(median),
+            scores[0],
+            scores[n - 1]
+        );
+        md.push_str("| Score | Submissions |\n|---|---:|\n");
+        let mut buckets = [0usize; 11];
+        for s in &scores {
+            let frac = if max > 0.0 { s / max } else { 1.0 };
+            let b = if frac >= 1.0 {
+                10
+            } else {
+                (frac * 10.0).floor().clamp(0.0, 9.0) as usize
+            };
+            buckets[b] += 1;
+        }
+        for (i, count) in buckets.iter().enumerate() {
+            let label = if i == 10 {
+                "100%".to_string()
+            } else {
+                format!("{}-{}%", i * 10, i * 10 + 10)
+            };
+            let bar = if *count > 0 {
+                format!(" {}", "#".repeat(*count))
+            } else {
+                String::new()
+            };
+            let _ = writeln!(md, "| {label} | {count}{bar} |");
+        }
+        // Checks that lost points, and the vectors failed most often.
+        let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
+        let mut vectors: BTreeMap<String, (usize, String)> = BTreeMap::new();
+        let mut fatal = 0usize;
+        for r in &graded {
+            if r.code.fatal.is_some() {
+                fatal += 1;
+            }
+            for c in &r.checks {
+                if c.score < c.max_score {
+                    let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
+                    e.1 += 1;
+                }
+                for f in c.failures.iter().filter(|f| f.definite) {
+                    let e = vectors
+                        .entry(f.id.clone())
+                        .or_insert((0, f.message.clone()));
+                    e.0 += 1;
+                }
+            }
+        }
+        md.push_str("\n## Most common failures\n\n");
+        if checks.is_empty() {
+            md.push_str("Every submission got full marks.\n");
+        } else {
+            let mut rows: Vec<_> = checks.into_iter().collect();
+            rows.sort_by(|a, b| b.1.1.cmp(&a.1.1).then(a.0.cmp(&b.0)));
+            md.push_str("| Check | Submissions losing points |\n|---|---:|\n");
+            for (id, (name, count)) in rows {
+                let _ = writeln!(md, "| `{id}` {name} | {count} |");
+            }
+        }
+        if fatal > 0 {
+            let _ = writeln!(md, "\n{fatal} submission(s) could not be imported.");
+        }
+        if !vectors.is_empty() {
+            let mut rows: Vec<_> = vectors.into_iter().collect();
+            rows.sort_by(|a, b| b.1.0.cmp(&a.1.0).then(a.0.cmp(&b.0)));
+            md.push_str("\n| Vector | Submissions failing it | Example |\n|---|---:|---|\n");
+            for (id, (count, msg)) in rows.into_iter().take(10) {
+                let _ = writeln!(md, "| `{id}` | {count} | {} |", msg.replace('|', "\\|"));
+            }
+        }
+    }
+    let errors: Vec<&BatchEntry> = entries.iter().filter(|e| e.result.is_err()).collect();
+    if !errors.is_empty() {
+        md.push_str("\n## Not graded\n\n");
+        for e in errors {
+            let _ = writeln!(
+                md,
+                "- {}: {}",
+                e.name,
+                e.result.as_ref().err().map_or("", |s| s)
+            );
+        }
+    }
+    md
+}

@@ -1,0 +1,204 @@
+//! The fixture submissions of this repository, made into real submissions, and the grading
+//! benchmark (`cargo bench --bench grade`): one submission, and a batch of 30 on 2 threads,
+//! against a baseline measured in the same run (starting Python once).
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use serde::Deserialize;
+
+use super::{Format, Rubric, StandinCodeChecker, StandinImageChecker, batch, grade_to_dir};
+use crate::image_io::{Rgb8Image, write_png};
+use crate::render::{RenderOptions, render};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FixtureSpec {
+    #[serde(default)]
+    base: Option<String>,
+    #[serde(default)]
+    loses: Vec<String>,
+    #[serde(default)]
+    image: Vec<FixtureImage>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FixtureImage {
+    file: String,
+    scene: String,
+    seed: u64,
+    #[serde(default)]
+    width: Option<usize>,
+    /// `"course"` (default) or `"linear"` (the square root forgotten).
+    #[serde(default)]
+    encoding: Option<String>,
+}
+
+/// `tests/fixtures/submissions` of this crate.
+pub fn fixtures_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/submissions")
+}
+
+/// The fixture names (the folders holding a `fixture.toml`), sorted.
+pub fn fixture_names() -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(fixtures_dir())
+        .map(|rd| {
+            rd.flatten()
+                .filter(|e| e.path().join("fixture.toml").is_file())
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+/// Makes fixture `name` a submission in `dest` (created): the `.py` files of its `base` then its
+/// own, and its images rendered by the reference renderer (20 spp, the fixture's seed and
+/// width). Returns the rubric groups it is meant to lose points in.
+pub fn materialize(name: &str, dest: &Path) -> Result<Vec<String>, String> {
+    let dir = fixtures_dir().join(name);
+    let spec_path = dir.join("fixture.toml");
+    let text =
+        std::fs::read_to_string(&spec_path).map_err(|e| format!("{}: {e}", spec_path.display()))?;
+    let spec: FixtureSpec =
+        toml::from_str(&text).map_err(|e| format!("{}: {e}", spec_path.display()))?;
+    std::fs::create_dir_all(dest).map_err(|e| format!("{}: {e}", dest.display()))?;
+    let copy_py = |from: &Path| -> Result<(), String> {
+        for e in std::fs::read_dir(from)
+            .map_err(|e| format!("{}: {e}", from.display()))?
+            .flatten()
+        {
+            let n = e.file_name().to_string_lossy().to_string();
+            if n.ends_with(".py") {
+                std::fs::copy(e.path(), dest.join(&n)).map_err(|e| format!("{n}: {e}"))?;
+            }
+        }
+        Ok(())
+    };
+    if let Some(base) = &spec.base {
+        copy_py(&fixtures_dir().join(base))?;
+    }
+    copy_py(&dir)?;
+    for img in &spec.image {
+        let d = crate::scene::builtin(&img.scene).map_err(|e| e.to_string())?;
+        let options = RenderOptions {
+            samples_per_pixel: 20,
+            seed: img.seed,
+            ..Default::default()
+        };
+        let film = render(&d.scene(), &d.camera(img.width), &options).map_err(|e| e.to_string())?;
+        write_png(
+            &dest.join(&img.file),
+            &Rgb8Image {
+                width: film.width,
+                height: film.height,
+                data: match img.encoding.as_deref() {
+                    None | Some("course") => film.to_course_rgb8(),
+                    Some("linear") => film
+                        .mean
+                        .iter()
+                        .flat_map(|c| c.to_array().map(|x| (255.0 * x.clamp(0.0, 0.999)) as u8))
+                        .collect(),
+                    Some(other) => return Err(format!("{name}: unknown encoding {other:?}")),
+                },
+            },
+        )
+        .map_err(|e| e.to_string())?;
+    }
+    Ok(spec.loses)
+}
+
+fn secs(d: Duration) -> f64 {
+    d.as_secs_f64()
+}
+
+/// Runs the benchmark and prints its figures; returns `(one submission, batch of 30)` in seconds.
+pub fn run() -> (f64, f64) {
+    let work = tempfile::tempdir().expect("a temporary folder");
+    let names = fixture_names();
+    let subs = work.path().join("subs");
+    for i in 0..30 {
+        let name = &names[i % names.len()];
+        materialize(name, &subs.join(format!("{i:02}-{name}"))).expect("fixtures materialize");
+    }
+    let honest = work.path().join("honest");
+    materialize("honest", &honest).expect("the honest fixture");
+
+    // Baseline: starting the interpreter once, as the grader must at least do.
+    let python = ["/usr/bin/python3", "python3"]
+        .into_iter()
+        .find(|p| {
+            std::process::Command::new(p)
+                .arg("-c")
+                .arg("pass")
+                .status()
+                .is_ok()
+        })
+        .unwrap_or("python3");
+    let mut starts: Vec<f64> = (0..5)
+        .map(|_| {
+            let t = Instant::now();
+            let _ = std::process::Command::new(python)
+                .args(["-I", "-S", "-c", "pass"])
+                .status();
+            secs(t.elapsed())
+        })
+        .collect();
+    starts.sort_by(f64::total_cmp);
+    let baseline = starts[2];
+
+    let rubric = Rubric::week04();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("a pool");
+    let one = pool.install(|| {
+        let t = Instant::now();
+        grade_to_dir(
+            &honest,
+            &rubric,
+            &StandinCodeChecker::default(),
+            &StandinImageChecker::default(),
+            &work.path().join("one"),
+            &Format::ALL,
+        )
+        .expect("grading works");
+        secs(t.elapsed())
+    });
+    let batch_time = pool.install(|| {
+        let t = Instant::now();
+        let entries = batch::grade_batch(
+            &subs,
+            &rubric,
+            &StandinCodeChecker::default(),
+            &StandinImageChecker::default(),
+            &work.path().join("batch"),
+            &Format::ALL,
+        )
+        .expect("batch grading works");
+        assert_eq!(entries.len(), 30);
+        secs(t.elapsed())
+    });
+    println!(
+        "grade benchmark (2 threads; fixtures: {})",
+        names.join(", ")
+    );
+    println!(
+        "  baseline: start python3 once            {:8.3} s",
+        baseline
+    );
+    println!(
+        "  one submission (honest, cold)           {:8.3} s  = {:6.1} x baseline  (target < 10 s)",
+        one,
+        one / baseline
+    );
+    println!(
+        "  batch of 30 (all fixtures, 2 threads)   {:8.3} s  = {:6.1} x baseline, {:.3} s per submission  (target < 180 s)",
+        batch_time,
+        batch_time / baseline,
+        batch_time / 30.0
+    );
+    (one, batch_time)
+}

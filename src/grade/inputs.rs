@@ -1,0 +1,168 @@
+//! The two narrow interfaces grading is built on: one checks a submission's code against the
+//! intersection vectors, the other compares one of its images with the reference.
+//!
+//! [`grade`](super::grade) only ever talks to a [`CodeChecker`] and an [`ImageChecker`], so the
+//! real `check` and `compare` modules plug in by implementing these two traits; the stand-ins in
+//! [`standin`](super::standin) and the fakes of the tests implement them too.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::oracle::vectors::ShapeKind;
+
+/// Checks the intersection code of a submission.
+pub trait CodeChecker: Sync {
+    /// Runs the vectors of every kind in `groups` against the submission in folder `submission`
+    /// and counts the outcomes per kind. Never panics and never returns an error: whatever goes
+    /// wrong with the student's code (import error, crash, hang, junk output) is described in
+    /// the outcome ([`CodeOutcome::fatal`], failure kinds), so the rest of the grading goes on.
+    fn check(&self, submission: &Path, groups: &[ShapeKind]) -> CodeOutcome;
+
+    /// What the checker runs, for the report (e.g. `"stand-in python driver, default suite seed 0"`).
+    fn describe(&self) -> String;
+
+    /// The SHA-256 (hex) of the vectors it runs, for the report's reproducibility block.
+    fn vectors_sha256(&self) -> String;
+}
+
+/// Compares one image of a submission with the reference of a scene.
+pub trait ImageChecker: Sync {
+    /// Compares `candidate_png` with the reference of the built-in scene `scene` (for example
+    /// `"week04-sphere"`), writing a heatmap to `heatmap_out` when it can. Never panics and never
+    /// returns an error: an unreadable or wrong-size file is [`ImageVerdict::Unusable`].
+    fn check(&self, candidate_png: &Path, scene: &str, heatmap_out: &Path) -> ImageOutcome;
+
+    /// What the checker does, for the report.
+    fn describe(&self) -> String;
+
+    /// The SHA-256 (hex) of the golden/reference it compares `scene` with.
+    fn golden_sha256(&self, scene: &str) -> String;
+}
+
+/// Counts of one shape kind's vectors.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GroupCounts {
+    /// Definite (`hit` / `miss`) vectors of this kind: the ones that are scored.
+    pub definite_total: usize,
+    /// Definite vectors answered correctly.
+    pub passed: usize,
+    /// Definite vectors answered wrongly (wrong hit/miss, t, normal or front_face, or junk).
+    pub failed: usize,
+    /// Definite vectors on which the code raised an exception.
+    pub errors: usize,
+    /// Definite vectors on which the code did not answer in time or crashed the interpreter.
+    pub timeouts: usize,
+    /// Definite vectors never run (after too many timeouts, or when the import failed).
+    pub not_run: usize,
+    /// Ambiguous vectors run (reported, scored only when the rubric says so).
+    pub ambiguous: usize,
+    /// Ambiguous vectors whose answer equals the exact one.
+    pub ambiguous_passed: usize,
+}
+
+/// How one vector went wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureKind {
+    /// An answer that differs from the expected one.
+    Mismatch,
+    /// The code raised an exception.
+    Error,
+    /// No answer within the per-case time limit (or the interpreter died on it).
+    Timeout,
+    /// Not run.
+    NotRun,
+    /// The answer could not be read (stray output, junk).
+    Protocol,
+}
+
+impl FailureKind {
+    /// The snake_case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            FailureKind::Mismatch => "mismatch",
+            FailureKind::Error => "error",
+            FailureKind::Timeout => "timeout",
+            FailureKind::NotRun => "not_run",
+            FailureKind::Protocol => "protocol",
+        }
+    }
+}
+
+/// One failing vector, ready to be shown to a student.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FailureSummary {
+    /// The vector's id (`sphere-basic-0000`).
+    pub id: String,
+    /// The shape kind.
+    pub shape: ShapeKind,
+    /// The vector's tags (`tangent`, `corner`, ...).
+    pub tags: Vec<String>,
+    /// How it failed.
+    pub kind: FailureKind,
+    /// Whether the vector is definite (scored) or ambiguous (reported only).
+    pub definite: bool,
+    /// The expected answer, as JSON.
+    pub expected: serde_json::Value,
+    /// The answer received, as JSON (`null` when there was none).
+    pub actual: serde_json::Value,
+    /// One line saying what differs.
+    pub message: String,
+    /// A ready-to-run Python snippet reproducing the case with the course's API.
+    pub repro: String,
+}
+
+/// Everything a [`CodeChecker`] found.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CodeOutcome {
+    /// Counts per shape kind (every kind asked for is present).
+    pub per_group: BTreeMap<ShapeKind, GroupCounts>,
+    /// Failing vectors, definite ones first, in the suite's order within each kind.
+    pub failures: Vec<FailureSummary>,
+    /// Set when nothing could be run at all: the import failed (the message shows the
+    /// exception), the interpreter is missing, ...
+    pub fatal: Option<String>,
+    /// The last lines the code wrote to stderr (truncated).
+    pub stderr_tail: String,
+    /// Facts about the sandbox the code ran in (limits, user, network), for the report.
+    pub sandbox: serde_json::Value,
+}
+
+/// The verdict on one image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "verdict", content = "reason", rename_all = "snake_case")]
+pub enum ImageVerdict {
+    /// Indistinguishable from the reference up to Monte Carlo noise.
+    Pass,
+    /// Differs from the reference.
+    Fail,
+    /// Cannot be compared: missing, unreadable, wrong size, ... (the reason says which).
+    Unusable(String),
+}
+
+/// Everything an [`ImageChecker`] found.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImageOutcome {
+    /// Pass, fail, or unusable.
+    pub verdict: ImageVerdict,
+    /// The comparison's figures (free-form JSON object).
+    pub metrics: serde_json::Value,
+    /// A sentence saying what the difference looks like, when there is one.
+    pub diagnosis: Option<String>,
+    /// The heatmap written, if any.
+    pub heatmap: Option<PathBuf>,
+}
+
+impl ImageOutcome {
+    /// An unusable image with `reason`.
+    pub fn unusable(reason: impl Into<String>) -> Self {
+        ImageOutcome {
+            verdict: ImageVerdict::Unusable(reason.into()),
+            metrics: serde_json::Value::Object(Default::default()),
+            diagnosis: None,
+            heatmap: None,
+        }
+    }
+}

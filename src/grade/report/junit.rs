@@ -1,0 +1,113 @@
+//! `junit.xml`: a `<testsuite>` per rubric group and a `<testcase>` per check, with `<failure>`,
+//! `<error>` or `<skipped>` as the check came out, written by a small escaping writer.
+
+use std::fmt::Write;
+
+use crate::grade::{CheckStatus, GradeReport};
+
+/// Escapes text for XML content and attribute values, dropping characters XML 1.0 forbids.
+pub fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            '\n' => out.push_str("&#10;"),
+            '\t' | '\r' => out.push_str(&format!("&#{};", c as u32)),
+            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => out.push('\u{FFFD}'),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// `junit.xml` text.
+pub fn render(report: &GradeReport) -> String {
+    let count = |s: CheckStatus| report.checks.iter().filter(|c| c.status == s).count();
+    let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        x,
+        "<testsuites name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"{}\" time=\"{}\">",
+        escape(&format!("rtoracle grade {}", report.submission)),
+        report.checks.len(),
+        count(CheckStatus::Failed),
+        count(CheckStatus::Error),
+        count(CheckStatus::Skipped),
+        report.execution_time
+    );
+    for (group, score, max) in report.group_scores() {
+        let checks: Vec<_> = report.checks.iter().filter(|c| c.group == group).collect();
+        let n = |s: CheckStatus| checks.iter().filter(|c| c.status == s).count();
+        let _ = writeln!(
+            x,
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"{}\">",
+            escape(&group),
+            checks.len(),
+            n(CheckStatus::Failed),
+            n(CheckStatus::Error),
+            n(CheckStatus::Skipped)
+        );
+        let _ = writeln!(
+            x,
+            "    <properties>\n      <property name=\"score\" value=\"{score}\"/>\n      <property name=\"max_score\" value=\"{max}\"/>\n    </properties>"
+        );
+        for c in checks {
+            let _ = write!(
+                x,
+                "    <testcase classname=\"{}\" name=\"{}\"",
+                escape(&c.group),
+                escape(&c.id)
+            );
+            let mut body = c.message.clone();
+            for f in &c.failures {
+                body.push_str(&format!(
+                    "\n\n{} [{}]: {}\n{}",
+                    f.id,
+                    f.kind.name(),
+                    f.message,
+                    f.repro
+                ));
+            }
+            let tag = match c.status {
+                CheckStatus::Passed => None,
+                CheckStatus::Failed => Some("failure"),
+                CheckStatus::Error => Some("error"),
+                CheckStatus::Skipped => Some("skipped"),
+            };
+            match tag {
+                None => x.push_str("/>\n"),
+                Some(tag) => {
+                    let _ = writeln!(
+                        x,
+                        ">\n      <{tag} message=\"{}\" type=\"{}\">{}</{tag}>\n    </testcase>",
+                        escape(&format!(
+                            "{} / {}: {}",
+                            c.score,
+                            c.max_score,
+                            c.message.lines().next().unwrap_or("")
+                        )),
+                        c.status.name(),
+                        escape(&body)
+                    );
+                }
+            }
+        }
+        x.push_str("  </testsuite>\n");
+    }
+    x.push_str("</testsuites>\n");
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escaping_covers_markup_quotes_and_control_characters() {
+        assert_eq!(escape("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&apos;");
+        assert_eq!(escape("x\u{1}y\nz"), "x\u{FFFD}y&#10;z");
+    }
+}
