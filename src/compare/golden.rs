@@ -322,14 +322,34 @@ pub fn cache_path(dir: &Path, name: &str, description: &SceneDescription, spp: u
     dir.join(format!("golden-{safe}-{spp}spp-{hex}.bin"))
 }
 
+/// The golden compiled into the binary for the built-in scene `name`, when there is one, it was
+/// made from the scene as it is now (its `rtoracle.sceneSha256` attribute), and it has at least
+/// `spp` samples per pixel.
+pub fn embedded_golden(name: &str, spp: u32) -> Option<Golden> {
+    let description = crate::scene::builtin(name).ok()?;
+    let image = crate::golden::embedded_golden_image(name)?;
+    let made_from = image.attribute(crate::golden::ATTR_SCENE_SHA256)?;
+    if made_from != crate::golden::scene_sha256(&description) {
+        return None;
+    }
+    let label = format!(
+        "(embedded) golden/{}",
+        crate::golden::golden_file_name(name)
+    );
+    let golden = Golden::from_exr_image(image, Path::new(&label)).ok()?;
+    (golden.samples_per_pixel >= spp).then_some(golden)
+}
+
 /// The golden of the built-in scene `name` for candidates with `candidate_spp` samples per
-/// pixel: read from the cache, or rendered once (with a progress bar) and cached atomically.
-///
-/// This is the single place to swap in goldens embedded in the binary.
+/// pixel (`M >= max(4096, 100 N)`): the one embedded in the binary when it is good enough,
+/// else read from the cache, else rendered once (with a progress bar) and cached atomically.
 pub fn golden_for_scene(name: &str, candidate_spp: u32) -> Result<Golden, CompareError> {
     let description =
         crate::scene::builtin(name).map_err(|e| CompareError::Golden(e.to_string()))?;
     let spp = golden_spp(candidate_spp);
+    if let Some(golden) = embedded_golden(name, spp) {
+        return Ok(golden);
+    }
     let cached = cache_dir().map(|d| cache_path(&d, name, &description, spp));
     if let Some(path) = &cached {
         if let Ok(bytes) = std::fs::read(path) {
@@ -435,6 +455,19 @@ mod tests {
         moved.objects.pop();
         assert_ne!(a, cache_path(dir, "week04-sphere", &moved, 4096));
         assert!(a.starts_with(dir));
+    }
+
+    #[test]
+    fn the_course_goldens_are_embedded_at_4096_spp() {
+        for scene in ["week04-sphere", "week04-quad"] {
+            let g = embedded_golden(scene, golden_spp(20)).expect("embedded");
+            assert_eq!(g.samples_per_pixel, 4096);
+            assert_eq!(g.scene.as_deref(), Some(scene));
+            let camera = crate::scene::builtin(scene).unwrap().camera(None);
+            assert_eq!((g.width, g.height), (camera.width, camera.height));
+            // Candidates with more than 40 spp need a golden with more samples than embedded.
+            assert!(embedded_golden(scene, golden_spp(41)).is_none());
+        }
     }
 
     #[test]

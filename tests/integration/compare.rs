@@ -442,3 +442,47 @@ fn bad_candidates_exit_2_naming_the_file() {
     let out = compare_cli(p, &["good.png"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// The comparison as grading's image checker: honest passes, a flipped image fails with the
+/// diagnosis and a heatmap, missing and wrong-size files are unusable.
+#[test]
+fn the_grading_image_checker_uses_the_comparison() {
+    use rtoracle::compare::CompareImageChecker;
+    use rtoracle::grade::inputs::{ImageChecker, ImageVerdict};
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    let honest = write(
+        p,
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 20, 11),
+    );
+    let bgr = write(p, "bgr.png", &render_with_mistake(&d, Mistake::Bgr, 20, 11));
+    let small = write(
+        p,
+        "small.png",
+        &Rgb8Image {
+            width: 4,
+            height: 4,
+            data: vec![0; 48],
+        },
+    );
+    let checker = CompareImageChecker::default();
+    let ok = checker.check(&honest, "week04-sphere", &p.join("h1.png"));
+    assert_eq!(ok.verdict, ImageVerdict::Pass);
+    assert_eq!(ok.metrics["verdict"], "pass");
+    let bad = checker.check(&bgr, "week04-sphere", &p.join("h2.png"));
+    assert_eq!(bad.verdict, ImageVerdict::Fail);
+    assert!(bad.diagnosis.unwrap().contains("BGR"));
+    assert!(bad.heatmap.unwrap().is_file());
+    for (file, needle) in [(p.join("none.png"), "missing"), (small, "is 4x4")] {
+        match checker
+            .check(&file, "week04-sphere", &p.join("h3.png"))
+            .verdict
+        {
+            ImageVerdict::Unusable(why) => assert!(why.contains(needle), "{why}"),
+            other => panic!("{other:?}"),
+        }
+    }
+    assert_eq!(checker.golden_sha256("week04-sphere").len(), 64);
+}
