@@ -485,3 +485,42 @@ fn the_grading_image_checker_uses_the_comparison() {
     }
     assert_eq!(checker.golden_sha256("week04-sphere").len(), 64);
 }
+
+/// An EXR candidate (linear f32, as `rtoracle render -o X.exr` writes it) is compared as values:
+/// an honest one passes, the same with every value times 0.97 fails.
+#[test]
+fn exr_candidates_are_compared_as_linear_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    let film = render(
+        &d.scene(),
+        &d.camera(None),
+        &RenderOptions {
+            samples_per_pixel: 20,
+            seed: 31,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let honest = dir.path().join("honest.exr");
+    rtoracle::image_io::write_exr(&honest, &film, &[]).unwrap();
+    let mut darker = film.clone();
+    for m in &mut darker.mean {
+        *m *= 0.97;
+    }
+    let dark = dir.path().join("dark.exr");
+    rtoracle::image_io::write_exr(&dark, &darker, &[]).unwrap();
+    let c = rtoracle::compare::compare_file(
+        &honest,
+        golden("week04-sphere"),
+        &CompareOptions::default(),
+    )
+    .unwrap();
+    assert!(c.passed(), "{:#?}", c.scales);
+    assert_eq!(c.encoding, "exr");
+    let c =
+        rtoracle::compare::compare_file(&dark, golden("week04-sphere"), &CompareOptions::default())
+            .unwrap();
+    assert!(!c.passed());
+    assert!(c.bias.iter().all(|b| *b < 0.0), "{:?}", c.bias);
+}
