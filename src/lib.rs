@@ -14,6 +14,8 @@
 //! - [`golden`]: the golden EXRs of the built-in scenes (mean and per-sample variance at 4096 spp),
 //!   embedded in the library, and their pixel comparison.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
+//! - [`compare`]: the noise-aware image comparison against goldens, with its diagnosis of
+//!   common mistakes, heatmaps and reports.
 //! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
 //!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
 //! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
@@ -21,6 +23,7 @@
 #![warn(missing_docs)]
 
 pub mod candidate;
+pub mod compare;
 pub mod geometry;
 pub mod golden;
 pub mod grade;

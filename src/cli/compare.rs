@@ -1,9 +1,161 @@
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// `rtoracle compare` (to be written).
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::Context;
+use rtoracle::compare::{
+    CandidateImage, CompareOptions, Comparison, Encoding, Golden, check_size, compare_image,
+    golden_for_scene, report, write_heatmap, write_report,
+};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("'compare' is not implemented yet")
+/// `rtoracle compare CANDIDATE (--scene NAME | --golden FILE.exr) [--spp N] [--encoding E]
+/// [--json] [--heatmap OUT.png] [--report DIR]`
+#[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("reference").required(true).args(["scene", "golden"])))]
+pub struct Args {
+    /// The image to judge: a PNG (8-bit RGB or RGBA) or an EXR.
+    candidate: PathBuf,
+    /// Compare with the golden of this built-in scene (see `rtoracle scenes`).
+    #[arg(long, value_name = "NAME")]
+    scene: Option<String>,
+    /// Compare with this golden EXR (mean and a `variance` layer).
+    #[arg(long, value_name = "FILE.exr")]
+    golden: Option<PathBuf>,
+    /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes).
+    #[arg(long, value_name = "N")]
+    spp: Option<i64>,
+    /// How the candidate's 8-bit codes encode linear values.
+    #[arg(long, value_name = "E", default_value = "course",
+          value_parser = ["course", "rtiow", "srgb", "gamma22", "linear"])]
+    encoding: String,
+    /// Print the JSON report on stdout instead of the summary.
+    #[arg(long)]
+    json: bool,
+    /// Write the signed z heatmap (failing regions outlined) to this PNG.
+    #[arg(long, value_name = "OUT.png")]
+    heatmap: Option<PathBuf>,
+    /// Write a report folder: report.json, heatmap.png, crops of the worst regions, index.html.
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
+}
+
+fn check_parent(path: &Path) -> anyhow::Result<()> {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        anyhow::bail!(
+            "{}: the output folder '{}' does not exist",
+            path.display(),
+            parent.display()
+        );
+    }
+    Ok(())
+}
+
+fn summary(c: &Comparison, candidate: &Path) -> String {
+    let mut s = format!(
+        "{} {}: {}x{}, {} spp against a {} spp golden{}, {} encoding\n",
+        if c.passed() { "PASS" } else { "FAIL" },
+        candidate.display(),
+        c.width,
+        c.height,
+        c.candidate_spp,
+        c.golden_spp,
+        c.scene
+            .as_ref()
+            .map(|n| format!(" of {n}"))
+            .unwrap_or_default(),
+        c.encoding
+    );
+    s.push_str("  scale      tests  smallest adjusted p  (threshold)  largest |z|  failing\n");
+    for r in &c.scales {
+        s.push_str(&format!(
+            "  {:<7} {:>8}  {:>19.3e}  ({:.1e})  {:>11.2}  {:>7}\n",
+            r.scale, r.tests, r.smallest_adjusted_p, r.threshold, r.largest_abs_z, r.failing
+        ));
+    }
+    s.push_str(&format!(
+        "  bias (linear R G B) {:+.5} {:+.5} {:+.5}; effective spp {}\n",
+        c.bias[0],
+        c.bias[1],
+        c.bias[2],
+        c.effective_spp
+            .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}"))
+    ));
+    for r in c.regions.iter().take(5) {
+        s.push_str(&format!(
+            "  failing region x {} y {} {}x{}: {} scale, channel {}, adjusted p {:.2e}, z {:+.1}\n",
+            r.x, r.y, r.width, r.height, r.scale, r.channel, r.adjusted_p, r.z
+        ));
+    }
+    if c.regions.len() > 5 {
+        s.push_str(&format!("  ... and {} more regions\n", c.regions.len() - 5));
+    }
+    if let Some(d) = &c.diagnosis {
+        s.push_str(&format!("  diagnosis: {}\n", d.summary));
+    }
+    s
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let encoding: Encoding = args
+        .encoding
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!(e))?;
+    if let Some(h) = &args.heatmap {
+        check_parent(h)?;
+    }
+    if let Some(r) = &args.report {
+        check_parent(r)?;
+        if r.exists() && !r.is_dir() {
+            anyhow::bail!("{}: exists and is not a folder", r.display());
+        }
+    }
+    // The candidate first: a bad candidate is reported before any golden work.
+    let candidate = CandidateImage::load(&args.candidate)?;
+    let (golden, default_spp): (Box<dyn FnOnce(u32) -> anyhow::Result<Golden>>, u32) =
+        match (&args.scene, &args.golden) {
+            (Some(name), _) => {
+                let description = rtoracle::scene::builtin(name)?;
+                let camera = description.camera(None);
+                check_size(&args.candidate, &candidate, camera.width, camera.height)?;
+                let name = name.clone();
+                (
+                    Box::new(move |spp| Ok(golden_for_scene(&name, spp)?)),
+                    description.image.samples_per_pixel,
+                )
+            }
+            (None, Some(path)) => {
+                let g = Golden::from_exr(path)?;
+                check_size(&args.candidate, &candidate, g.width, g.height)?;
+                (Box::new(move |_| Ok(g)), 20)
+            }
+            (None, None) => anyhow::bail!("give --scene NAME or --golden FILE.exr"),
+        };
+    let spp = match args.spp {
+        Some(n) if n <= 0 => anyhow::bail!("--spp {n}: samples per pixel must be at least 1"),
+        Some(n) => u32::try_from(n).map_err(|_| anyhow::anyhow!("--spp {n}: too large"))?,
+        None => default_spp,
+    };
+    let golden = golden(spp)?;
+    let options = CompareOptions {
+        samples_per_pixel: spp,
+        encoding,
+        ..Default::default()
+    };
+    let comparison = compare_image(&candidate, &golden, &options)
+        .with_context(|| args.candidate.display().to_string())?;
+    if let Some(h) = &args.heatmap {
+        write_heatmap(h, &comparison)?;
+    }
+    if let Some(r) = &args.report {
+        write_report(r, &comparison, &candidate, &golden, encoding)?;
+    }
+    if args.json {
+        println!("{}", report::to_json(&comparison));
+    } else {
+        print!("{}", summary(&comparison, &args.candidate));
+    }
+    Ok(ExitCode::from(if comparison.passed() { 0 } else { 1 }))
 }

@@ -2,6 +2,7 @@
 
 mod check;
 mod common;
+mod compare;
 mod golden;
 mod grade;
 mod render;

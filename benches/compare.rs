@@ -1,0 +1,5 @@
+//! `cargo bench --bench compare`: the comparison's speed against a plain difference pass.
+
+fn main() {
+    print!("{}", rtoracle::compare::bench::run());
+}

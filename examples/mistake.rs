@@ -1,0 +1,37 @@
+//! Renders a built-in scene with one of the common mistakes injected, as a course-encoded PNG:
+//! `cargo run --release --example mistake -- SCENE MISTAKE OUT.png [SEED]`.
+//! MISTAKE is one of: honest, no-gamma, gamma22, albedo, half-pixel, jitter01, flip-y, bgr,
+//! fov, missing, sky.
+
+use rtoracle::compare::mistakes::{Mistake, render_with_mistake};
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [scene, mistake, out, rest @ ..] = args.as_slice() else {
+        anyhow::bail!("usage: mistake SCENE MISTAKE OUT.png [SEED]");
+    };
+    let mistake = match mistake.as_str() {
+        "honest" => Mistake::Honest,
+        "no-gamma" => Mistake::NoGamma,
+        "gamma22" => Mistake::Gamma22,
+        "albedo" => Mistake::AlbedoScaled,
+        "half-pixel" => Mistake::HalfPixelShift,
+        "jitter01" => Mistake::JitterZeroOne,
+        "flip-y" => Mistake::YFlipped,
+        "bgr" => Mistake::Bgr,
+        "fov" => Mistake::WiderFov,
+        "missing" => Mistake::ObjectMissing,
+        "sky" => Mistake::SkyReversed,
+        other => anyhow::bail!("unknown mistake '{other}'"),
+    };
+    let seed = rest.first().map(|s| s.parse()).transpose()?.unwrap_or(1);
+    let description = rtoracle::scene::builtin(scene)?;
+    let spp = description.image.samples_per_pixel;
+    let image = render_with_mistake(&description, mistake, spp, seed);
+    rtoracle::image_io::write_png(std::path::Path::new(out), &image)?;
+    eprintln!(
+        "wrote {out}: {scene} with '{}', {spp} spp, seed {seed}",
+        mistake.name()
+    );
+    Ok(())
+}

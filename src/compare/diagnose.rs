@@ -1,0 +1,169 @@
+//! When an image fails: test the common mistakes as alternative hypotheses and name the one
+//! that explains the image.
+
+use rayon::prelude::*;
+
+use super::{
+    CandidateImage, CompareOptions, Diagnosis, ENCODINGS, Encoding, Evaluation, Golden,
+    HypothesisScore, evaluate,
+};
+
+/// A hypothesis must remove at least this share of the misfit to be named as the explanation.
+const EXPLAINS: f64 = 0.5;
+
+fn encoding_mistake(e: Encoding, asked: Encoding) -> String {
+    match e {
+        Encoding::Linear => "fits the golden with no gamma applied (linear values written as codes)".into(),
+        Encoding::Gamma22 => format!("fits the golden encoded with gamma 2.2, where the {asked} encoding is asked for"),
+        Encoding::Srgb => format!("fits the golden encoded with the sRGB curve, where the {asked} encoding is asked for"),
+        Encoding::Rtiow => "fits the golden encoded as the book does (256 * clamp(sqrt(x), 0, 0.999)), not as the course does (255 * ...)".into(),
+        Encoding::Course => "fits the golden encoded as the course does (255 * clamp(sqrt(x), 0, 0.999), truncated)".into(),
+    }
+}
+
+fn flip_y(c: &CandidateImage) -> CandidateImage {
+    match c {
+        CandidateImage::Rgb8 {
+            width,
+            height,
+            data,
+        } => CandidateImage::Rgb8 {
+            width: *width,
+            height: *height,
+            data: data
+                .chunks_exact(3 * width)
+                .rev()
+                .flatten()
+                .copied()
+                .collect(),
+        },
+        CandidateImage::Linear {
+            width,
+            height,
+            data,
+        } => CandidateImage::Linear {
+            width: *width,
+            height: *height,
+            data: data.chunks_exact(*width).rev().flatten().copied().collect(),
+        },
+    }
+}
+
+fn bgr(c: &CandidateImage) -> CandidateImage {
+    match c {
+        CandidateImage::Rgb8 {
+            width,
+            height,
+            data,
+        } => CandidateImage::Rgb8 {
+            width: *width,
+            height: *height,
+            data: data
+                .chunks_exact(3)
+                .flat_map(|p| [p[2], p[1], p[0]])
+                .collect(),
+        },
+        CandidateImage::Linear {
+            width,
+            height,
+            data,
+        } => CandidateImage::Linear {
+            width: *width,
+            height: *height,
+            data: data.iter().map(|p| [p[2], p[1], p[0]]).collect(),
+        },
+    }
+}
+
+enum Try {
+    Encoding(Encoding),
+    FlipY,
+    Bgr,
+    Shift(i32),
+}
+
+/// Tries every hypothesis on a failed image and names the best one that explains at least half
+/// of the misfit.
+pub fn diagnose(
+    candidate: &CandidateImage,
+    golden: &Golden,
+    options: &CompareOptions,
+    base: &Evaluation,
+) -> Diagnosis {
+    let asked = options.encoding;
+    let mut tries: Vec<Try> = Vec::new();
+    if matches!(candidate, CandidateImage::Rgb8 { .. }) {
+        for e in ENCODINGS.into_iter().filter(|&e| e != asked) {
+            tries.push(Try::Encoding(e));
+        }
+    }
+    tries.extend([Try::FlipY, Try::Bgr, Try::Shift(1), Try::Shift(-1)]);
+    // The hypotheses are independent: evaluate them in parallel (each is deterministic).
+    let mut scores: Vec<HypothesisScore> = tries
+        .par_iter()
+        .map(|t| {
+            let (name, mistake, e) = match *t {
+                Try::Encoding(e) => (
+                    format!("encoding:{e}"),
+                    encoding_mistake(e, asked),
+                    evaluate(candidate, golden, e, options),
+                ),
+                Try::FlipY => (
+                    "flip-y".to_string(),
+                    "fits the golden upside down: rows written bottom to top (y flipped)"
+                        .to_string(),
+                    evaluate(&flip_y(candidate), golden, asked, options),
+                ),
+                Try::Bgr => (
+                    "bgr".to_string(),
+                    "fits the golden with red and blue swapped: channels written in BGR order"
+                        .to_string(),
+                    evaluate(&bgr(candidate), golden, asked, options),
+                ),
+                Try::Shift(s) if s > 0 => (
+                    "shift:+0.5".to_string(),
+                    "fits the golden shifted half a pixel right and down: samples jittered in [0, 1) instead of [-0.5, 0.5)".to_string(),
+                    evaluate(candidate, &golden.half_pixel_shifted(1), asked, options),
+                ),
+                Try::Shift(_) => (
+                    "shift:-0.5".to_string(),
+                    "fits the golden shifted half a pixel left and up: a half-pixel camera shift (pixel00 without its half-pixel offset?)".to_string(),
+                    evaluate(candidate, &golden.half_pixel_shifted(-1), asked, options),
+                ),
+            };
+            HypothesisScore {
+                name,
+                mistake,
+                misfit_ratio: if base.misfit > 0.0 {
+                    e.misfit / base.misfit
+                } else {
+                    1.0
+                },
+                passes: e.passed,
+            }
+        })
+        .collect();
+    scores.sort_by(|a, b| {
+        b.passes
+            .cmp(&a.passes)
+            .then(a.misfit_ratio.total_cmp(&b.misfit_ratio))
+    });
+    let best = scores
+        .first()
+        .filter(|s| s.passes || s.misfit_ratio < EXPLAINS)
+        .cloned();
+    let summary = match &best {
+        Some(s) if s.passes => s.mistake.clone(),
+        Some(s) => format!(
+            "closest explanation: {} (it removes {:.0}% of the misfit but the image still fails)",
+            s.mistake,
+            100.0 * (1.0 - s.misfit_ratio)
+        ),
+        None => "no common mistake explains the image (tried other encodings, y flipped, BGR, half-pixel shifts): look at the failing regions".into(),
+    };
+    Diagnosis {
+        summary,
+        best: best.map(|s| s.name),
+        hypotheses: scores,
+    }
+}

@@ -1,0 +1,348 @@
+//! The noise-aware image comparison: is a candidate image a render of the golden's scene with
+//! `N` samples per pixel, or does it differ by more than Monte Carlo noise can explain?
+//!
+//! Each 8-bit code is an interval of linear values under the chosen [`Encoding`]; the golden
+//! gives each pixel's mean and per-sample variance; Bernstein bounds turn the distance from the
+//! candidate's interval to the golden's mean into p-values at four scales (pixel, 8x8 tile,
+//! 32x32 tile, whole image), each given a quarter of the per-image false-failure rate and
+//! adjusted with Šidák's formula over its tests. When an image fails, [`diagnose`] tests the
+//! common mistakes as alternative hypotheses. See `docs/sections/compare.md`.
+
+pub mod bench;
+pub mod checker;
+pub mod diagnose;
+pub mod encoding;
+pub mod golden;
+pub mod heatmap;
+pub mod mistakes;
+pub mod report;
+pub mod stats;
+mod verdict;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use checker::CompareImageChecker;
+pub use encoding::{ENCODINGS, Encoding};
+pub use golden::{Golden, golden_for_scene, golden_spp};
+pub use heatmap::write_heatmap;
+pub use report::write_report;
+pub use verdict::{Evaluation, evaluate};
+
+use crate::image_io::ImageError;
+
+/// What stops a comparison (one line, naming the file when there is one).
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// An image could not be read.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    /// A file was read but cannot be used as asked.
+    #[error("{path}: {message}")]
+    Input {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The golden is unusable.
+    #[error("golden: {0}")]
+    Golden(String),
+}
+
+/// A candidate image: 8-bit codes (from a PNG) or linear values (from an EXR).
+#[derive(Clone, Debug, PartialEq)]
+pub enum CandidateImage {
+    /// 8-bit RGB, row-major, top row first.
+    Rgb8 {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+        /// `3 * width * height` codes.
+        data: Vec<u8>,
+    },
+    /// Linear RGB (an EXR, read as `f32`), row-major, top row first.
+    Linear {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+        /// One linear RGB triple per pixel.
+        data: Vec<[f32; 3]>,
+    },
+}
+
+impl CandidateImage {
+    /// Reads a PNG (8-bit RGB or RGBA) or an EXR, telling them apart by their first bytes.
+    pub fn load(path: &Path) -> Result<Self, CompareError> {
+        let bad = |message: String| CompareError::Input {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mut head = [0u8; 8];
+        let n = {
+            use std::io::Read;
+            let mut f = std::fs::File::open(path).map_err(|e| {
+                bad(if e.kind() == std::io::ErrorKind::NotFound {
+                    "no such file".to_string()
+                } else {
+                    format!("cannot open: {e}")
+                })
+            })?;
+            if f.metadata().map(|m| m.is_dir()).unwrap_or(false) {
+                return Err(bad("is a folder, not an image".into()));
+            }
+            f.read(&mut head)
+                .map_err(|e| bad(format!("cannot read: {e}")))?
+        };
+        if n >= 8 && head == *b"\x89PNG\r\n\x1a\n" {
+            let img = crate::image_io::read_png(path)?;
+            Ok(CandidateImage::Rgb8 {
+                width: img.width,
+                height: img.height,
+                data: img.data,
+            })
+        } else if n >= 4 && head[..4] == [0x76, 0x2f, 0x31, 0x01] {
+            let img = crate::image_io::read_exr(path)?;
+            if img.data_is_bad() {
+                return Err(bad("has a NaN or infinite pixel value".into()));
+            }
+            Ok(CandidateImage::Linear {
+                width: img.width,
+                height: img.height,
+                data: img.mean,
+            })
+        } else if n == 0 {
+            Err(bad("is empty, not an image".into()))
+        } else {
+            Err(bad("is not a PNG or EXR image".into()))
+        }
+    }
+
+    /// `(width, height)`.
+    pub fn size(&self) -> (usize, usize) {
+        match self {
+            CandidateImage::Rgb8 { width, height, .. }
+            | CandidateImage::Linear { width, height, .. } => (*width, *height),
+        }
+    }
+
+    /// The image as 8-bit RGB for pictures (linear images are encoded with `encoding`).
+    pub fn to_rgb8(&self, encoding: Encoding) -> Vec<u8> {
+        match self {
+            CandidateImage::Rgb8 { data, .. } => data.clone(),
+            CandidateImage::Linear { data, .. } => data
+                .iter()
+                .flat_map(|p| p.map(|x| encoding.encode(x as f64)))
+                .collect(),
+        }
+    }
+}
+
+trait ExrCheck {
+    fn data_is_bad(&self) -> bool;
+}
+
+impl ExrCheck for crate::image_io::ExrImage {
+    fn data_is_bad(&self) -> bool {
+        self.mean.iter().any(|p| p.iter().any(|x| !x.is_finite()))
+    }
+}
+
+/// How to compare.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CompareOptions {
+    /// The candidate's samples per pixel `N`.
+    pub samples_per_pixel: u32,
+    /// The encoding the assignment asks for (how 8-bit codes are read).
+    pub encoding: Encoding,
+    /// The per-image false-failure rate, split equally across the four scales.
+    pub alpha: f64,
+    /// How much more per-sample variance than the golden's an honest sampler may have.
+    pub lambda: f64,
+    /// Test the common mistakes when the image fails.
+    pub diagnose: bool,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        Self {
+            samples_per_pixel: 20,
+            encoding: Encoding::Course,
+            alpha: 1e-4,
+            lambda: 2.25,
+            diagnose: true,
+        }
+    }
+}
+
+/// Pass or fail.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Within Monte Carlo noise at every scale.
+    Pass,
+    /// Outside it at some scale.
+    Fail,
+}
+
+/// The result at one scale.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScaleResult {
+    /// `pixel`, `tile8`, `tile32` or `global`.
+    pub scale: String,
+    /// Number of tests (pixel or tile and channel) at this scale.
+    pub tests: usize,
+    /// The smallest p-value after Šidák's adjustment for `tests`.
+    pub smallest_adjusted_p: f64,
+    /// The threshold: a quarter of the per-image false-failure rate.
+    pub threshold: f64,
+    /// The largest `|z|` (distance over standard error) at this scale.
+    pub largest_abs_z: f64,
+    /// Tests whose adjusted p fell below the threshold.
+    pub failing: usize,
+}
+
+/// A failing region of the image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Region {
+    /// Left column.
+    pub x: usize,
+    /// Top row.
+    pub y: usize,
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// The scale of the strongest evidence inside.
+    pub scale: String,
+    /// The channel of the strongest evidence (`R`, `G` or `B`).
+    pub channel: String,
+    /// The smallest adjusted p inside.
+    pub adjusted_p: f64,
+    /// Its signed z: positive when the candidate is brighter than the golden.
+    pub z: f64,
+}
+
+/// One alternative hypothesis the diagnosis tried.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HypothesisScore {
+    /// Short name (`encoding:linear`, `flip-y`, `bgr`, `shift:+0.5`, `shift:-0.5`).
+    pub name: String,
+    /// The mistake it stands for, in words.
+    pub mistake: String,
+    /// Its misfit over the misfit of the image as given (below 1 explains some of it).
+    pub misfit_ratio: f64,
+    /// Whether the image passes under this hypothesis.
+    pub passes: bool,
+}
+
+/// What the diagnosis found.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Diagnosis {
+    /// One sentence: the mistake that explains the image, or that none does.
+    pub summary: String,
+    /// The best hypothesis's name, when one explains the image.
+    pub best: Option<String>,
+    /// Every hypothesis tried, best first.
+    pub hypotheses: Vec<HypothesisScore>,
+}
+
+/// The full result of a comparison (serialised as the JSON report).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Comparison {
+    /// Pass or fail.
+    pub verdict: Verdict,
+    /// Image width.
+    pub width: usize,
+    /// Image height.
+    pub height: usize,
+    /// The candidate's samples per pixel.
+    pub candidate_spp: u32,
+    /// The golden's samples per pixel.
+    pub golden_spp: u32,
+    /// The golden's scene, when known.
+    pub scene: Option<String>,
+    /// How the candidate's codes were read (`exr` for linear candidates).
+    pub encoding: String,
+    /// The per-image false-failure rate.
+    pub alpha: f64,
+    /// One entry per scale: pixel, tile8, tile32, global.
+    pub scales: Vec<ScaleResult>,
+    /// The failing regions, worst first (at most 50).
+    pub regions: Vec<Region>,
+    /// Mean of (candidate - golden) per channel, linear, over all pixels (mid-points of the
+    /// candidate's intervals).
+    pub bias: [f64; 3],
+    /// The candidate's samples per pixel as its noise suggests (from the noisy pixels).
+    pub effective_spp: Option<f64>,
+    /// The diagnosis, when the image fails and diagnosis was asked for.
+    pub diagnosis: Option<Diagnosis>,
+    /// Signed z per pixel (the channel with the largest |z|), clamped to +-1000; for pictures.
+    #[serde(skip)]
+    pub z_map: Vec<f32>,
+}
+
+impl Comparison {
+    /// Whether the candidate passed.
+    pub fn passed(&self) -> bool {
+        self.verdict == Verdict::Pass
+    }
+}
+
+/// Compares a candidate with a golden. Errors when the sizes differ.
+pub fn compare_image(
+    candidate: &CandidateImage,
+    golden: &Golden,
+    options: &CompareOptions,
+) -> Result<Comparison, CompareError> {
+    let (w, h) = candidate.size();
+    if (w, h) != (golden.width, golden.height) {
+        return Err(CompareError::Golden(format!(
+            "the candidate is {w}x{h} but the golden is {}x{}",
+            golden.width, golden.height
+        )));
+    }
+    if options.samples_per_pixel == 0 {
+        return Err(CompareError::Golden(
+            "the candidate's samples per pixel must be at least 1".into(),
+        ));
+    }
+    let evaluation = evaluate(candidate, golden, options.encoding, options);
+    let diagnosis = if !evaluation.passed && options.diagnose {
+        Some(diagnose::diagnose(candidate, golden, options, &evaluation))
+    } else {
+        None
+    };
+    Ok(evaluation.into_comparison(candidate, golden, options, diagnosis))
+}
+
+/// Reads a candidate file and compares it, naming the file in errors (size mismatches too).
+pub fn compare_file(
+    path: &Path,
+    golden: &Golden,
+    options: &CompareOptions,
+) -> Result<Comparison, CompareError> {
+    let candidate = CandidateImage::load(path)?;
+    check_size(path, &candidate, golden.width, golden.height)?;
+    compare_image(&candidate, golden, options)
+}
+
+/// Checks the candidate has the golden's size, with an error naming the file.
+pub fn check_size(
+    path: &Path,
+    candidate: &CandidateImage,
+    width: usize,
+    height: usize,
+) -> Result<(), CompareError> {
+    let (w, h) = candidate.size();
+    if (w, h) != (width, height) {
+        return Err(CompareError::Input {
+            path: path.to_path_buf(),
+            message: format!("is {w}x{h} but the golden is {width}x{height}"),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,207 @@
+//! The report folder: `report.json`, `heatmap.png`, side-by-side crops of the worst regions
+//! (candidate, golden, difference) and an `index.html` that shows them.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::heatmap::heatmap_image;
+use super::{CandidateImage, CompareError, Comparison, Encoding, Golden};
+use crate::image_io::{ImageError, Rgb8Image, write_atomically, write_png};
+
+/// How many regions get crops.
+const CROPS: usize = 6;
+const GAP: usize = 4;
+
+/// The JSON report (pretty-printed).
+pub fn to_json(comparison: &Comparison) -> String {
+    serde_json::to_string_pretty(comparison).expect("a comparison always serialises")
+}
+
+/// The crop `(x, y, w, h)` shown for a region: the region with an 8-pixel margin, at least
+/// 24 pixels on a side, inside the image.
+fn crop_box(r: &super::Region, w: usize, h: usize) -> (usize, usize, usize, usize) {
+    let grow = |start: usize, len: usize, total: usize| {
+        let len2 = (len + 16).max(24).min(total);
+        let centre = start + len / 2;
+        let s = centre.saturating_sub(len2 / 2).min(total - len2);
+        (s, len2)
+    };
+    let (x, cw) = grow(r.x, r.width, w);
+    let (y, ch) = grow(r.y, r.height, h);
+    (x, y, cw, ch)
+}
+
+/// Candidate, golden and |difference| (x4, in codes) side by side, scaled up to about 300 pixels.
+fn side_by_side(
+    cand: &[u8],
+    gold: &[u8],
+    width: usize,
+    (x0, y0, cw, ch): (usize, usize, usize, usize),
+) -> Rgb8Image {
+    let scale = (300 / cw.max(ch)).clamp(1, 8);
+    let pw = cw * scale;
+    let out_w = 3 * pw + 2 * GAP;
+    let out_h = ch * scale;
+    let mut data = vec![255u8; out_w * out_h * 3];
+    for y in 0..out_h {
+        for x in 0..out_w {
+            let panel = x / (pw + GAP);
+            let px = x % (pw + GAP);
+            if px >= pw {
+                continue;
+            }
+            let src = 3 * ((y0 + y / scale) * width + x0 + px / scale);
+            let rgb: [u8; 3] = match panel {
+                0 => [cand[src], cand[src + 1], cand[src + 2]],
+                1 => [gold[src], gold[src + 1], gold[src + 2]],
+                _ => {
+                    let d = (0..3)
+                        .map(|c| (cand[src + c] as i32 - gold[src + c] as i32).abs())
+                        .max()
+                        .unwrap_or(0);
+                    let v = 255 - (4 * d).min(255) as u8;
+                    [v, v, v]
+                }
+            };
+            data[3 * (y * out_w + x)..3 * (y * out_w + x) + 3].copy_from_slice(&rgb);
+        }
+    }
+    Rgb8Image {
+        width: out_w,
+        height: out_h,
+        data,
+    }
+}
+
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
+    let mut h = String::new();
+    let verdict = if c.passed() { "PASS" } else { "FAIL" };
+    let _ = write!(
+        h,
+        "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>rtoracle compare: {verdict}</title>\
+         <style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 10px;text-align:right}}\
+         img{{image-rendering:pixelated;border:1px solid #ccc}}</style></head><body>\n\
+         <h1>{verdict}</h1>\n<p>{w}x{hh}, candidate {n} spp against a golden of {m} spp{scene}, \
+         encoding {enc}, false-failure rate {alpha}.</p>\n",
+        w = c.width,
+        hh = c.height,
+        n = c.candidate_spp,
+        m = c.golden_spp,
+        scene = c
+            .scene
+            .as_ref()
+            .map(|s| format!(" ({})", html_escape(s)))
+            .unwrap_or_default(),
+        enc = c.encoding,
+        alpha = c.alpha
+    );
+    if let Some(d) = &c.diagnosis {
+        let _ = writeln!(
+            h,
+            "<h2>Diagnosis</h2><p><b>{}</b></p>",
+            html_escape(&d.summary)
+        );
+    }
+    h.push_str("<h2>Scales</h2><table><tr><th>scale</th><th>tests</th><th>smallest adjusted p</th><th>threshold</th><th>largest |z|</th><th>failing</th></tr>\n");
+    for s in &c.scales {
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{:.3e}</td><td>{:.1e}</td><td>{:.2}</td><td>{}</td></tr>",
+            s.scale, s.tests, s.smallest_adjusted_p, s.threshold, s.largest_abs_z, s.failing
+        );
+    }
+    let _ = writeln!(
+        h,
+        "</table><p>Bias (linear, R G B): {:+.5} {:+.5} {:+.5}. Effective spp: {}.</p>",
+        c.bias[0],
+        c.bias[1],
+        c.bias[2],
+        c.effective_spp
+            .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}"))
+    );
+    h.push_str("<h2>Signed z (red: brighter than the golden, blue: darker; failing regions in green)</h2>\n<img src=\"heatmap.png\" alt=\"heatmap\">\n");
+    if !crops.is_empty() {
+        h.push_str("<h2>Worst regions: candidate, golden, |difference| x4</h2>\n");
+        for (file, r) in crops {
+            let _ = writeln!(
+                h,
+                "<p>x {} y {} ({}x{}), {} scale, channel {}, adjusted p {:.2e}, z {:+.1}<br><img src=\"{file}\" alt=\"{file}\"></p>",
+                r.x, r.y, r.width, r.height, r.scale, r.channel, r.adjusted_p, r.z
+            );
+        }
+    }
+    h.push_str("<p>Report: <a href=\"report.json\">report.json</a></p></body></html>\n");
+    h
+}
+
+/// Writes the report folder. When `dir` does not exist it is built beside it under a temporary
+/// name and renamed into place, so it appears whole or not at all; when it exists each file is
+/// written atomically.
+pub fn write_report(
+    dir: &Path,
+    comparison: &Comparison,
+    candidate: &CandidateImage,
+    golden: &Golden,
+    encoding: Encoding,
+) -> Result<(), CompareError> {
+    let io = |e: std::io::Error| {
+        CompareError::Image(ImageError::Io {
+            path: dir.to_path_buf(),
+            message: e.to_string(),
+        })
+    };
+    let fresh = !dir.exists();
+    let (target, staging): (PathBuf, Option<tempfile::TempDir>) = if fresh {
+        let parent = match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let tmp = tempfile::Builder::new()
+            .prefix(".rtoracle-report-")
+            .tempdir_in(parent)
+            .map_err(io)?;
+        (tmp.path().to_path_buf(), Some(tmp))
+    } else if dir.is_dir() {
+        (dir.to_path_buf(), None)
+    } else {
+        return Err(io(std::io::Error::other("exists and is not a folder")));
+    };
+    write_atomically(&target.join("report.json"), to_json(comparison).as_bytes())?;
+    write_png(&target.join("heatmap.png"), &heatmap_image(comparison))?;
+    let cand = candidate.to_rgb8(encoding);
+    let gold: Vec<u8> = golden
+        .mean
+        .iter()
+        .flat_map(|p| p.map(|x| encoding.encode(x)))
+        .collect();
+    let mut crops = Vec::new();
+    for (k, r) in comparison.regions.iter().take(CROPS).enumerate() {
+        let name = format!("region-{}.png", k + 1);
+        let img = side_by_side(
+            &cand,
+            &gold,
+            comparison.width,
+            crop_box(r, comparison.width, comparison.height),
+        );
+        write_png(&target.join(&name), &img)?;
+        crops.push((name, r.clone()));
+    }
+    write_atomically(
+        &target.join("index.html"),
+        index_html(comparison, &crops).as_bytes(),
+    )?;
+    if let Some(tmp) = staging {
+        let path = tmp.keep();
+        std::fs::rename(&path, dir).map_err(|e| {
+            let _ = std::fs::remove_dir_all(&path);
+            io(e)
+        })?;
+    }
+    Ok(())
+}

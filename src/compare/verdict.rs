@@ -1,0 +1,539 @@
+//! The statistic: per pixel and channel, the distance from the candidate's interval to the
+//! golden's mean over its standard error, tested with Bernstein bounds at four scales.
+
+use super::stats::{bernstein_p, sidak};
+use super::{
+    CandidateImage, CompareOptions, Comparison, Diagnosis, Encoding, Golden, Region, ScaleResult,
+    Verdict,
+};
+
+/// The names of the scales, in order.
+pub const SCALES: [&str; 4] = ["pixel", "tile8", "tile32", "global"];
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+/// Relative precision of a half float: EXR candidates are their values +- this.
+const HALF_EPSILON: f64 = 1.0 / 2048.0;
+/// Side of the cells failing regions are built from.
+const CELL: usize = 8;
+/// Regions never cross a block of this many cells a side (32 pixels), so a failing outline of
+/// an object gives boxes along it rather than one box around the whole object.
+const BLOCK: usize = 4;
+
+/// The intervals of linear values a candidate's pixels stand for, and the width of a code at a
+/// given linear value (to tell pixels whose noise shows through the quantisation).
+struct Intervals {
+    lo: Vec<[f64; 3]>,
+    hi: Vec<[f64; 3]>,
+    encoding: Option<Encoding>,
+    table: [(f64, f64); 256],
+}
+
+impl Intervals {
+    fn of(candidate: &CandidateImage, encoding: Encoding) -> Self {
+        let table = encoding.table();
+        match candidate {
+            CandidateImage::Rgb8 { data, .. } => {
+                let mut lo = Vec::with_capacity(data.len() / 3);
+                let mut hi = Vec::with_capacity(data.len() / 3);
+                for p in data.chunks_exact(3) {
+                    let t = [
+                        table[p[0] as usize],
+                        table[p[1] as usize],
+                        table[p[2] as usize],
+                    ];
+                    lo.push(t.map(|x| x.0));
+                    hi.push(t.map(|x| x.1));
+                }
+                Intervals {
+                    lo,
+                    hi,
+                    encoding: Some(encoding),
+                    table,
+                }
+            }
+            CandidateImage::Linear { data, .. } => {
+                let spread = |x: f32| {
+                    let x = x as f64;
+                    let e = x.abs() * HALF_EPSILON + 1e-7;
+                    (x - e, x + e)
+                };
+                Intervals {
+                    lo: data.iter().map(|p| p.map(|x| spread(x).0)).collect(),
+                    hi: data.iter().map(|p| p.map(|x| spread(x).1)).collect(),
+                    encoding: None,
+                    table,
+                }
+            }
+        }
+    }
+
+    /// Width of the interval a candidate with the value `mu` would have.
+    #[inline]
+    fn width_at(&self, mu: f64) -> f64 {
+        match self.encoding {
+            Some(e) => {
+                let (lo, hi) = self.table[e.encode(mu) as usize];
+                hi - lo
+            }
+            None => 2.0 * (mu.abs() * HALF_EPSILON + 1e-7),
+        }
+    }
+}
+
+/// Sums of one tile or of the whole image, per channel.
+#[derive(Clone, Copy, Default)]
+struct Sums {
+    /// Sum of `L - mu_hi`: a lower bound on how much brighter the candidate is.
+    above: f64,
+    /// Sum of `mu_lo - U`: a lower bound on how much darker it is.
+    below: f64,
+    variance: f64,
+    bound: f64,
+    count: usize,
+}
+
+impl Sums {
+    fn add(&mut self, above: f64, below: f64, variance: f64, bound: f64) {
+        self.above += above;
+        self.below += below;
+        self.variance += variance;
+        self.bound = self.bound.max(bound);
+        self.count += 1;
+    }
+
+    /// `(p, signed z)`.
+    fn test(&self) -> (f64, f64) {
+        if self.count == 0 {
+            return (1.0, 0.0);
+        }
+        let (t, sign) = if self.above >= self.below {
+            (self.above.max(0.0), 1.0)
+        } else {
+            (self.below.max(0.0), -1.0)
+        };
+        let p = bernstein_p(t, self.variance, self.bound);
+        (p, sign * z_of(t, self.variance))
+    }
+}
+
+#[inline]
+fn z_of(t: f64, variance: f64) -> f64 {
+    if t <= 0.0 {
+        0.0
+    } else if variance > 0.0 {
+        (t / variance.sqrt()).min(1000.0)
+    } else {
+        1000.0
+    }
+}
+
+/// The worst evidence in one cell of the region grid.
+#[derive(Clone, Copy)]
+struct Worst {
+    p: f64,
+    scale: usize,
+    channel: usize,
+    z: f64,
+}
+
+fn mark(cell: &mut Option<Worst>, w: Worst) {
+    if cell.is_none_or(|c| w.p < c.p) {
+        *cell = Some(w);
+    }
+}
+
+/// Everything one pass of the statistic finds.
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    /// Whether every scale passed.
+    pub passed: bool,
+    /// Per scale.
+    pub scales: Vec<ScaleResult>,
+    /// Failing regions, worst first.
+    pub regions: Vec<Region>,
+    /// Signed z per pixel.
+    pub z_map: Vec<f32>,
+    /// Mean (candidate mid-point - golden) per channel.
+    pub bias: [f64; 3],
+    /// Estimated samples per pixel.
+    pub effective_spp: Option<f64>,
+    /// Sum of min(z^2, 100) over pixel and 8x8-tile tests: how badly the image fits.
+    pub misfit: f64,
+    /// The encoding used to read the codes (`None` for linear candidates).
+    pub encoding: Option<Encoding>,
+}
+
+/// Runs the statistic on a candidate read with `encoding` against `golden`.
+pub fn evaluate(
+    candidate: &CandidateImage,
+    golden: &Golden,
+    encoding: Encoding,
+    options: &CompareOptions,
+) -> Evaluation {
+    let (width, height) = (golden.width, golden.height);
+    let iv = Intervals::of(candidate, encoding);
+    let n = options.samples_per_pixel.max(1) as f64;
+    let m = golden.samples_per_pixel as f64;
+    let lambda = options.lambda;
+    let threshold = options.alpha / SCALES.len() as f64;
+
+    let grid = |s: usize| (width.div_ceil(s), height.div_ceil(s));
+    let (t8x, t8y) = grid(8);
+    let (t32x, t32y) = grid(32);
+    let (cx, cy) = grid(CELL);
+    let mut tiles8 = vec![Sums::default(); t8x * t8y * 3];
+    let mut tiles32 = vec![Sums::default(); t32x * t32y * 3];
+    let mut global = [Sums::default(); 3];
+    let mut cells: Vec<Option<Worst>> = vec![None; cx * cy];
+
+    let pixel_tests = (width * height * 3) as f64;
+    let mut pixel_min_p = 1.0f64;
+    let mut pixel_max_z = 0.0f64;
+    let mut pixel_failing = 0usize;
+    let mut z_map = vec![0.0f32; width * height];
+    let mut bias = [0.0f64; 3];
+    let (mut neff_num, mut neff_den, mut neff_count) = (0.0f64, 0.0f64, 0usize);
+    let mut misfit = 0.0f64;
+
+    for y in 0..height {
+        for x in 0..width {
+            let i = y * width + x;
+            let mut best_z = 0.0f64;
+            for c in 0..3 {
+                let mu = golden.mean[i][c];
+                let s2 = golden.variance[i][c];
+                let b = golden.bound[i][c];
+                let (lo, hi) = (iv.lo[i][c], iv.hi[i][c]);
+                // The golden's range: its mean up to f32 and float-order rounding.
+                let slack = 1e-6 * (1.0 + mu.abs());
+                let (mu_lo, mu_hi) = (mu - slack, mu + slack);
+                // Samples the golden may have missed: an unseen event of probability up to
+                // about 4/M with the neighbourhood's contrast.
+                let s2_eff = s2.max(4.0 * b * b / m);
+                let variance = lambda * s2_eff / n + s2 / m;
+                let bound = b / n;
+                let above = lo - mu_hi;
+                let below = mu_lo - hi;
+                let (t, sign) = if above > 0.0 {
+                    (above, 1.0)
+                } else if below > 0.0 {
+                    (below, -1.0)
+                } else {
+                    (0.0, 0.0)
+                };
+                let p = bernstein_p(t, variance, bound);
+                let z = sign * z_of(t, variance);
+                misfit += (z * z).min(100.0);
+                if z.abs() > best_z.abs() {
+                    best_z = z;
+                }
+                pixel_max_z = pixel_max_z.max(z.abs());
+                if p < 1.0 {
+                    let adjusted = sidak(p, pixel_tests);
+                    pixel_min_p = pixel_min_p.min(adjusted);
+                    if adjusted < threshold {
+                        pixel_failing += 1;
+                        mark(
+                            &mut cells[(y / CELL) * cx + x / CELL],
+                            Worst {
+                                p: adjusted,
+                                scale: 0,
+                                channel: c,
+                                z,
+                            },
+                        );
+                    }
+                }
+                let mid = 0.5 * (lo + hi);
+                bias[c] += mid - mu;
+                // Pixels whose noise shows through the quantisation enter the sums; the others
+                // are decided exactly at the pixel scale (a rule that reads only the golden).
+                let width_here = iv.width_at(mu);
+                if variance.sqrt() >= width_here {
+                    tiles8[((y / 8) * t8x + x / 8) * 3 + c].add(above, below, variance, bound);
+                    tiles32[((y / 32) * t32x + x / 32) * 3 + c].add(above, below, variance, bound);
+                    global[c].add(above, below, variance, bound);
+                    if s2 > 0.0 && hi - lo < 1.0 {
+                        neff_num += s2;
+                        neff_den += (mid - mu).powi(2) - (hi - lo).powi(2) / 12.0 - s2 / m;
+                        neff_count += 1;
+                    }
+                }
+            }
+            z_map[i] = best_z as f32;
+        }
+    }
+
+    let tiles8_counts: Vec<usize> = tiles8.iter().map(|s| s.count).collect();
+    let mut scales = vec![ScaleResult {
+        scale: SCALES[0].into(),
+        tests: pixel_tests as usize,
+        smallest_adjusted_p: pixel_min_p,
+        threshold,
+        largest_abs_z: pixel_max_z,
+        failing: pixel_failing,
+    }];
+    let mut tile_scale = |sums: &[Sums], scale: usize, size: usize, tx: usize| -> ScaleResult {
+        let tests = sums.len() as f64;
+        let (mut min_p, mut max_z, mut failing) = (1.0f64, 0.0f64, 0usize);
+        for (k, s) in sums.iter().enumerate() {
+            let (p, z) = s.test();
+            max_z = max_z.max(z.abs());
+            if p >= 1.0 {
+                continue;
+            }
+            misfit += if scale == 1 { (z * z).min(100.0) } else { 0.0 };
+            let adjusted = sidak(p, tests);
+            min_p = min_p.min(adjusted);
+            if adjusted < threshold {
+                failing += 1;
+                let tile = k / 3;
+                let (x0, y0) = ((tile % tx) * size, (tile / tx) * size);
+                for yy in (y0..(y0 + size).min(height)).step_by(CELL) {
+                    for xx in (x0..(x0 + size).min(width)).step_by(CELL) {
+                        // Only the cells whose pixels entered the sum (cells are 8x8 tiles).
+                        if tiles8_counts[((yy / 8) * t8x + xx / 8) * 3 + k % 3] == 0 {
+                            continue;
+                        }
+                        mark(
+                            &mut cells[(yy / CELL) * cx + xx / CELL],
+                            Worst {
+                                p: adjusted,
+                                scale,
+                                channel: k % 3,
+                                z,
+                            },
+                        );
+                    }
+                }
+            }
+        }
+        ScaleResult {
+            scale: SCALES[scale].into(),
+            tests: sums.len(),
+            smallest_adjusted_p: min_p,
+            threshold,
+            largest_abs_z: max_z,
+            failing,
+        }
+    };
+    scales.push(tile_scale(&tiles8, 1, 8, t8x));
+    scales.push(tile_scale(&tiles32, 2, 32, t32x));
+
+    let (mut g_min, mut g_z, mut g_fail, mut g_worst) = (1.0f64, 0.0f64, 0usize, None);
+    for (c, s) in global.iter().enumerate() {
+        let (p, z) = s.test();
+        g_z = g_z.max(z.abs());
+        let adjusted = sidak(p, 3.0);
+        if adjusted < g_min {
+            g_min = adjusted;
+        }
+        if adjusted < threshold {
+            g_fail += 1;
+            mark(
+                &mut g_worst,
+                Worst {
+                    p: adjusted,
+                    scale: 3,
+                    channel: c,
+                    z,
+                },
+            );
+        }
+    }
+    scales.push(ScaleResult {
+        scale: SCALES[3].into(),
+        tests: 3,
+        smallest_adjusted_p: g_min,
+        threshold,
+        largest_abs_z: g_z,
+        failing: g_fail,
+    });
+
+    let mut regions = regions_of(&cells, cx, cy, width, height);
+    if let (true, Some(w)) = (regions.is_empty(), g_worst) {
+        regions.push(region(0, 0, width, height, w));
+    }
+    let passed = scales.iter().all(|s| s.failing == 0);
+    let pixels = (width * height) as f64;
+    Evaluation {
+        passed,
+        scales,
+        regions,
+        z_map,
+        bias: bias.map(|b| b / pixels),
+        effective_spp: (neff_count >= 100 && neff_den > 0.0).then(|| neff_num / neff_den),
+        misfit,
+        encoding: iv.encoding,
+    }
+}
+
+fn region(x: usize, y: usize, width: usize, height: usize, w: Worst) -> Region {
+    Region {
+        x,
+        y,
+        width,
+        height,
+        scale: SCALES[w.scale].into(),
+        channel: CHANNELS[w.channel].into(),
+        adjusted_p: w.p,
+        z: w.z,
+    }
+}
+
+/// Connected groups of failing cells (8-connected within 32x32 blocks), as pixel boxes, worst
+/// first, at most 50.
+fn regions_of(
+    cells: &[Option<Worst>],
+    cx: usize,
+    cy: usize,
+    width: usize,
+    height: usize,
+) -> Vec<Region> {
+    let mut seen = vec![false; cells.len()];
+    let mut out = Vec::new();
+    for start in 0..cells.len() {
+        if seen[start] || cells[start].is_none() {
+            continue;
+        }
+        seen[start] = true;
+        let mut stack = vec![start];
+        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+        let mut worst = cells[start].unwrap();
+        while let Some(k) = stack.pop() {
+            let (x, y) = (k % cx, k / cx);
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x);
+            y1 = y1.max(y);
+            let w = cells[k].unwrap();
+            if w.p < worst.p || (w.p == worst.p && w.z.abs() > worst.z.abs()) {
+                worst = w;
+            }
+            for dy in -1isize..=1 {
+                for dx in -1isize..=1 {
+                    let (nx, ny) = (x as isize + dx, y as isize + dy);
+                    if nx < 0 || ny < 0 || nx >= cx as isize || ny >= cy as isize {
+                        continue;
+                    }
+                    let j = ny as usize * cx + nx as usize;
+                    let same_block =
+                        (nx as usize / BLOCK, ny as usize / BLOCK) == (x / BLOCK, y / BLOCK);
+                    if same_block && !seen[j] && cells[j].is_some() {
+                        seen[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        let (px, py) = (x0 * CELL, y0 * CELL);
+        let pw = ((x1 + 1) * CELL).min(width) - px;
+        let ph = ((y1 + 1) * CELL).min(height) - py;
+        out.push(region(px, py, pw, ph, worst));
+    }
+    out.sort_by(|a, b| {
+        a.adjusted_p
+            .total_cmp(&b.adjusted_p)
+            .then(b.z.abs().total_cmp(&a.z.abs()))
+            .then((a.y, a.x).cmp(&(b.y, b.x)))
+    });
+    out.truncate(50);
+    out
+}
+
+impl Evaluation {
+    /// The report of this evaluation.
+    pub(crate) fn into_comparison(
+        self,
+        candidate: &CandidateImage,
+        golden: &Golden,
+        options: &CompareOptions,
+        diagnosis: Option<Diagnosis>,
+    ) -> Comparison {
+        let (width, height) = candidate.size();
+        Comparison {
+            verdict: if self.passed {
+                Verdict::Pass
+            } else {
+                Verdict::Fail
+            },
+            width,
+            height,
+            candidate_spp: options.samples_per_pixel,
+            golden_spp: golden.samples_per_pixel,
+            scene: golden.scene.clone(),
+            encoding: self
+                .encoding
+                .map_or_else(|| "exr".to_string(), |e| e.name().to_string()),
+            alpha: options.alpha,
+            scales: self.scales,
+            regions: self.regions,
+            bias: self.bias,
+            effective_spp: self.effective_spp,
+            diagnosis,
+            z_map: self.z_map,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flat golden (every sample the same colour) is decided exactly: the right codes pass,
+    /// one code off fails.
+    #[test]
+    fn a_flat_golden_is_decided_exactly() {
+        let (w, h) = (16, 16);
+        let colour = [0.25, 0.5, 0.64];
+        let golden =
+            Golden::new(w, h, 1024, vec![colour; w * h], vec![[0.0; 3]; w * h], None).unwrap();
+        let codes: Vec<u8> = (0..w * h)
+            .flat_map(|_| colour.map(|x| Encoding::Course.encode(x)))
+            .collect();
+        let options = CompareOptions::default();
+        let good = CandidateImage::Rgb8 {
+            width: w,
+            height: h,
+            data: codes.clone(),
+        };
+        assert!(evaluate(&good, &golden, Encoding::Course, &options).passed);
+        let mut off = codes;
+        off[3 * 37 + 1] += 1;
+        let bad = CandidateImage::Rgb8 {
+            width: w,
+            height: h,
+            data: off,
+        };
+        let e = evaluate(&bad, &golden, Encoding::Course, &options);
+        assert!(!e.passed);
+        assert_eq!(e.scales[0].failing, 1);
+        // The region is the cell of pixel 37 = (5, 2).
+        assert_eq!((e.regions[0].x, e.regions[0].y), (0, 0));
+        assert_eq!(e.regions[0].channel, "G");
+        assert!(e.regions[0].z > 0.0);
+    }
+
+    /// A linear candidate equal to the golden passes; off by 1% in red fails, darker.
+    #[test]
+    fn linear_candidates_use_half_float_intervals() {
+        let golden = Golden::new(4, 4, 4096, vec![[0.5; 3]; 16], vec![[0.0; 3]; 16], None).unwrap();
+        let same = CandidateImage::Linear {
+            width: 4,
+            height: 4,
+            data: vec![[0.5; 3]; 16],
+        };
+        let options = CompareOptions::default();
+        assert!(evaluate(&same, &golden, Encoding::Course, &options).passed);
+        let mut data = vec![[0.5f32; 3]; 16];
+        data[5][0] = 0.495;
+        let off = CandidateImage::Linear {
+            width: 4,
+            height: 4,
+            data,
+        };
+        let e = evaluate(&off, &golden, Encoding::Course, &options);
+        assert!(!e.passed);
+        assert!(e.regions[0].z < 0.0);
+        assert_eq!(e.encoding, None);
+    }
+}

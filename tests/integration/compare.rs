@@ -1,0 +1,526 @@
+//! The noise-aware comparison: honest renders pass (measured false-failure rate), every
+//! mistake of IMAGES.md fails and the diagnosis names it, the course's PNGs pass, bad input
+//! exits 2 without leaving files behind.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
+use rtoracle::compare::mistakes::{MUST_FAIL, Mistake, render_with_mistake};
+use rtoracle::compare::{CandidateImage, CompareOptions, Comparison, Golden, compare_image};
+use rtoracle::image_io::Rgb8Image;
+use rtoracle::render::{PixelJitter, RenderOptions, render};
+
+use crate::common::*;
+
+const COURSE_SCENES: [&str; 2] = ["week04-sphere", "week04-quad"];
+
+/// The golden of a course scene: the one embedded in the binary (4096 spp, seed 0; the
+/// candidates below use other seeds), decoded once per test process.
+fn golden(scene: &str) -> &'static Golden {
+    static SPHERE: OnceLock<Golden> = OnceLock::new();
+    static QUAD: OnceLock<Golden> = OnceLock::new();
+    let cell = match scene {
+        "week04-sphere" => &SPHERE,
+        "week04-quad" => &QUAD,
+        _ => panic!("no test golden for {scene}"),
+    };
+    cell.get_or_init(|| {
+        rtoracle::compare::golden::embedded_golden(scene, rtoracle::compare::golden_spp(20))
+            .expect("the course goldens are embedded")
+    })
+}
+
+fn candidate(img: Rgb8Image) -> CandidateImage {
+    CandidateImage::Rgb8 {
+        width: img.width,
+        height: img.height,
+        data: img.data,
+    }
+}
+
+fn compare(scene: &str, img: Rgb8Image) -> Comparison {
+    compare_image(&candidate(img), golden(scene), &CompareOptions::default()).unwrap()
+}
+
+fn smallest_p(results: &[Comparison], scale: usize) -> f64 {
+    results
+        .iter()
+        .map(|c| c.scales[scale].smallest_adjusted_p)
+        .fold(1.0, f64::min)
+}
+
+/// 200 honest renders per course scene at 20 spp with different seeds, and 20 with stratified
+/// jitter, all pass. With a per-image false-failure rate of 1e-4, one failure in 440 would
+/// already be a 4% event; the smallest adjusted p per scale is printed for the record.
+#[test]
+fn honest_renders_pass_at_every_seed() {
+    for scene in COURSE_SCENES {
+        let d = rtoracle::scene::builtin(scene).unwrap();
+        let g = golden(scene);
+        let uniform: Vec<Comparison> = (1..=200u64)
+            .into_par_iter()
+            .map(|seed| compare(scene, render_with_mistake(&d, Mistake::Honest, 20, seed)))
+            .collect();
+        let stratified: Vec<Comparison> = (1..=20u64)
+            .into_par_iter()
+            .map(|seed| {
+                let film = render(
+                    &d.scene(),
+                    &d.camera(None),
+                    &RenderOptions {
+                        samples_per_pixel: 20,
+                        seed: 1000 + seed,
+                        jitter: PixelJitter::Stratified,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                compare_image(
+                    &CandidateImage::Rgb8 {
+                        width: film.width,
+                        height: film.height,
+                        data: film.to_course_rgb8(),
+                    },
+                    g,
+                    &CompareOptions::default(),
+                )
+                .unwrap()
+            })
+            .collect();
+        for (kind, results) in [("uniform", &uniform), ("stratified", &stratified)] {
+            let failed: Vec<usize> = results
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| !c.passed())
+                .map(|(i, _)| i + 1)
+                .collect();
+            eprintln!(
+                "{scene} {kind}: {} renders, {} failed; smallest adjusted p: pixel {:.3e}, tile8 {:.3e}, tile32 {:.3e}, global {:.3e}; largest |z| at the pixel scale {:.2}",
+                results.len(),
+                failed.len(),
+                smallest_p(results, 0),
+                smallest_p(results, 1),
+                smallest_p(results, 2),
+                smallest_p(results, 3),
+                results
+                    .iter()
+                    .map(|c| c.scales[0].largest_abs_z)
+                    .fold(0.0, f64::max),
+            );
+            assert!(failed.is_empty(), "{scene} {kind}: seeds {failed:?} failed");
+        }
+        // The noise is that of 20 samples: the estimated effective spp is near 20 (the
+        // estimate pools thousands of noisy pixels; 12..32 allows for its own spread).
+        let mean_neff = uniform
+            .iter()
+            .map(|c| c.effective_spp.unwrap())
+            .sum::<f64>()
+            / uniform.len() as f64;
+        assert!((12.0..32.0).contains(&mean_neff), "{scene}: {mean_neff}");
+    }
+}
+
+/// Every mistake IMAGES.md lists fails on both course scenes, including the half-pixel shift
+/// and jitter in [0, 1), and the diagnosis names the mistake for those it tests.
+#[test]
+fn every_must_fail_mistake_fails_and_is_diagnosed() {
+    let expected = |m: Mistake| match m {
+        Mistake::NoGamma => Some("encoding:linear"),
+        Mistake::Gamma22 => Some("encoding:gamma22"),
+        Mistake::YFlipped => Some("flip-y"),
+        Mistake::Bgr => Some("bgr"),
+        Mistake::HalfPixelShift => Some("shift:-0.5"),
+        Mistake::JitterZeroOne => Some("shift:+0.5"),
+        _ => None,
+    };
+    for scene in COURSE_SCENES {
+        let d = rtoracle::scene::builtin(scene).unwrap();
+        let results: Vec<(Mistake, Comparison)> = MUST_FAIL
+            .par_iter()
+            .map(|&m| (m, compare(scene, render_with_mistake(&d, m, 20, 77))))
+            .collect();
+        for (m, c) in results {
+            assert!(!c.passed(), "{scene}: '{}' passed", m.name());
+            assert!(
+                !c.regions.is_empty(),
+                "{scene}: '{}' has no region",
+                m.name()
+            );
+            let diagnosis = c.diagnosis.as_ref().expect("a failing image is diagnosed");
+            eprintln!("{scene}: {} -> {}", m.name(), diagnosis.summary);
+            if let Some(name) = expected(m) {
+                assert_eq!(
+                    diagnosis.best.as_deref(),
+                    Some(name),
+                    "{scene}: '{}' diagnosed as {:?}",
+                    m.name(),
+                    diagnosis.summary
+                );
+                // The named hypothesis makes the image pass outright.
+                assert!(diagnosis.hypotheses[0].passes, "{scene}: {}", m.name());
+            } else {
+                // Mistakes outside the catalogue of hypotheses are not explained away.
+                assert!(
+                    diagnosis.best.is_none() || !diagnosis.hypotheses[0].passes,
+                    "{scene}: '{}' explained as {}",
+                    m.name(),
+                    diagnosis.summary
+                );
+            }
+        }
+    }
+}
+
+/// The half-pixel shift is found where it is: in boxes along the objects' edges, not over the
+/// flat inside of the back quad, and by the tiles (edge pixels at 20 spp are too noisy for the
+/// pixel scale alone).
+#[test]
+fn a_half_pixel_shift_is_located_on_the_edges() {
+    let d = rtoracle::scene::builtin("week04-quad").unwrap();
+    let c = compare(
+        "week04-quad",
+        render_with_mistake(&d, Mistake::HalfPixelShift, 20, 5),
+    );
+    assert!(!c.passed());
+    assert!(c.scales[2].failing > 0);
+    assert_eq!(c.scales[0].failing, 0, "{:?}", c.scales[0]);
+    // Boxes follow the edges: none is larger than 32x32.
+    for r in &c.regions {
+        assert!(r.width <= 32 && r.height <= 32, "{r:?}");
+    }
+    // The back quad spans x, y in [-2, 2] at z = 0, 10 units from the eye with a 20-unit
+    // viewport: pixels 160..240. Its centre is flat, right, and in no failing region.
+    let centre = 200 * c.width + 200;
+    assert_eq!(c.z_map[centre], 0.0);
+    assert!(
+        c.regions
+            .iter()
+            .all(|r| !(r.x <= 200 && 200 < r.x + r.width && r.y <= 200 && 200 < r.y + r.height))
+    );
+}
+
+fn course_png(dir: &Path, name: &str) -> CandidateImage {
+    CandidateImage::load(&dir.join(name)).unwrap()
+}
+
+/// The course's published PNGs (rendered by its Python code, unseeded) pass.
+#[test]
+fn the_course_pngs_pass() {
+    let Some(dir) = course_fixtures("the_course_pngs_pass") else {
+        return;
+    };
+    for (file, scene) in [
+        ("week04_sphere.png", "week04-sphere"),
+        ("week04_quad.png", "week04-quad"),
+    ] {
+        let c = compare_image(
+            &course_png(&dir, file),
+            golden(scene),
+            &CompareOptions::default(),
+        )
+        .unwrap();
+        eprintln!(
+            "{file}: {:?}, smallest adjusted p {:?}",
+            c.verdict,
+            c.scales
+                .iter()
+                .map(|s| s.smallest_adjusted_p)
+                .collect::<Vec<_>>()
+        );
+        assert!(c.passed(), "{file}: {:#?}", c.scales);
+        // And read as linear (no gamma) they fail, so the pass is not vacuous.
+        let linear = compare_image(
+            &course_png(&dir, file),
+            golden(scene),
+            &CompareOptions {
+                encoding: rtoracle::compare::Encoding::Linear,
+                diagnose: false,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(!linear.passed(), "{file} passed as linear");
+    }
+}
+
+// ---- The command line ----
+
+/// A cache folder shared by the command-line tests, so the 4096-spp golden of the sphere scene
+/// is rendered once per build folder.
+fn cache() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rtoracle-cache");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn compare_cli(dir: &Path, args: &[&str]) -> std::process::Output {
+    rtoracle()
+        .current_dir(dir)
+        .env("RTORACLE_CACHE_DIR", cache())
+        .arg("compare")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn write(dir: &Path, name: &str, img: &Rgb8Image) -> PathBuf {
+    let p = dir.join(name);
+    rtoracle::image_io::write_png(&p, img).unwrap();
+    p
+}
+
+/// End to end with `--scene`: an honest render passes (exit 0, JSON says so), a y-flipped one
+/// fails (exit 1) with the diagnosis, a heatmap and a report folder.
+#[test]
+fn the_command_judges_renders_of_a_builtin_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    write(
+        dir.path(),
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 20, 3),
+    );
+    write(
+        dir.path(),
+        "flipped.png",
+        &render_with_mistake(&d, Mistake::YFlipped, 20, 3),
+    );
+
+    let out = compare_cli(
+        dir.path(),
+        &["honest.png", "--scene", "week04-sphere", "--json"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["verdict"], "pass");
+    assert_eq!(json["golden_spp"], 4096);
+    assert_eq!(json["scales"].as_array().unwrap().len(), 4);
+
+    let out = compare_cli(
+        dir.path(),
+        &[
+            "flipped.png",
+            "--scene",
+            "week04-sphere",
+            "--heatmap",
+            "z.png",
+            "--report",
+            "report",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.starts_with("FAIL"), "{stdout}");
+    assert!(stdout.contains("y flipped"), "{stdout}");
+    let heat = rtoracle::image_io::read_png(&dir.path().join("z.png")).unwrap();
+    assert_eq!((heat.width, heat.height), (400, 225));
+    // The outline colour is there, and so are both signs: a flipped image is brighter than the
+    // golden in some places and darker in others.
+    let has = |rgb: [u8; 3]| heat.data.chunks_exact(3).any(|p| p == rgb);
+    assert!(has([0, 170, 0]));
+    assert!(has([255, 0, 0]) && has([0, 0, 255]));
+    let report = dir.path().join("report");
+    for f in ["report.json", "heatmap.png", "index.html", "region-1.png"] {
+        assert!(report.join(f).is_file(), "{f} missing");
+    }
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(html.contains("region-1.png") && html.contains("FAIL"));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["diagnosis"]["best"], "flip-y");
+}
+
+#[test]
+fn the_course_pngs_pass_on_the_command_line() {
+    let Some(fixtures) = course_fixtures("the_course_pngs_pass_on_the_command_line") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let png = fixtures.join("week04_sphere.png");
+    let out = compare_cli(
+        dir.path(),
+        &[png.to_str().unwrap(), "--scene", "week04-sphere"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Bad candidates: one line naming the file, exit 2, and no heatmap or report left behind.
+#[test]
+fn bad_candidates_exit_2_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    let good = write(
+        p,
+        "good.png",
+        &render_with_mistake(&d, Mistake::Honest, 1, 1),
+    );
+    std::fs::write(p.join("notes.png"), "this is not an image\n").unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    std::fs::write(p.join("truncated.png"), &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::write(p.join("empty.png"), b"").unwrap();
+    write(
+        p,
+        "small.png",
+        &Rgb8Image {
+            width: 40,
+            height: 30,
+            data: vec![0; 40 * 30 * 3],
+        },
+    );
+    image::ImageBuffer::<image::Luma<u8>, _>::from_raw(400, 225, vec![0u8; 400 * 225])
+        .unwrap()
+        .save(p.join("grey.png"))
+        .unwrap();
+    image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(400, 225, vec![0u16; 400 * 225 * 3])
+        .unwrap()
+        .save(p.join("deep.png"))
+        .unwrap();
+    // An EXR header with nothing behind it.
+    std::fs::write(p.join("broken.exr"), [0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0]).unwrap();
+
+    for (file, needle) in [
+        ("missing.png", "no such file"),
+        ("notes.png", "not a PNG or EXR"),
+        ("truncated.png", "truncated.png"),
+        ("empty.png", "empty"),
+        ("small.png", "is 40x30 but the golden is 400x225"),
+        ("grey.png", "expected 8-bit RGB"),
+        ("deep.png", "expected 8-bit RGB"),
+        ("broken.exr", "broken.exr"),
+    ] {
+        let out = compare_cli(
+            p,
+            &[
+                file,
+                "--scene",
+                "week04-sphere",
+                "--heatmap",
+                "z.png",
+                "--report",
+                "rep",
+            ],
+        );
+        assert_bad_input(&out, needle);
+        assert_bad_input(&out, file);
+        assert!(
+            !p.join("z.png").exists() && !p.join("rep").exists(),
+            "{file}"
+        );
+    }
+    // Bad options are usage errors, also exit 2.
+    let out = compare_cli(p, &["good.png", "--scene", "week04-sphere", "--spp", "0"]);
+    assert_bad_input(&out, "--spp 0");
+    let out = compare_cli(p, &["good.png", "--scene", "no-such-scene"]);
+    assert_bad_input(&out, "no-such-scene");
+    let out = compare_cli(p, &["good.png", "--golden", "missing.exr"]);
+    assert_bad_input(&out, "missing.exr");
+    let out = compare_cli(
+        p,
+        &[
+            "good.png",
+            "--scene",
+            "week04-sphere",
+            "--heatmap",
+            "nodir/z.png",
+        ],
+    );
+    assert_bad_input(&out, "nodir");
+    let out = compare_cli(p, &["good.png"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// The comparison as grading's image checker: honest passes, a flipped image fails with the
+/// diagnosis and a heatmap, missing and wrong-size files are unusable.
+#[test]
+fn the_grading_image_checker_uses_the_comparison() {
+    use rtoracle::compare::CompareImageChecker;
+    use rtoracle::grade::inputs::{ImageChecker, ImageVerdict};
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    let honest = write(
+        p,
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 20, 11),
+    );
+    let bgr = write(p, "bgr.png", &render_with_mistake(&d, Mistake::Bgr, 20, 11));
+    let small = write(
+        p,
+        "small.png",
+        &Rgb8Image {
+            width: 4,
+            height: 4,
+            data: vec![0; 48],
+        },
+    );
+    let checker = CompareImageChecker::default();
+    let ok = checker.check(&honest, "week04-sphere", &p.join("h1.png"));
+    assert_eq!(ok.verdict, ImageVerdict::Pass);
+    assert_eq!(ok.metrics["verdict"], "pass");
+    let bad = checker.check(&bgr, "week04-sphere", &p.join("h2.png"));
+    assert_eq!(bad.verdict, ImageVerdict::Fail);
+    assert!(bad.diagnosis.unwrap().contains("BGR"));
+    assert!(bad.heatmap.unwrap().is_file());
+    for (file, needle) in [(p.join("none.png"), "missing"), (small, "is 4x4")] {
+        match checker
+            .check(&file, "week04-sphere", &p.join("h3.png"))
+            .verdict
+        {
+            ImageVerdict::Unusable(why) => assert!(why.contains(needle), "{why}"),
+            other => panic!("{other:?}"),
+        }
+    }
+    assert_eq!(checker.golden_sha256("week04-sphere").len(), 64);
+}
+
+/// An EXR candidate (linear f32, as `rtoracle render -o X.exr` writes it) is compared as values:
+/// an honest one passes, the same with every value times 0.97 fails.
+#[test]
+fn exr_candidates_are_compared_as_linear_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    let film = render(
+        &d.scene(),
+        &d.camera(None),
+        &RenderOptions {
+            samples_per_pixel: 20,
+            seed: 31,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let honest = dir.path().join("honest.exr");
+    rtoracle::image_io::write_exr(&honest, &film, &[]).unwrap();
+    let mut darker = film.clone();
+    for m in &mut darker.mean {
+        *m *= 0.97;
+    }
+    let dark = dir.path().join("dark.exr");
+    rtoracle::image_io::write_exr(&dark, &darker, &[]).unwrap();
+    let c = rtoracle::compare::compare_file(
+        &honest,
+        golden("week04-sphere"),
+        &CompareOptions::default(),
+    )
+    .unwrap();
+    assert!(c.passed(), "{:#?}", c.scales);
+    assert_eq!(c.encoding, "exr");
+    let c =
+        rtoracle::compare::compare_file(&dark, golden("week04-sphere"), &CompareOptions::default())
+            .unwrap();
+    assert!(!c.passed());
+    assert!(c.bias.iter().all(|b| *b < 0.0), "{:?}", c.bias);
+}
