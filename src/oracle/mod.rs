@@ -1,7 +1,14 @@
-//! The intersection oracle: the language-agnostic vector format (more to come: exact decisions,
-//! error bands, edge-case generators).
+//! The intersection oracle: exact decisions ([`exact`]), the error bands of the course's naive
+//! formulas ([`band`]), the classification of a case ([`classify`]), edge-case generators
+//! ([`generate`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
+//! transcriptions of the course's code ([`variants`]), fuzzing entry points ([`fuzzing`]), the
+//! benchmark ([`bench`]) and the language-agnostic vector format ([`vectors`]).
 
+pub mod band;
+pub mod classify;
+pub mod exact;
 pub mod suite;
 pub mod vectors;
 
+pub use classify::{analyse, classify, classify_tagged};
 pub use suite::default_suite;
