@@ -7,6 +7,7 @@
 pub mod band;
 pub mod classify;
 pub mod exact;
+pub mod generate;
 pub mod suite;
 pub mod vectors;
 
