@@ -286,6 +286,7 @@ fn sphere(
     }
     if disc_pos && near_after && near_before {
         let definite = checks.iter().all(|c| c.definite);
+        let (definite, why) = normal_check(definite, center, radius, ray, b.t_near, &mut tags);
         return finish(
             decision,
             by_filter,
@@ -294,7 +295,7 @@ fn sphere(
             definite,
             tags,
             Some(b.t_near),
-            None,
+            why,
         );
     }
     let near_fails_definitely = checks[1..].iter().any(|c| !c.passes && c.definite);
@@ -326,6 +327,11 @@ fn sphere(
     // A tangent ray whose roots both miss the interval is still a miss for every variant; a
     // tangent ray that hits is not definite.
     let definite = definite && (checks[0].definite || decision == Decision::Miss);
+    let (definite, why) = if decision == Decision::SphereHit(Root::Far) {
+        normal_check(definite, center, radius, ray, b.t_far, &mut tags)
+    } else {
+        (definite, None)
+    };
     if ex.disc.is_zero() && decision == Decision::Miss && definite {
         // Exact tangent outside the interval: fine, but say so.
         tags.push("tangent".into());
@@ -338,8 +344,38 @@ fn sphere(
         definite,
         tags,
         Some(b.t_far),
-        None,
+        why,
     )
+}
+
+/// A definite sphere hit also needs the naive normal `(O + t d - C) / r` within the 1e-6 the
+/// normal is compared to: far from the sphere, or far from the origin of coordinates, the naive
+/// `t` and point are too coarse for that, and the case is ambiguous (`ill-conditioned`).
+fn normal_check(
+    definite: bool,
+    center: [f64; 3],
+    radius: f64,
+    ray: &RaySpec,
+    t: Iv,
+    tags: &mut Vec<String>,
+) -> (bool, Option<String>) {
+    if !definite {
+        return (false, None);
+    }
+    let p = IV3::of(ray.origin).add(IV3::of(ray.direction).scale(t));
+    let n = p.sub(IV3::of(center)).div(Iv::point(radius));
+    let worst = n.0.iter().map(|c| c.widen(K).rad()).fold(0.0, f64::max);
+    if worst <= 1e-6 {
+        (true, None)
+    } else {
+        tags.push("ill-conditioned".into());
+        (
+            false,
+            Some(format!(
+                "the decision is certain, but the naive normal (O + t d - C) / r is only known to +-{worst:e} (band widened by K = {K}), more than the 1e-6 it is compared to"
+            )),
+        )
+    }
 }
 
 /// Exact `(t > t_min, t < t_max)` of a root.

@@ -9,6 +9,7 @@ pub mod classify;
 pub mod exact;
 pub mod generate;
 pub mod suite;
+pub mod variants;
 pub mod vectors;
 
 pub use classify::{analyse, classify, classify_tagged};
