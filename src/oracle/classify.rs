@@ -154,7 +154,13 @@ pub fn analyse(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Analysis
         }
         ShapeSpec::Quad { q, u, v } => {
             let s = exact::plane_signs(shape, ray, interval).expect("a plane shape");
-            let bands = plane_bands(IV3::of(q), IV3::of(u), IV3::of(v), ray.origin, ray.direction);
+            let bands = plane_bands(
+                IV3::of(q),
+                IV3::of(u),
+                IV3::of(v),
+                ray.origin,
+                ray.direction,
+            );
             plane(false, bands, s, ray, interval, decision, by_filter, hit)
         }
         ShapeSpec::Triangle { a, b, c } => {
@@ -183,7 +189,9 @@ fn finish(
     why: Option<String>,
 ) -> Analysis {
     let is_hit = hit.is_some();
-    let overflow = checks.iter().any(|c| !c.band.is_finite());
+    let overflow = checks
+        .iter()
+        .any(|c| !c.definite && !(c.band.lo.is_finite() || c.band.hi.is_finite()));
     if !definite {
         for c in &checks {
             if !c.definite {
@@ -429,12 +437,32 @@ fn plane(
     let (tmin, tmax) = (Iv::point(interval[0]), Iv::point(interval[1]));
     let one = Iv::point(1.0);
     let mut checks = vec![
-        Check::new("t - t_min >= 0", "interval-boundary", b.t - tmin, s.after_min),
-        Check::new("t_max - t >= 0", "interval-boundary", tmax - b.t, s.before_max),
+        Check::new(
+            "t - t_min >= 0",
+            "interval-boundary",
+            b.t - tmin,
+            s.after_min,
+        ),
+        Check::new(
+            "t_max - t >= 0",
+            "interval-boundary",
+            tmax - b.t,
+            s.before_max,
+        ),
     ];
     if triangle {
-        checks.push(Check::new("beta_b >= 0 (edge ca)", "edge", b.alpha, s.alpha_ge_0));
-        checks.push(Check::new("beta_c >= 0 (edge ab)", "edge", b.beta, s.beta_ge_0));
+        checks.push(Check::new(
+            "beta_b >= 0 (edge ca)",
+            "edge",
+            b.alpha,
+            s.alpha_ge_0,
+        ));
+        checks.push(Check::new(
+            "beta_c >= 0 (edge ab)",
+            "edge",
+            b.beta,
+            s.beta_ge_0,
+        ));
         checks.push(Check::new(
             "1 - beta_b - beta_c >= 0 (edge bc)",
             "edge",
@@ -443,9 +471,19 @@ fn plane(
         ));
     } else {
         checks.push(Check::new("alpha >= 0", "edge", b.alpha, s.alpha_ge_0));
-        checks.push(Check::new("1 - alpha >= 0", "edge", one - b.alpha, s.alpha_le_1));
+        checks.push(Check::new(
+            "1 - alpha >= 0",
+            "edge",
+            one - b.alpha,
+            s.alpha_le_1,
+        ));
         checks.push(Check::new("beta >= 0", "edge", b.beta, s.beta_ge_0));
-        checks.push(Check::new("1 - beta >= 0", "edge", one - b.beta, s.beta_le_1));
+        checks.push(Check::new(
+            "1 - beta >= 0",
+            "edge",
+            one - b.beta,
+            s.beta_le_1,
+        ));
     }
     // Only the comparisons that can pass or fail matter; a passing t comparison with an
     // infinite interval end is trivially definite.
@@ -484,7 +522,16 @@ fn plane(
         tags.push("corner".into());
     }
     let _ = triangle;
-    finish(decision, by_filter, hit, checks, definite, tags, Some(b.t), why)
+    finish(
+        decision,
+        by_filter,
+        hit,
+        checks,
+        definite,
+        tags,
+        Some(b.t),
+        why,
+    )
 }
 
 #[cfg(test)]
@@ -507,7 +554,12 @@ mod tests {
             radius: 1.0,
         };
         let e = classify(&s, &ray([0.0; 3], [0.0, 0.0, -1.0]), CAM);
-        assert_eq!(e.class, Class::Hit, "{:#?}", analyse(&s, &ray([0.0; 3], [0.0, 0.0, -1.0]), CAM));
+        assert_eq!(
+            e.class,
+            Class::Hit,
+            "{:#?}",
+            analyse(&s, &ray([0.0; 3], [0.0, 0.0, -1.0]), CAM)
+        );
         assert_eq!(e.t, Some(4.0));
         assert_eq!(e.normal, Some([0.0, 0.0, 1.0]));
         assert_eq!(e.front_face, Some(true));
@@ -553,7 +605,10 @@ mod tests {
             center: [0.0, 0.0, f64::NAN],
             radius: 1.0,
         };
-        assert_eq!(classify(&s, &ray([0.0; 3], [0.0, 0.0, -1.0]), CAM).class, Class::Any);
+        assert_eq!(
+            classify(&s, &ray([0.0; 3], [0.0, 0.0, -1.0]), CAM).class,
+            Class::Any
+        );
         let t = ShapeSpec::Triangle {
             a: [0.0; 3],
             b: [1.0, 1.0, 1.0],

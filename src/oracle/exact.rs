@@ -330,7 +330,11 @@ pub struct PlaneSigns {
 /// Whether a case's inputs are all finite (NaN or an infinity anywhere but the interval ends).
 pub fn inputs_finite(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> bool {
     shape.numbers().iter().all(|x| x.is_finite())
-        && ray.origin.iter().chain(&ray.direction).all(|x| x.is_finite())
+        && ray
+            .origin
+            .iter()
+            .chain(&ray.direction)
+            .all(|x| x.is_finite())
         && !interval[0].is_nan()
         && !interval[1].is_nan()
         && interval[0] != f64::INFINITY
@@ -457,7 +461,13 @@ pub fn plane_decide<N: Num>(
             (Decision::Miss, s)
         });
     }
-    let flip = |x: N| if sd == Ordering::Less { N::of(0.0).minus(&x) } else { x };
+    let flip = |x: N| {
+        if sd == Ordering::Less {
+            N::of(0.0).minus(&x)
+        } else {
+            x
+        }
+    };
     if !triangle {
         // (n.d)^2 < eps^2 (n.n)
         let eps = N::of(PARALLEL_EPSILON);
@@ -480,12 +490,8 @@ pub fn plane_decide<N: Num>(
         s.alpha_le_1 = flip(nd.minus(&an)).sign()? != Ordering::Less;
         s.beta_le_1 = flip(nd.minus(&bn)).sign()? != Ordering::Less;
     }
-    let inside = s.after_min
-        && s.before_max
-        && s.alpha_ge_0
-        && s.alpha_le_1
-        && s.beta_ge_0
-        && s.beta_le_1;
+    let inside =
+        s.after_min && s.before_max && s.alpha_ge_0 && s.alpha_le_1 && s.beta_ge_0 && s.beta_le_1;
     let _ = gt0;
     Some((
         if inside && !s.below_threshold {
@@ -517,7 +523,9 @@ pub fn decide_with<N: Num>(
 ) -> Option<Decision> {
     match *shape {
         ShapeSpec::Sphere { center, radius } => sphere_decide::<N>(center, radius, ray, interval),
-        ShapeSpec::Quad { q, u, v } => plane_decide::<N>(q, u, v, false, ray, interval).map(|x| x.0),
+        ShapeSpec::Quad { q, u, v } => {
+            plane_decide::<N>(q, u, v, false, ray, interval).map(|x| x.0)
+        }
         ShapeSpec::Triangle { a, b, c } => {
             plane_decide::<N>(a, b, c, true, ray, interval).map(|x| x.0)
         }
@@ -607,7 +615,13 @@ pub fn sphere_exact(center: [f64; 3], radius: f64, ray: &RaySpec) -> SphereExact
 }
 
 /// The exact plane quantities (finite inputs).
-pub fn plane_exact(q: [f64; 3], u: [f64; 3], v: [f64; 3], triangle: bool, ray: &RaySpec) -> PlaneExact {
+pub fn plane_exact(
+    q: [f64; 3],
+    u: [f64; 3],
+    v: [f64; 3],
+    triangle: bool,
+    ray: &RaySpec,
+) -> PlaneExact {
     let qn = dv(q);
     let (un, vn) = if triangle {
         (dv(u).minus(&qn), dv(v).minus(&qn))
@@ -709,7 +723,12 @@ fn plane_hit(q: [f64; 3], u: [f64; 3], v: [f64; 3], triangle: bool, ray: &RaySpe
     let o = dv(ray.origin);
     let t = ex.tn.div_to_f64(&ex.nd);
     // P_i = (O_i nd + tn d_i) / nd, rounded once.
-    let point = [0, 1, 2].map(|i| o.0[i].mul(&ex.nd).add(&ex.tn.mul(&d.0[i])).div_to_f64(&ex.nd));
+    let point = [0, 1, 2].map(|i| {
+        o.0[i]
+            .mul(&ex.nd)
+            .add(&ex.tn.mul(&d.0[i]))
+            .div_to_f64(&ex.nd)
+    });
     let nf = ex.n.clone().map(|x| x.to_f64());
     let outward = unit(nf);
     let front_face = ex.nd.signum() == Ordering::Less;
@@ -737,7 +756,17 @@ mod tests {
 
     #[test]
     fn dyadic_round_trips_every_kind_of_f64() {
-        for x in [0.0, 1.0, -1.5, 0.1, 1e300, -5e-324, f64::MAX, f64::MIN_POSITIVE, 3.0e-310] {
+        for x in [
+            0.0,
+            1.0,
+            -1.5,
+            0.1,
+            1e300,
+            -5e-324,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            3.0e-310,
+        ] {
             assert_eq!(dy(x).to_f64().to_bits(), x.to_bits(), "{x}");
         }
     }
@@ -763,7 +792,10 @@ mod tests {
         // Ties go to even: 1 + 2^-53 rounds to 1.
         assert_eq!(dy(1.0).add(&dy(2f64.powi(-53))).to_f64(), 1.0);
         assert_eq!(
-            dy(1.0).add(&dy(2f64.powi(-53))).add(&dy(2f64.powi(-100))).to_f64(),
+            dy(1.0)
+                .add(&dy(2f64.powi(-53)))
+                .add(&dy(2f64.powi(-100)))
+                .to_f64(),
             1.0 + f64::EPSILON
         );
     }

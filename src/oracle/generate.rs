@@ -134,13 +134,29 @@ pub struct Raw {
     pub tags: Vec<&'static str>,
 }
 
-fn raw(shape: ShapeSpec, origin: [f64; 3], direction: [f64; 3], interval: [f64; 2], tags: &[&'static str]) -> Raw {
+fn raw(
+    shape: ShapeSpec,
+    origin: [f64; 3],
+    direction: [f64; 3],
+    interval: [f64; 2],
+    tags: &[&'static str],
+) -> Raw {
     Raw {
         shape,
         ray: RaySpec { origin, direction },
         interval,
         tags: tags.to_vec(),
     }
+}
+
+/// A raw case with no tags.
+pub fn raw_parts(
+    shape: ShapeSpec,
+    origin: [f64; 3],
+    direction: [f64; 3],
+    interval: [f64; 2],
+) -> Raw {
+    raw(shape, origin, direction, interval, &[])
 }
 
 /// Integer Pythagorean frames: `(d, n, L)` with `d . n = 0` and `|d| = |n| = L`.
@@ -154,7 +170,14 @@ const FRAMES: [([f64; 3], [f64; 3], f64); 4] = [
 /// A frame under a random signed permutation of the axes (which keeps orthogonality).
 fn frame(r: &mut Stream, i: usize) -> ([f64; 3], [f64; 3], f64) {
     let (d, n, l) = FRAMES[i % FRAMES.len()];
-    let perms = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    let perms = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
     let p = perms[r.int(0, 5) as usize];
     let s = [0; 3].map(|_| if r.coin() { 1.0 } else { -1.0 });
     let apply = |v: [f64; 3]| [v[p[0]] * s[0], v[p[1]] * s[1], v[p[2]] * s[2]];
@@ -340,7 +363,10 @@ fn sphere_case(cat: &str, r: &mut Stream, i: usize) -> Raw {
             let o = scale(r.unit(), s * r.uniform(0.0, 4.0));
             let d = scale(r.unit(), r.log_scale(-10.0, 10.0));
             let far = s * r.uniform(2.0, 100.0) / dot(d, d).sqrt();
-            let c = add(sub(o, scale(d, far)), scale(r.unit(), s * r.uniform(0.0, 0.5)));
+            let c = add(
+                sub(o, scale(d, far)),
+                scale(r.unit(), s * r.uniform(0.0, 0.5)),
+            );
             raw(sph(c, s), o, d, CAMERA, &["behind"])
         }
         "interval-boundary" => {
@@ -393,7 +419,8 @@ fn sphere_case(cat: &str, r: &mut Stream, i: usize) -> Raw {
         }
         "unnormalised" => {
             let mut c = random_sphere(r, 1e3, None);
-            let len = libm::pow(10.0, r.uniform(-3.0, 3.0)) / dot(c.ray.direction, c.ray.direction).sqrt();
+            let len = libm::pow(10.0, r.uniform(-3.0, 3.0))
+                / dot(c.ray.direction, c.ray.direction).sqrt();
             c.ray.direction = scale(c.ray.direction, len);
             c.tags = vec!["unnormalised"];
             c
@@ -491,7 +518,11 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
             }
             let n = cross(u, v);
             let nd = dot(n, d);
-            let d = if nd * nd < 0.01 * dot(n, n) * dot(d, d) { n } else { d };
+            let d = if nd * nd < 0.01 * dot(n, n) * dot(d, d) {
+                n
+            } else {
+                d
+            };
             let (a, b) = (r.int(-16, 80) as f64 / 64.0, r.int(-16, 80) as f64 / 64.0);
             let p = add(q, add(scale(u, a), scale(v, b)));
             let o = sub(p, scale(d, r.pow2(0, 4)));
@@ -503,8 +534,18 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
             let n = cross(u, v);
             let (a, b) = (r.int(-4, 4) as f64, r.int(1, 4) as f64);
             let d = add(scale(u, a), scale(v, b));
-            let p = add(q, add(scale(u, r.int(0, 64) as f64 / 64.0), scale(v, r.int(0, 64) as f64 / 64.0)));
-            let lift = if i % 4 == 3 { 0.0 } else { r.int(-4, 4) as f64 * r.pow2(-10, 0) };
+            let p = add(
+                q,
+                add(
+                    scale(u, r.int(0, 64) as f64 / 64.0),
+                    scale(v, r.int(0, 64) as f64 / 64.0),
+                ),
+            );
+            let lift = if i % 4 == 3 {
+                0.0
+            } else {
+                r.int(-4, 4) as f64 * r.pow2(-10, 0)
+            };
             let lift = if lift == 0.0 && i % 4 != 3 { 1.0 } else { lift };
             let o = sub(add(p, scale(n, lift)), scale(d, r.int(1, 4) as f64));
             raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["parallel"])
@@ -513,14 +554,29 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
             let (q, u, v, _) = int_quad(r, 8);
             let n = cross(u, v);
             let j = r.int(5, 60);
-            let d = add(add(scale(u, r.int(-4, 4) as f64), scale(v, r.int(1, 4) as f64)), scale(n, pow2(-j)));
-            let p = add(q, add(scale(u, r.int(8, 24) as f64 / 64.0), scale(v, r.int(8, 24) as f64 / 64.0)));
+            let d = add(
+                add(scale(u, r.int(-4, 4) as f64), scale(v, r.int(1, 4) as f64)),
+                scale(n, pow2(-j)),
+            );
+            let p = add(
+                q,
+                add(
+                    scale(u, r.int(8, 24) as f64 / 64.0),
+                    scale(v, r.int(8, 24) as f64 / 64.0),
+                ),
+            );
             let o = sub(p, scale(d, r.pow2(0, 3)));
             raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["grazing"])
         }
         "interval-boundary" => {
             let (q, u, v, d) = int_quad(r, 8);
-            let p = add(q, add(scale(u, r.int(8, 24) as f64 / 64.0), scale(v, r.int(8, 24) as f64 / 64.0)));
+            let p = add(
+                q,
+                add(
+                    scale(u, r.int(8, 24) as f64 / 64.0),
+                    scale(v, r.int(8, 24) as f64 / 64.0),
+                ),
+            );
             let t = r.pow2(0, 5);
             let o = sub(p, scale(d, t));
             let step = 1i64 << r.int(0, 40);
@@ -531,11 +587,23 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
                 3 => [1e-6, nudge(t, if r.coin() { step } else { -step })],
                 _ => [t, t],
             };
-            raw(plane_shape(triangle, q, u, v), o, d, interval, &["interval-boundary"])
+            raw(
+                plane_shape(triangle, q, u, v),
+                o,
+                d,
+                interval,
+                &["interval-boundary"],
+            )
         }
         "behind" => {
             let (q, u, v, d) = int_quad(r, 8);
-            let p = add(q, add(scale(u, r.int(0, 64) as f64 / 64.0), scale(v, r.int(0, 32) as f64 / 64.0)));
+            let p = add(
+                q,
+                add(
+                    scale(u, r.int(0, 64) as f64 / 64.0),
+                    scale(v, r.int(0, 32) as f64 / 64.0),
+                ),
+            );
             let o = add(p, scale(d, r.pow2(0, 4)));
             raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["behind"])
         }
@@ -550,7 +618,8 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
         }
         "unnormalised" => {
             let mut c = random_plane(r, triangle);
-            let len = libm::pow(10.0, r.uniform(-3.0, 3.0)) / dot(c.ray.direction, c.ray.direction).sqrt();
+            let len = libm::pow(10.0, r.uniform(-3.0, 3.0))
+                / dot(c.ray.direction, c.ray.direction).sqrt();
             c.ray.direction = scale(c.ray.direction, len);
             c.tags = vec!["unnormalised"];
             c
@@ -564,7 +633,13 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
             };
             let o = sub(q, scale(d, 2.0));
             let d = if i % 5 == 4 { [0.0; 3] } else { d };
-            raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["degenerate"])
+            raw(
+                plane_shape(triangle, q, u, v),
+                o,
+                d,
+                CAMERA,
+                &["degenerate"],
+            )
         }
         "nonfinite" => {
             let c = random_plane(r, triangle);

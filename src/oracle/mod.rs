@@ -5,8 +5,11 @@
 //! benchmark ([`bench`]) and the language-agnostic vector format ([`vectors`]).
 
 pub mod band;
+pub mod bench;
 pub mod classify;
 pub mod exact;
+pub mod explain;
+pub mod fuzzing;
 pub mod generate;
 pub mod suite;
 pub mod variants;

@@ -41,7 +41,8 @@ mod tests {
         assert!(suite.len() >= 3000);
         let mut by: BTreeMap<(String, Class), usize> = BTreeMap::new();
         for c in &suite {
-            *by.entry((c.shape.kind().to_string(), c.expect.class)).or_default() += 1;
+            *by.entry((c.shape.kind().to_string(), c.expect.class))
+                .or_default() += 1;
         }
         eprintln!("{by:?}");
         for tag in ORACLE_TAGS {
@@ -54,8 +55,14 @@ mod tests {
             .iter()
             .filter(|c| c.expect.class.is_definite() && c.shape.kind() != ShapeKind::Triangle)
             .count();
-        assert!(definite_sq >= 1000, "{definite_sq} definite sphere and quad cases");
-        let loose = suite.iter().filter(|c| !c.expect.class.is_definite()).count();
+        assert!(
+            definite_sq >= 1000,
+            "{definite_sq} definite sphere and quad cases"
+        );
+        let loose = suite
+            .iter()
+            .filter(|c| !c.expect.class.is_definite())
+            .count();
         assert!(
             loose * 100 <= 35 * suite.len(),
             "{loose} of {} ambiguous or any",

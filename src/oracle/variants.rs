@@ -59,7 +59,9 @@ pub fn judge(expect: &Expect, answer: &Answer) -> Result<(), String> {
                 return Err(format!("t = {} but expected {t} +- {tol:e}", h.t));
             }
             if let Some(n) = expect.normal {
-                let off = (0..3).map(|i| (h.normal[i] - n[i]).abs()).fold(0.0, f64::max);
+                let off = (0..3)
+                    .map(|i| (h.normal[i] - n[i]).abs())
+                    .fold(0.0, f64::max);
                 if !(off <= 1e-6) {
                     return Err(format!("normal {:?} but expected {n:?}", h.normal));
                 }
@@ -228,7 +230,13 @@ fn quad_with(o: QuadOpts, shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Ans
         d = unit(d)?;
     }
     let denom = dot(normal, d);
-    if !o.no_parallel && (if o.exact_zero { denom == 0.0 } else { denom.abs() < 1e-8 }) {
+    if !o.no_parallel
+        && (if o.exact_zero {
+            denom == 0.0
+        } else {
+            denom.abs() < 1e-8
+        })
+    {
         return Ok(None);
     }
     let mut t = div(big_d - dot(normal, orig), denom)?;
@@ -307,11 +315,14 @@ fn moller_trumbore(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
 /// The reference tracer (`rtoracle::geometry`).
 fn reference(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
     let interval = crate::geometry::Interval::new(iv[0], iv[1]);
-    Ok(shape.object().intersect(&ray.ray(), interval).map(|h| VHit {
-        t: h.t,
-        normal: h.normal.to_array(),
-        front_face: h.front_face,
-    }))
+    Ok(shape
+        .object()
+        .intersect(&ray.ray(), interval)
+        .map(|h| VHit {
+            t: h.t,
+            normal: h.normal.to_array(),
+            front_face: h.front_face,
+        }))
 }
 
 macro_rules! sphere_variant {
@@ -428,7 +439,12 @@ mod tests {
         for v in honest() {
             let f = failures(&v, &suite);
             if !f.is_empty() {
-                bad.push(format!("{} fails {} vectors, e.g. {:?}", v.name, f.len(), &f[..f.len().min(3)]));
+                bad.push(format!(
+                    "{} fails {} vectors, e.g. {:?}",
+                    v.name,
+                    f.len(),
+                    &f[..f.len().min(3)]
+                ));
             }
         }
         assert!(bad.is_empty(), "{bad:#?}");
