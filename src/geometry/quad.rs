@@ -47,7 +47,7 @@ impl Quad {
     fn solve(&self, ray: &Ray, interval: Interval) -> Option<(f64, f64, f64)> {
         let denom = self.normal.dot(ray.direction);
         // `!(|denom| >= eps)` also rejects a NaN normal (degenerate quad) and NaN input.
-        if !(denom.abs() >= PARALLEL_EPSILON) {
+        if denom.is_nan() || denom.abs() < PARALLEL_EPSILON {
             return None;
         }
         let t = (self.d - self.normal.dot(ray.origin)) / denom;

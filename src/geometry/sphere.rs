@@ -36,7 +36,7 @@ impl Sphere {
         let perpendicular = f - d * (half_b / a);
         let disc = a * (r2 - perpendicular.dot(perpendicular));
         // `!(disc >= 0)` also rejects NaN.
-        if !(disc >= 0.0) {
+        if disc.is_nan() || disc < 0.0 {
             return None;
         }
         let c = f.dot(f) - r2;

@@ -213,6 +213,7 @@ impl Div for Iv {
 #[derive(Clone, Copy, Debug)]
 pub struct IV3(pub [Iv; 3]);
 
+#[allow(clippy::should_implement_trait)]
 impl IV3 {
     /// From points.
     pub fn of(v: [f64; 3]) -> Self {

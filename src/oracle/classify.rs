@@ -178,6 +178,7 @@ pub fn analyse(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Analysis
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn finish(
     decision: Decision,
     by_filter: bool,
@@ -191,7 +192,7 @@ fn finish(
     let is_hit = hit.is_some();
     let overflow = checks
         .iter()
-        .any(|c| !c.definite && !(c.band.lo.is_finite() || c.band.hi.is_finite()));
+        .any(|c| !(c.definite || c.band.lo.is_finite() || c.band.hi.is_finite()));
     if !definite {
         for c in &checks {
             if !c.definite {

@@ -184,7 +184,7 @@ fn round_parts(m: &BigInt, e: i64, sticky: bool) -> f64 {
     let (top, e) = if bits > 62 {
         let s = bits - 62;
         let top = &mag >> s as usize;
-        let lost = sticky || !(&top << s as usize == mag);
+        let lost = sticky || (&top << s as usize) != mag;
         let top = top.to_u64().expect("62 bits fit") | u64::from(lost);
         (top, e + s as i64)
     } else {

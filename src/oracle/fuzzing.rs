@@ -66,7 +66,7 @@ pub fn check_shape_bytes(kind: ShapeKind, bytes: &[u8]) -> Result<(), Violation>
                 a.hit.map(|e| e.t).unwrap_or(f64::NAN),
                 a.t_tol.unwrap_or(0.0),
             );
-            if !((h.t - t).abs() <= tol) {
+            if (h.t - t).abs().is_nan() || (h.t - t).abs() > tol {
                 return Err(Violation(format!(
                     "{}: the reference's t = {} is not within {tol:e} of the exact {t}",
                     case(),
@@ -152,8 +152,11 @@ pub fn check_vector_line_bytes(bytes: &[u8]) -> Result<(), Violation> {
     Ok(())
 }
 
+/// The body of a fuzz target.
+pub type Target = fn(&[u8]) -> Result<(), Violation>;
+
 /// The function of each fuzz target, by target name.
-pub fn target(name: &str) -> Option<fn(&[u8]) -> Result<(), Violation>> {
+pub fn target(name: &str) -> Option<Target> {
     Some(match name {
         "sphere" => check_sphere_bytes,
         "quad" => check_quad_bytes,

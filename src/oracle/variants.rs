@@ -55,14 +55,14 @@ pub fn judge(expect: &Expect, answer: &Answer) -> Result<(), String> {
         (Class::Hit, Ok(None)) => Err("missed where the ray hits".into()),
         (Class::Hit, Ok(Some(h))) => {
             let (t, tol) = (expect.t.unwrap_or(f64::NAN), expect.t_tol.unwrap_or(0.0));
-            if !((h.t - t).abs() <= tol) {
+            if (h.t - t).abs().is_nan() || (h.t - t).abs() > tol {
                 return Err(format!("t = {} but expected {t} +- {tol:e}", h.t));
             }
             if let Some(n) = expect.normal {
                 let off = (0..3)
                     .map(|i| (h.normal[i] - n[i]).abs())
                     .fold(0.0, f64::max);
-                if !(off <= 1e-6) {
+                if h.normal.iter().any(|x| !x.is_finite()) || off > 1e-6 {
                     return Err(format!("normal {:?} but expected {n:?}", h.normal));
                 }
             }
