@@ -245,14 +245,18 @@ fn plane(
     }
     if let Some(sg) = exact::plane_signs(&plane_spec(q, u, v, triangle), ray, _iv) {
         let yes = |b: bool| if b { "yes" } else { "NO" };
+        let (e1, e2, e3) = if triangle {
+            ("beta_b >= 0", "beta_c >= 0", "beta_b + beta_c <= 1")
+        } else {
+            ("alpha >= 0", "beta >= 0", "alpha <= 1")
+        };
         let _ = writeln!(
             s,
-            "  exactly: t >= t_min {}, t <= t_max {}, first edge {}, second edge {}, {} {}{}",
+            "  exactly: t >= t_min {}, t <= t_max {}, {e1} {}, {e2} {}, {e3} {}{}",
             yes(sg.after_min),
             yes(sg.before_max),
             yes(sg.alpha_ge_0),
             yes(sg.beta_ge_0),
-            if triangle { "third edge" } else { "alpha <= 1" },
             yes(sg.alpha_le_1),
             if triangle {
                 String::new()

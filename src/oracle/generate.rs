@@ -221,7 +221,8 @@ pub fn random_plane(r: &mut Stream, triangle: bool) -> Raw {
     let q = scale(r.unit(), s * r.uniform(0.0, 8.0));
     let u = scale(r.unit(), s * r.uniform(0.3, 3.0));
     let v = scale(r.unit(), s * r.uniform(0.3, 3.0));
-    let (a, b) = (r.uniform(-0.4, 1.4), r.uniform(-0.4, 1.4));
+    let (lo, hi) = if triangle { (-0.2, 0.8) } else { (-0.4, 1.4) };
+    let (a, b) = (r.uniform(lo, hi), r.uniform(lo, hi));
     let p = add(q, add(scale(u, a), scale(v, b)));
     let d = scale(r.unit(), r.log_scale(-10.0, 10.0));
     let origin = sub(p, scale(d, s * r.uniform(0.5, 20.0) / dot(d, d).sqrt()));
