@@ -26,29 +26,76 @@ impl Sphere {
     /// of the centre from the line, which does not cancel catastrophically far from the sphere),
     /// and the roots as `c / q` and `q / a` with `q = -(b' + sign(b') sqrt(disc))`, which avoids
     /// the cancellation of `-b' + sqrt(disc)`.
+    ///
+    /// When an intermediate would overflow or underflow (inputs near `f64::MAX` or far below 1),
+    /// the problem is solved again with the positions and the radius scaled by one power of two
+    /// and the direction by another, which is exact, and `t` is scaled back.
     #[inline]
     pub fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
-        let d = ray.direction;
-        let f = ray.origin - self.center;
+        match Self::solve(ray.origin - self.center, ray.direction, self.radius) {
+            Ok(roots) => roots,
+            Err(()) => self.rescaled_roots(ray),
+        }
+    }
+
+    /// The roots for `f = O - C`, or `Err` when an intermediate over- or underflowed.
+    #[inline]
+    fn solve(f: DVec3, d: DVec3, radius: f64) -> Result<Option<(f64, f64)>, ()> {
         let a = d.dot(d);
         let half_b = f.dot(d);
-        let r2 = self.radius * self.radius;
+        let r2 = radius * radius;
+        let c = f.dot(f) - r2;
+        // a must be a normal number and squares must not overflow.
+        if !(a.is_normal() && a < 1e300 && c.is_finite() && r2 < 1e300 && half_b.is_finite()) {
+            return Err(());
+        }
         let perpendicular = f - d * (half_b / a);
         let disc = a * (r2 - perpendicular.dot(perpendicular));
-        // `!(disc >= 0)` also rejects NaN.
-        if disc.is_nan() || disc < 0.0 {
-            return None;
+        if disc.is_nan() || disc.is_infinite() {
+            return Err(());
         }
-        let c = f.dot(f) - r2;
+        if disc < 0.0 {
+            return Ok(None);
+        }
         let q = -(half_b + disc.sqrt().copysign(half_b));
         if q == 0.0 {
             // Tangent with the origin on the tangent point's plane: a double root at -b'/a.
             let t = -half_b / a;
-            return Some((t, t));
+            return Ok(Some((t, t)));
         }
         let t0 = c / q;
         let t1 = q / a;
-        Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) })
+        Ok(Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) }))
+    }
+
+    /// [`Sphere::roots`] with the inputs scaled by powers of two so that the largest position
+    /// coordinate (or radius) and the largest direction coordinate are near 1.
+    #[cold]
+    fn rescaled_roots(&self, ray: &Ray) -> Option<(f64, f64)> {
+        let (o, c, d) = (ray.origin, self.center, ray.direction);
+        let scale = |v: DVec3, e: i32| {
+            DVec3::new(
+                libm::scalbn(v.x, -e),
+                libm::scalbn(v.y, -e),
+                libm::scalbn(v.z, -e),
+            )
+        };
+        // `O - C` overflows by at most a factor of 2: halve first then.
+        let (mut f, mut r, mut pre) = (o - c, self.radius, 0);
+        if !super::is_finite(f) {
+            f = scale(o, 1) - scale(c, 1);
+            r = libm::scalbn(r, -1);
+            pre = 1;
+        }
+        let big = f.abs().max_element().max(r.abs());
+        let dbig = d.abs().max_element();
+        if !(big.is_finite() && dbig.is_finite()) || dbig == 0.0 || big == 0.0 {
+            return None;
+        }
+        let (ef, ed) = (libm::ilogb(big), libm::ilogb(dbig));
+        let (t0, t1) = Self::solve(scale(f, ef), scale(d, ed), libm::scalbn(r, -ef)).ok()??;
+        let back = |t: f64| libm::scalbn(t, ef + pre - ed);
+        Some((back(t0), back(t1)))
     }
 
     /// The spherical surface coordinates `(u, v)` in `[0, 1]` of a point whose outward unit

@@ -2,6 +2,12 @@ use glam::DVec3;
 
 use super::{HitRecord, Interval, Ray, Shape, unit_vector};
 
+/// The relative error bound of an edge function, generous (2^-48; the rounding unit is 2^-53).
+const EDGE_ERROR: f64 = 3.552713678800501e-15;
+
+const TINY: f64 = 3.054936363499605e-151; // 2^-500
+const HUGE: f64 = 3.273390607896142e150; // 2^500
+
 /// A triangle `(a, b, c)` intersected watertightly (Woop, Benthin and Wald, JCGT 2013).
 ///
 /// The ray is moved to the origin and sheared so that it runs along +z; the three edge functions
@@ -33,8 +39,35 @@ impl Triangle {
     }
 
     /// The watertight decision with `(t, beta, gamma)`, the barycentric weights of `b` and `c`.
+    ///
+    /// A direction whose largest component is outside `2^-500 .. 2^500` is first scaled by a
+    /// power of two (exact), so that `1 / d_z` neither overflows nor loses bits as a subnormal,
+    /// and `t` is scaled back.
     #[inline]
     fn solve(&self, ray: &Ray, interval: Interval) -> Option<(f64, f64, f64)> {
+        let big = ray.direction.abs().max_element();
+        let (t, beta, gamma) = if (TINY..=HUGE).contains(&big) || !big.is_finite() || big == 0.0 {
+            self.solve_unbounded(ray)?
+        } else {
+            let e = libm::ilogb(big);
+            let d = ray.direction;
+            let scaled = DVec3::new(
+                libm::scalbn(d.x, -e),
+                libm::scalbn(d.y, -e),
+                libm::scalbn(d.z, -e),
+            );
+            let (t, beta, gamma) = self.solve_unbounded(&Ray::new(ray.origin, scaled))?;
+            (libm::scalbn(t, -e), beta, gamma)
+        };
+        if !interval.contains(t) {
+            return None;
+        }
+        Some((t, beta, gamma))
+    }
+
+    /// The watertight test without the interval check.
+    #[inline]
+    fn solve_unbounded(&self, ray: &Ray) -> Option<(f64, f64, f64)> {
         let d = ray.direction;
         let ad = d.abs();
         // The axis along which the direction is largest becomes z.
@@ -57,7 +90,6 @@ impl Triangle {
         }
         let sx = d[kx] / dz;
         let sy = d[ky] / dz;
-        let sz = 1.0 / dz;
 
         let a = self.a - ray.origin;
         let b = self.b - ray.origin;
@@ -70,21 +102,78 @@ impl Triangle {
         let u = cx * by - cy * bx;
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
-        let negative = u < 0.0 || v < 0.0 || w < 0.0;
-        let positive = u > 0.0 || v > 0.0 || w > 0.0;
-        if (negative && positive) || u.is_nan() || v.is_nan() || w.is_nan() {
+        // A generous bound on each edge function's rounding error (the shear, the products and
+        // the difference): a sign inside its bound is not trusted.
+        let m = |p: DVec3| {
+            (
+                p[kx].abs() + (sx * p[kz]).abs(),
+                p[ky].abs() + (sy * p[kz]).abs(),
+            )
+        };
+        let ((max, may), (mbx, mby), (mcx, mcy)) = (m(a), m(b), m(c));
+        let bound = |p: f64, q: f64| EDGE_ERROR * p + EDGE_ERROR * q + 1e-300;
+        let clear = [
+            (u, bound(mcx * mby, mcy * mbx)),
+            (v, bound(max * mcy, may * mcx)),
+            (w, bound(mbx * may, mby * max)),
+        ]
+        .map(|(e, err)| {
+            if e > err {
+                1
+            } else if e < -err {
+                -1
+            } else {
+                0
+            }
+        });
+        if clear.contains(&1) && clear.contains(&-1) {
             return None;
         }
         let det = u + v + w;
-        if det == 0.0 || !det.is_finite() {
+        if clear.contains(&0) || det == 0.0 || !det.is_finite() {
+            // Too close to an edge (or over- or underflowing) for f64: decide exactly. Exact
+            // edge tests are watertight too, and the same for every triangle sharing the edge.
+            if !self.inside_exactly(ray) {
+                return None;
+            }
+        }
+        // The decision is watertight; `t` comes from the plane equation, as the course computes
+        // it for quads (`(D - n.O) / n.d` with the unit normal): the sheared-space formula
+        // `(u a_z + v b_z + w c_z) / det` loses all relative accuracy when the origin is very
+        // near the plane, where this one keeps it.
+        let t = (self.normal.dot(self.a) - self.normal.dot(ray.origin)) / self.normal.dot(d);
+        if !t.is_finite() {
             return None;
         }
-        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
-        let t = (u * az + v * bz + w * cz) / det;
-        if !interval.contains(t) {
-            return None;
+        let (beta, gamma) = if det != 0.0 && det.is_finite() {
+            (v / det, w / det)
+        } else {
+            (0.0, 0.0)
+        };
+        Some((t, beta, gamma))
+    }
+
+    /// Whether the ray's line meets the closed triangle, decided exactly (big integers behind
+    /// an interval filter, see [`crate::oracle::exact`]).
+    #[cold]
+    fn inside_exactly(&self, ray: &Ray) -> bool {
+        use crate::oracle::band::Iv;
+        use crate::oracle::exact::{Dyadic, plane_decide};
+        let finite = |v: DVec3| super::is_finite(v);
+        if !(finite(self.a) && finite(self.b) && finite(self.c))
+            || !(finite(ray.origin) && finite(ray.direction))
+        {
+            return false;
         }
-        Some((t, v / det, w / det))
+        let spec = crate::oracle::vectors::RaySpec {
+            origin: ray.origin.to_array(),
+            direction: ray.direction.to_array(),
+        };
+        let all = [f64::NEG_INFINITY, f64::INFINITY];
+        let (a, b, c) = (self.a.to_array(), self.b.to_array(), self.c.to_array());
+        let decided = plane_decide::<Iv>(a, b, c, true, &spec, all)
+            .or_else(|| plane_decide::<Dyadic>(a, b, c, true, &spec, all));
+        matches!(decided, Some((crate::oracle::exact::Decision::PlaneHit, _)))
     }
 }
 

@@ -169,3 +169,50 @@ pub fn target(name: &str) -> Option<Target> {
 
 /// The names of the fuzz targets.
 pub const TARGETS: [&str; 5] = ["sphere", "quad", "triangle", "scene_file", "vector_line"];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::oracle::generate::Stream;
+
+    /// A cheap fuzzer in the test suite: inputs drawn from special values and random bits.
+    #[test]
+    fn special_values_never_break_the_shape_properties() {
+        let special = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            2.0,
+            f64::MAX,
+            -f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            1e300,
+            -1e300,
+            1e-300,
+            1e154,
+            1e-160,
+        ];
+        let mut r = Stream::new(5, "fuzz-special");
+        for i in 0..60_000 {
+            let kind = [ShapeKind::Sphere, ShapeKind::Quad, ShapeKind::Triangle][i % 3];
+            let mut bytes = Vec::new();
+            for _ in 0..17 {
+                let x = match r.int(0, 3) {
+                    0 => special[r.int(0, special.len() as i64 - 1) as usize],
+                    1 => f64::from_bits(r.bits()),
+                    _ => r.int(-4, 4) as f64,
+                };
+                bytes.extend(x.to_le_bytes());
+            }
+            if let Err(v) = check_shape_bytes(kind, &bytes) {
+                panic!("{v}");
+            }
+        }
+    }
+}
