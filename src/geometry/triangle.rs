@@ -160,9 +160,10 @@ impl Triangle {
         use crate::oracle::band::Iv;
         use crate::oracle::exact::{Dyadic, plane_decide};
         let finite = |v: DVec3| super::is_finite(v);
-        if !(finite(self.a) && finite(self.b) && finite(self.c))
-            || !(finite(ray.origin) && finite(ray.direction))
-        {
+        let all_finite = [self.a, self.b, self.c, ray.origin, ray.direction]
+            .into_iter()
+            .all(finite);
+        if !all_finite {
             return false;
         }
         let spec = crate::oracle::vectors::RaySpec {
