@@ -225,6 +225,69 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(config(200))]
+
+    /// Permuting a scene's objects does not change the closest t (ties aside).
+    #[test]
+    fn permuting_a_scenes_objects_keeps_the_closest_hit(seed in any::<u64>(), n in 2usize..7, rot in 1usize..6) {
+        use rtoracle::scene::{Scene, SceneObject};
+        let mut r = Stream::new(seed, "scene-perm");
+        let base = random_sphere(&mut r, 20.0, Some((0.0, 0.8)));
+        let ray = base.ray.ray();
+        let mut objects = vec![base.shape];
+        for k in 1..n {
+            // More primitives around the same ray: random spheres and quads near its path.
+            let t = r.uniform(0.5, 3.0) * k as f64;
+            let p = ray.at(t).to_array();
+            let s = r.uniform(0.1, 1.0) * (ray.direction.length() * t).max(1e-300);
+            objects.push(if r.coin() {
+                ShapeSpec::Sphere { center: p, radius: s }
+            } else {
+                let u = r.unit().map(|x| x * s);
+                let v = r.unit().map(|x| x * s);
+                ShapeSpec::Quad { q: [0, 1, 2].map(|i| p[i] - 0.5 * (u[i] + v[i])), u, v }
+            });
+        }
+        let scene = |shapes: &[ShapeSpec]| Scene {
+            objects: shapes.iter().map(|s| SceneObject { shape: s.object(), material: 0 }).collect(),
+            materials: vec![],
+        };
+        let hits: Vec<f64> = objects
+            .iter()
+            .filter_map(|o| o.object().hit_t(&ray, Interval::CAMERA))
+            .collect();
+        let mut sorted = hits.clone();
+        sorted.sort_by(f64::total_cmp);
+        prop_assume!(sorted.windows(2).all(|w| w[0] != w[1]));
+        let a = scene(&objects).closest(&ray, Interval::CAMERA).map(|h| h.0);
+        let mut permuted = objects.clone();
+        permuted.rotate_left(rot % n);
+        permuted.reverse();
+        let b = scene(&permuted).closest(&ray, Interval::CAMERA).map(|h| h.0);
+        prop_assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        prop_assert_eq!(a, sorted.first().copied());
+    }
+
+    /// Reversing a ray that hits a quad or triangle definitely, from a point beyond the hit,
+    /// meets the same point (approximately).
+    #[test]
+    fn reversing_the_ray_meets_the_same_point(c in case()) {
+        if matches!(c.shape, ShapeSpec::Sphere { .. }) { return Ok(()); }
+        let e = rtoracle::oracle::classify(&c.shape, &c.ray, c.interval);
+        let (Class::Hit, Some(p), Some(t)) = (e.class, e.point, e.t) else { return Ok(()); };
+        let o2 = [0, 1, 2].map(|i| c.ray.origin[i] + 2.0 * t * c.ray.direction[i]);
+        let back = RaySpec { origin: o2, direction: c.ray.direction.map(|x| -x) };
+        let e2 = rtoracle::oracle::classify(&c.shape, &back, [0.0, f64::MAX]);
+        if e2.class == Class::Hit {
+            let q = e2.point.unwrap();
+            let size = c.shape.numbers().iter().chain(&c.ray.origin).fold(0.0f64, |m, x| m.max(x.abs()));
+            let off = (0..3).map(|i| (p[i] - q[i]).abs()).fold(0.0, f64::max);
+            prop_assert!(off <= 1e-9 * (size + t.abs() * 4.0), "{:?} vs {:?}", p, q);
+        }
+    }
+}
+
 /// pbrt-v4's re-intersection test: a ray spawned from a hit point, offset off the surface and
 /// leaving it, never hits the same primitive again, at scales 1e-8 .. 1e8.
 #[test]
