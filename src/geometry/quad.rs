@@ -51,7 +51,8 @@ impl Quad {
             return None;
         }
         let t = (self.d - self.normal.dot(ray.origin)) / denom;
-        if !interval.contains(t) {
+        // An overflowing t (huge inputs) is no hit, even when the interval is unbounded.
+        if !t.is_finite() || !interval.contains(t) {
             return None;
         }
         let planar = ray.at(t) - self.q;
