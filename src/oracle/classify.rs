@@ -423,16 +423,36 @@ fn plane(
     hit: Option<ExactHit>,
 ) -> Analysis {
     if s.parallel {
-        // Exactly parallel and off the plane (in the plane is degenerate, handled before).
+        // Exactly parallel and off the plane (in the plane is degenerate, handled before). It is
+        // a definite miss when the course's f64 denominator `unit(n) . d` is surely below the
+        // 1e-8 threshold; with large or skewed inputs the rounded unit normal is not exactly
+        // perpendicular to d, honest code computes a t, and the case is ambiguous.
+        let check = Check::new(
+            "1e-8 - |unit(n) . d| > 0 (parallel)",
+            "grazing",
+            Iv::point(PARALLEL_EPSILON) - b.denom.abs(),
+            true,
+        );
+        let definite = check.definite;
         return Analysis {
             decision: Some(decision),
             by_filter,
             hit: None,
-            checks: vec![],
-            class: Class::Miss,
-            tags: vec!["parallel".into()],
+            checks: vec![check],
+            class: if definite {
+                Class::Miss
+            } else {
+                Class::Ambiguous
+            },
+            tags: if definite {
+                vec!["parallel".into()]
+            } else {
+                vec!["grazing".into(), "parallel".into()]
+            },
             t_tol: None,
-            why: None,
+            why: (!definite).then(|| {
+                "the ray is exactly parallel to the plane, but the course's rounded unit normal is not exactly perpendicular to d, so honest f64 code may compute a t".to_string()
+            }),
         };
     }
     let (tmin, tmax) = (Iv::point(interval[0]), Iv::point(interval[1]));
