@@ -1,9 +1,86 @@
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// `rtoracle vectors` (to be written).
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::Context;
+use rtoracle::image_io::write_atomically;
+use rtoracle::oracle::generate::generate;
+use rtoracle::oracle::suite::DEFAULT_COUNT;
+use rtoracle::oracle::vectors::{SCHEMA_VERSION, ShapeKind};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("'vectors' is not implemented yet")
+/// `rtoracle vectors [--seed S] [--count N] [--shapes sphere,quad,triangle] -o FILE.jsonl`
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Seed of the generators: the same seed gives the same bytes.
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    seed: u64,
+    /// Number of vectors (the default suite has 4000).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_COUNT as i64)]
+    count: i64,
+    /// Comma-separated shapes to generate.
+    #[arg(long, value_name = "LIST", default_value = "sphere,quad,triangle")]
+    shapes: String,
+    /// The JSON-lines file to write; `FILE.meta.json` is written beside it.
+    #[arg(short, long, value_name = "FILE.jsonl")]
+    output: PathBuf,
+}
+
+/// Parses a `--shapes` list.
+pub fn parse_shapes(list: &str) -> anyhow::Result<Vec<ShapeKind>> {
+    let mut out = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let kind = ShapeKind::from_name(name).with_context(|| {
+            format!("--shapes {list}: unknown shape {name:?} (expected sphere, quad or triangle)")
+        })?;
+        if !out.contains(&kind) {
+            out.push(kind);
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let shapes = parse_shapes(&args.shapes)?;
+    if args.count <= 0 {
+        anyhow::bail!("--count {}: at least one vector is needed", args.count);
+    }
+    let count = usize::try_from(args.count).context("--count: too large")?;
+    let cases = generate(args.seed, count, &shapes);
+    let mut text = String::with_capacity(cases.len() * 400);
+    let mut classes = std::collections::BTreeMap::<String, usize>::new();
+    for c in &cases {
+        text.push_str(&c.to_json_line());
+        text.push('\n');
+        let class = serde_json::to_value(c.expect.class)?;
+        *classes
+            .entry(class.as_str().unwrap_or("?").to_string())
+            .or_default() += 1;
+    }
+    let meta = serde_json::json!({
+        "schema_version": SCHEMA_VERSION,
+        "generator": format!("rtoracle {}", env!("CARGO_PKG_VERSION")),
+        "seed": args.seed,
+        "count": cases.len(),
+        "shapes": shapes.iter().map(|k| k.name()).collect::<Vec<_>>(),
+        "classes": classes,
+    });
+    let mut meta_path = args.output.clone().into_os_string();
+    meta_path.push(".meta.json");
+    let meta_path = PathBuf::from(meta_path);
+    write_atomically(&args.output, text.as_bytes())?;
+    write_atomically(
+        &meta_path,
+        (serde_json::to_string_pretty(&meta)? + "\n").as_bytes(),
+    )?;
+    eprintln!(
+        "wrote {} vectors to {} ({})",
+        cases.len(),
+        args.output.display(),
+        classes
+            .iter()
+            .map(|(k, v)| format!("{v} {k}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(ExitCode::SUCCESS)
 }

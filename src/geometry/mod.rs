@@ -19,7 +19,6 @@ pub use ray::Ray;
 pub use sphere::Sphere;
 pub(crate) use sphere::{pick_root, roots_of};
 pub use triangle::Triangle;
-pub(crate) use triangle::{Shear, solve_sheared};
 
 /// The `f64` 3-vector used everywhere (re-exported from glam).
 pub use glam::DVec3;

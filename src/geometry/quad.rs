@@ -68,11 +68,12 @@ impl Quad {
     ) -> Option<(f64, f64, f64)> {
         let denom = self.normal.dot(ray.direction);
         // `!(|denom| >= eps)` also rejects a NaN normal (degenerate quad) and NaN input.
-        if !(denom.abs() >= PARALLEL_EPSILON) {
+        if denom.is_nan() || denom.abs() < PARALLEL_EPSILON {
             return None;
         }
         let t = offset / denom;
-        if !interval.contains(t) {
+        // An overflowing t (huge inputs) is no hit, even when the interval is unbounded.
+        if !t.is_finite() || !interval.contains(t) {
             return None;
         }
         let planar = ray.at(t) - self.q;

@@ -2,6 +2,12 @@ use glam::DVec3;
 
 use super::{HitRecord, Interval, Ray, Shape, unit_vector};
 
+/// The relative error bound of an edge function, generous (2^-48; the rounding unit is 2^-53).
+const EDGE_ERROR: f64 = 3.552713678800501e-15;
+
+const TINY: f64 = 3.054936363499605e-151; // 2^-500
+const HUGE: f64 = 3.273390607896142e150; // 2^500
+
 /// A triangle `(a, b, c)` intersected watertightly (Woop, Benthin and Wald, JCGT 2013).
 ///
 /// The ray is moved to the origin and sheared so that it runs along +z; the three edge functions
@@ -33,37 +39,36 @@ impl Triangle {
     }
 
     /// The watertight decision with `(t, beta, gamma)`, the barycentric weights of `b` and `c`.
+    ///
+    /// A direction whose largest component is outside `2^-500 .. 2^500` is first scaled by a
+    /// power of two (exact), so that `1 / d_z` neither overflows nor loses bits as a subnormal,
+    /// and `t` is scaled back.
     #[inline]
     fn solve(&self, ray: &Ray, interval: Interval) -> Option<(f64, f64, f64)> {
-        let shear = Shear::of(ray.direction)?;
-        solve_sheared(
-            self.a - ray.origin,
-            self.b - ray.origin,
-            self.c - ray.origin,
-            &shear,
-            interval,
-        )
+        let big = ray.direction.abs().max_element();
+        let (t, beta, gamma) = if (TINY..=HUGE).contains(&big) || !big.is_finite() || big == 0.0 {
+            self.solve_unbounded(ray)?
+        } else {
+            let e = libm::ilogb(big);
+            let d = ray.direction;
+            let scaled = DVec3::new(
+                libm::scalbn(d.x, -e),
+                libm::scalbn(d.y, -e),
+                libm::scalbn(d.z, -e),
+            );
+            let (t, beta, gamma) = self.solve_unbounded(&Ray::new(ray.origin, scaled))?;
+            (libm::scalbn(t, -e), beta, gamma)
+        };
+        if !interval.contains(t) {
+            return None;
+        }
+        Some((t, beta, gamma))
     }
-}
 
-/// The per-ray part of the watertight test: the axis permutation that makes the direction's
-/// largest component z, and the shear that maps the direction onto +z. It depends only on the
-/// direction, so the renderer computes it once per ray for all triangles.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Shear {
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f64,
-    sy: f64,
-    sz: f64,
-}
-
-impl Shear {
-    /// The shear of direction `d`, or `None` when `d` has no usable largest component (zero or
-    /// not finite), in which case no triangle is hit.
+    /// The watertight test without the interval check.
     #[inline]
-    pub(crate) fn of(d: DVec3) -> Option<Shear> {
+    fn solve_unbounded(&self, ray: &Ray) -> Option<(f64, f64, f64)> {
+        let d = ray.direction;
         let ad = d.abs();
         // The axis along which the direction is largest becomes z.
         let kz = if ad.x > ad.y {
@@ -83,59 +88,94 @@ impl Shear {
         if dz == 0.0 || !dz.is_finite() {
             return None;
         }
-        Some(Shear {
-            kx,
-            ky,
-            kz,
-            sx: d[kx] / dz,
-            sy: d[ky] / dz,
-            sz: 1.0 / dz,
-        })
-    }
-}
+        let sx = d[kx] / dz;
+        let sy = d[ky] / dz;
 
-/// The watertight decision for the vertices relative to the ray's origin (`a - origin`, ...)
-/// under the ray's `shear`. [`Triangle`]'s `intersect` and the renderer's fixed-origin fast path
-/// (which subtracts the origin once per render) both call it, so they agree bit for bit.
-#[inline(always)]
-pub(crate) fn solve_sheared(
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
-    shear: &Shear,
-    interval: Interval,
-) -> Option<(f64, f64, f64)> {
-    let Shear {
-        kx,
-        ky,
-        kz,
-        sx,
-        sy,
-        sz,
-    } = *shear;
-    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let a = self.a - ray.origin;
+        let b = self.b - ray.origin;
+        let c = self.c - ray.origin;
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
 
-    // Edge functions: U for edge bc, V for ca, W for ab.
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
-    let negative = u < 0.0 || v < 0.0 || w < 0.0;
-    let positive = u > 0.0 || v > 0.0 || w > 0.0;
-    if (negative && positive) || u.is_nan() || v.is_nan() || w.is_nan() {
-        return None;
+        // Edge functions: U for edge bc, V for ca, W for ab.
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        // A generous bound on each edge function's rounding error (the shear, the products and
+        // the difference): a sign inside its bound is not trusted.
+        let m = |p: DVec3| {
+            (
+                p[kx].abs() + (sx * p[kz]).abs(),
+                p[ky].abs() + (sy * p[kz]).abs(),
+            )
+        };
+        let ((max, may), (mbx, mby), (mcx, mcy)) = (m(a), m(b), m(c));
+        let bound = |p: f64, q: f64| EDGE_ERROR * p + EDGE_ERROR * q + 1e-300;
+        let clear = [
+            (u, bound(mcx * mby, mcy * mbx)),
+            (v, bound(max * mcy, may * mcx)),
+            (w, bound(mbx * may, mby * max)),
+        ]
+        .map(|(e, err)| {
+            if e > err {
+                1
+            } else if e < -err {
+                -1
+            } else {
+                0
+            }
+        });
+        if clear.contains(&1) && clear.contains(&-1) {
+            return None;
+        }
+        let det = u + v + w;
+        if clear.contains(&0) || det == 0.0 || !det.is_finite() {
+            // Too close to an edge (or over- or underflowing) for f64: decide exactly. Exact
+            // edge tests are watertight too, and the same for every triangle sharing the edge.
+            if !self.inside_exactly(ray) {
+                return None;
+            }
+        }
+        // The decision is watertight; `t` comes from the plane equation, as the course computes
+        // it for quads (`(D - n.O) / n.d` with the unit normal): the sheared-space formula
+        // `(u a_z + v b_z + w c_z) / det` loses all relative accuracy when the origin is very
+        // near the plane, where this one keeps it.
+        let t = (self.normal.dot(self.a) - self.normal.dot(ray.origin)) / self.normal.dot(d);
+        if !t.is_finite() {
+            return None;
+        }
+        let (beta, gamma) = if det != 0.0 && det.is_finite() {
+            (v / det, w / det)
+        } else {
+            (0.0, 0.0)
+        };
+        Some((t, beta, gamma))
     }
-    let det = u + v + w;
-    if det == 0.0 || !det.is_finite() {
-        return None;
+
+    /// Whether the ray's line meets the closed triangle, decided exactly (big integers behind
+    /// an interval filter, see [`crate::oracle::exact`]).
+    #[cold]
+    fn inside_exactly(&self, ray: &Ray) -> bool {
+        use crate::oracle::band::Iv;
+        use crate::oracle::exact::{Dyadic, plane_decide};
+        let finite = |v: DVec3| super::is_finite(v);
+        let all_finite = [self.a, self.b, self.c, ray.origin, ray.direction]
+            .into_iter()
+            .all(finite);
+        if !all_finite {
+            return false;
+        }
+        let spec = crate::oracle::vectors::RaySpec {
+            origin: ray.origin.to_array(),
+            direction: ray.direction.to_array(),
+        };
+        let all = [f64::NEG_INFINITY, f64::INFINITY];
+        let (a, b, c) = (self.a.to_array(), self.b.to_array(), self.c.to_array());
+        let decided = plane_decide::<Iv>(a, b, c, true, &spec, all)
+            .or_else(|| plane_decide::<Dyadic>(a, b, c, true, &spec, all));
+        matches!(decided, Some((crate::oracle::exact::Decision::PlaneHit, _)))
     }
-    let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
-    let t = (u * az + v * bz + w * cz) / det;
-    if !interval.contains(t) {
-        return None;
-    }
-    Some((t, v / det, w / det))
 }
 
 impl Shape for Triangle {
@@ -202,85 +242,5 @@ mod tests {
         let hit = tri().intersect(&ray, Interval::CAMERA).unwrap();
         assert!(!hit.front_face);
         assert_eq!(hit.normal, DVec3::new(0.0, 0.0, -1.0));
-    }
-
-    /// A small deterministic generator for the tests (SplitMix64), uniform in `[lo, hi)`.
-    struct Gen(u64);
-    impl Gen {
-        fn next(&mut self, lo: f64, hi: f64) -> f64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^= z >> 31;
-            lo + (hi - lo) * ((z >> 11) as f64 / (1u64 << 53) as f64)
-        }
-        fn vec(&mut self, lo: f64, hi: f64) -> DVec3 {
-            DVec3::new(self.next(lo, hi), self.next(lo, hi), self.next(lo, hi))
-        }
-    }
-
-    fn close(a: f64, b: f64, tol: f64) -> bool {
-        (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
-    }
-
-    /// A ray aimed at `a + beta (b - a) + gamma (c - a)` hits there at t = 1 with barycentrics
-    /// `(beta, gamma)`, from either side.
-    #[test]
-    fn aimed_rays_hit_where_they_are_aimed() {
-        let mut g = Gen(3);
-        for _ in 0..10_000 {
-            let t = Triangle::new(g.vec(-10.0, 10.0), g.vec(-10.0, 10.0), g.vec(-10.0, 10.0));
-            if !t.normal.is_finite() {
-                continue;
-            }
-            let (mut beta, mut gamma) = (g.next(0.01, 0.98), g.next(0.01, 0.98));
-            if beta + gamma > 0.99 {
-                (beta, gamma) = (0.99 - beta, 0.99 - gamma);
-            }
-            let p = t.a + beta * (t.b - t.a) + gamma * (t.c - t.a);
-            let side = if g.next(0.0, 1.0) < 0.5 { 1.0 } else { -1.0 };
-            let origin = p + (t.normal * side + g.vec(-0.5, 0.5)) * g.next(0.5, 20.0);
-            let ray = Ray::new(origin, p - origin);
-            if t.normal.dot(ray.direction).abs() < 1e-2 * ray.direction.length() {
-                continue;
-            }
-            let hit = t.intersect(&ray, Interval::CAMERA).unwrap();
-            assert!(close(hit.t, 1.0, 1e-8), "{}", hit.t);
-            assert!(
-                close(hit.uv.0, beta, 1e-6) && close(hit.uv.1, gamma, 1e-6),
-                "{:?} vs ({beta}, {gamma})",
-                hit.uv
-            );
-        }
-    }
-
-    /// Two coplanar triangles sharing an edge: a ray through any point of the edge hits at least
-    /// one of them (watertightness), from random origins on both sides.
-    #[test]
-    fn rays_through_a_shared_edge_hit_one_of_the_triangles() {
-        let mut g = Gen(4);
-        for _ in 0..2_000 {
-            let (p, q) = (g.vec(-5.0, 5.0), g.vec(-5.0, 5.0));
-            let first = Triangle::new(p, q, g.vec(-5.0, 5.0));
-            // The other apex across the edge, in the same plane (two faces of a fold seen from
-            // outside can both project to one side of the edge: a ray grazing the fold can then
-            // rightly pass beside both).
-            let across = first.a + first.b - first.c + (first.b - first.a) * g.next(-0.5, 0.5);
-            let second = Triangle::new(q, p, across);
-            for _ in 0..20 {
-                let s = g.next(0.001, 0.999);
-                let on_edge = p + s * (q - p);
-                let origin = on_edge + g.vec(-10.0, 10.0);
-                let ray = Ray::new(origin, on_edge - origin);
-                let hits = first
-                    .intersect(&ray, Interval::new(0.0, f64::MAX))
-                    .is_some()
-                    || second
-                        .intersect(&ray, Interval::new(0.0, f64::MAX))
-                        .is_some();
-                assert!(hits, "a ray through {on_edge} fell between the triangles");
-            }
-        }
     }
 }

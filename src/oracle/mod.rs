@@ -1,7 +1,19 @@
-//! The intersection oracle: the language-agnostic vector format (more to come: exact decisions,
-//! error bands, edge-case generators).
+//! The intersection oracle: exact decisions ([`exact`]), the error bands of the course's naive
+//! formulas ([`band`]), the classification of a case ([`classify`]), edge-case generators
+//! ([`generate`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
+//! transcriptions of the course's code ([`variants`]), fuzzing entry points ([`fuzzing`]), the
+//! benchmark ([`bench`]) and the language-agnostic vector format ([`vectors`]).
 
+pub mod band;
+pub mod bench;
+pub mod classify;
+pub mod exact;
+pub mod explain;
+pub mod fuzzing;
+pub mod generate;
 pub mod suite;
+pub mod variants;
 pub mod vectors;
 
+pub use classify::{analyse, classify, classify_tagged};
 pub use suite::default_suite;

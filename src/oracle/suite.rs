@@ -1,79 +1,79 @@
-//! The built-in vector suite.
-//!
-//! Placeholder until the generators land: a handful of hand-checked cases, so that code which
-//! consumes a suite (checking, grading) can be written against this function's signature.
+//! The built-in vector suite: [`DEFAULT_COUNT`] generated cases for a seed.
 
-use super::vectors::{Case, Class, Expect, RaySpec, ShapeSpec};
+use super::generate::generate;
+use super::vectors::{Case, ShapeKind};
+
+/// The number of cases of the default suite.
+pub const DEFAULT_COUNT: usize = 4000;
 
 /// The default suite for `seed`: every case `rtoracle check` runs when no vector file is given.
+/// The same seed always gives the same cases, bit for bit, with stable ids.
 pub fn default_suite(seed: u64) -> Vec<Case> {
-    let _ = seed;
-    let expect = |class, t: Option<f64>, normal: Option<[f64; 3]>| Expect {
-        class,
-        tags: vec![],
-        t,
-        t_tol: t.map(|t| 1e-9 * t),
-        point: None,
-        normal,
-        front_face: t.map(|_| true),
-    };
-    let down = RaySpec {
-        origin: [0.0, 0.0, 5.0],
-        direction: [0.0, 0.0, -1.0],
-    };
-    vec![
-        Case {
-            id: "sphere-basic-0000".into(),
-            shape: ShapeSpec::Sphere {
-                center: [0.0, 0.0, 0.0],
-                radius: 1.0,
-            },
-            ray: down,
-            interval: [1e-6, f64::MAX],
-            expect: expect(Class::Hit, Some(4.0), Some([0.0, 0.0, 1.0])),
-        },
-        Case {
-            id: "sphere-basic-0001".into(),
-            shape: ShapeSpec::Sphere {
-                center: [3.0, 0.0, 0.0],
-                radius: 1.0,
-            },
-            ray: down,
-            interval: [1e-6, f64::MAX],
-            expect: expect(Class::Miss, None, None),
-        },
-        Case {
-            id: "quad-basic-0000".into(),
-            shape: ShapeSpec::Quad {
-                q: [-1.0, -1.0, 0.0],
-                u: [2.0, 0.0, 0.0],
-                v: [0.0, 2.0, 0.0],
-            },
-            ray: down,
-            interval: [1e-6, f64::MAX],
-            expect: expect(Class::Hit, Some(5.0), Some([0.0, 0.0, 1.0])),
-        },
-        Case {
-            id: "quad-basic-0001".into(),
-            shape: ShapeSpec::Quad {
-                q: [2.0, -1.0, 0.0],
-                u: [2.0, 0.0, 0.0],
-                v: [0.0, 2.0, 0.0],
-            },
-            ray: down,
-            interval: [1e-6, f64::MAX],
-            expect: expect(Class::Miss, None, None),
-        },
-        Case {
-            id: "triangle-basic-0000".into(),
-            shape: ShapeSpec::Triangle {
-                a: [-1.0, -1.0, 0.0],
-                b: [1.0, -1.0, 0.0],
-                c: [0.0, 1.0, 0.0],
-            },
-            ray: down,
-            interval: [1e-6, f64::MAX],
-            expect: expect(Class::Hit, Some(5.0), Some([0.0, 0.0, 1.0])),
-        },
-    ]
+    generate(seed, DEFAULT_COUNT, &ShapeKind::ALL)
+}
+
+/// Every tag `ORACLE.md` names; the default suite holds each.
+pub const ORACLE_TAGS: [&str; 13] = [
+    "tangent",
+    "near-tangent",
+    "edge",
+    "corner",
+    "parallel",
+    "degenerate",
+    "grazing",
+    "interval-boundary",
+    "inside",
+    "behind",
+    "negative-radius",
+    "scale",
+    "nonfinite",
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::oracle::vectors::Class;
+    use std::collections::BTreeMap;
+
+    #[test]
+    fn default_suite_meets_the_issue_figures_and_is_stable() {
+        let suite = default_suite(0);
+        assert!(suite.len() >= 3000);
+        let mut by: BTreeMap<(String, Class), usize> = BTreeMap::new();
+        for c in &suite {
+            *by.entry((c.shape.kind().to_string(), c.expect.class))
+                .or_default() += 1;
+        }
+        eprintln!("{by:?}");
+        for tag in ORACLE_TAGS {
+            assert!(
+                suite.iter().any(|c| c.expect.tags.iter().any(|t| t == tag)),
+                "no case tagged {tag}"
+            );
+        }
+        let definite_sq = suite
+            .iter()
+            .filter(|c| c.expect.class.is_definite() && c.shape.kind() != ShapeKind::Triangle)
+            .count();
+        assert!(
+            definite_sq >= 1000,
+            "{definite_sq} definite sphere and quad cases"
+        );
+        let loose = suite
+            .iter()
+            .filter(|c| !c.expect.class.is_definite())
+            .count();
+        assert!(
+            loose * 100 <= 35 * suite.len(),
+            "{loose} of {} ambiguous or any",
+            suite.len()
+        );
+        let mut ids: Vec<&str> = suite.iter().map(|c| c.id.as_str()).collect();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), suite.len(), "ids are unique");
+        // Same seed, same cases; another seed, other cases.
+        assert_eq!(default_suite(0)[..50], suite[..50]);
+        assert_ne!(default_suite(1)[..50], suite[..50]);
+    }
 }

@@ -11,7 +11,7 @@
 use glam::DVec3;
 
 use crate::geometry::{Interval, Quad, Ray};
-use crate::geometry::{Shear, pick_root, roots_of, solve_sheared};
+use crate::geometry::{Shape, Sphere, Triangle, pick_root, roots_of};
 use crate::scene::{Object, Scene};
 
 /// The sphere pre-filter's margin, relative to `a (f . f + r2)`.
@@ -33,6 +33,8 @@ const SANE_MAX: f64 = 1e100;
 /// A sphere's origin-dependent constants.
 #[derive(Clone, Copy, Debug)]
 struct PreparedSphere {
+    /// The sphere itself, for the rare rays whose intermediates over- or underflow.
+    sphere: Sphere,
     /// `origin - center`.
     f: DVec3,
     /// `radius^2`.
@@ -45,11 +47,12 @@ struct PreparedSphere {
 }
 
 impl PreparedSphere {
-    fn new(sphere: &crate::geometry::Sphere, origin: DVec3) -> Self {
+    fn new(sphere: &Sphere, origin: DVec3) -> Self {
         let f = origin - sphere.center;
         let r2 = sphere.radius * sphere.radius;
         let scale = f.dot(f) + r2;
         Self {
+            sphere: *sphere,
             f,
             r2,
             c: f.dot(f) - r2,
@@ -64,13 +67,23 @@ impl PreparedSphere {
     /// The sphere's hit along `d` within `within`, given `a = d . d` and
     /// `a_margin = a * PREFILTER_MARGIN` (or NaN).
     #[inline(always)]
-    fn hit_t(&self, d: DVec3, a: f64, a_margin: f64, within: Interval) -> Option<f64> {
+    fn hit_t(
+        &self,
+        origin: DVec3,
+        d: DVec3,
+        a: f64,
+        a_margin: f64,
+        within: Interval,
+    ) -> Option<f64> {
         let half_b = self.f.dot(d);
         if half_b * half_b - a * self.c < -(a_margin * self.scale) {
             // A sure miss: see the pre-filter's note above.
-            None
-        } else {
-            roots_of(self.f, d, a, self.r2, || self.c).and_then(|roots| pick_root(roots, within))
+            return None;
+        }
+        match roots_of(self.f, d, a, half_b, self.r2, self.c) {
+            Ok(roots) => roots.and_then(|roots| pick_root(roots, within)),
+            // Over- or underflow: the sphere's own path rescales.
+            Err(()) => self.sphere.hit_t(&Ray::new(origin, d), within),
         }
     }
 }
@@ -84,14 +97,8 @@ enum Prepared {
         /// `quad.d - quad.normal . origin`.
         offset: f64,
     },
-    Triangle {
-        /// The vertices minus the origin.
-        a: DVec3,
-        b: DVec3,
-        c: DVec3,
-        /// The triangle has a finite normal (a degenerate one is never hit).
-        usable: bool,
-    },
+    /// Triangles take their own (watertight, exactly-decided near edges) path.
+    Triangle(Triangle),
 }
 
 /// The objects, with the common cases of a scene of one kind stored without the enum, so the
@@ -109,7 +116,6 @@ enum Layout {
 pub(crate) struct FixedOrigin {
     origin: DVec3,
     layout: Layout,
-    has_triangles: bool,
 }
 
 impl FixedOrigin {
@@ -124,17 +130,9 @@ impl FixedOrigin {
                     quad,
                     offset: quad.plane_offset(origin),
                 },
-                Object::Triangle(t) => Prepared::Triangle {
-                    a: t.a - origin,
-                    b: t.b - origin,
-                    c: t.c - origin,
-                    usable: t.normal.is_finite(),
-                },
+                Object::Triangle(t) => Prepared::Triangle(t),
             })
             .collect();
-        let has_triangles = objects
-            .iter()
-            .any(|o| matches!(o, Prepared::Triangle { .. }));
         let layout = if objects.iter().all(|o| matches!(o, Prepared::Sphere(_))) {
             Layout::Spheres(
                 objects
@@ -158,11 +156,7 @@ impl FixedOrigin {
         } else {
             Layout::Mixed(objects)
         };
-        Self {
-            origin,
-            layout,
-            has_triangles,
-        }
+        Self { origin, layout }
     }
 
     /// The origin every ray leaves from.
@@ -178,7 +172,7 @@ impl FixedOrigin {
         // Each layout has its own loop; the two homogeneous ones are inlined into the sample
         // loop, the mixed one is not (measured on the course's scenes).
         match &self.layout {
-            Layout::Spheres(spheres) => Self::closest_sphere(spheres, d, interval),
+            Layout::Spheres(spheres) => Self::closest_sphere(self.origin, spheres, d, interval),
             Layout::Quads(quads) => self.closest_quad(quads, d, interval),
             Layout::Mixed(objects) => self.closest_mixed(objects, d, interval),
         }
@@ -197,6 +191,7 @@ impl FixedOrigin {
 
     #[inline(always)]
     fn closest_sphere(
+        origin: DVec3,
         spheres: &[PreparedSphere],
         d: DVec3,
         interval: Interval,
@@ -207,7 +202,7 @@ impl FixedOrigin {
         let mut closest = interval.max;
         for (index, sphere) in spheres.iter().enumerate() {
             let within = Interval::new(interval.min, closest);
-            if let Some(t) = sphere.hit_t(d, a, a_margin, within) {
+            if let Some(t) = sphere.hit_t(origin, d, a, a_margin, within) {
                 closest = t;
                 best = Some((t, index));
             }
@@ -245,26 +240,16 @@ impl FixedOrigin {
         let ray = Ray::new(self.origin, d);
         let a = d.dot(d);
         let a_margin = Self::margin(a);
-        let shear = if self.has_triangles {
-            Shear::of(d)
-        } else {
-            None
-        };
         let mut best = None;
         let mut closest = interval.max;
         for (index, object) in objects.iter().enumerate() {
             let within = Interval::new(interval.min, closest);
             let t = match *object {
-                Prepared::Sphere(ref sphere) => sphere.hit_t(d, a, a_margin, within),
+                Prepared::Sphere(ref sphere) => sphere.hit_t(self.origin, d, a, a_margin, within),
                 Prepared::Quad { ref quad, offset } => {
                     quad.solve_from(&ray, offset, within).map(|(t, _, _)| t)
                 }
-                Prepared::Triangle { a, b, c, usable } => match shear {
-                    Some(ref shear) if usable => {
-                        solve_sheared(a, b, c, shear, within).map(|(t, _, _)| t)
-                    }
-                    _ => None,
-                },
+                Prepared::Triangle(ref triangle) => triangle.hit_t(&ray, within),
             };
             if let Some(t) = t {
                 closest = t;

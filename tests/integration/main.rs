@@ -5,4 +5,6 @@ mod common;
 mod compare;
 mod golden;
 mod grade;
+mod oracle;
+mod oracle_props;
 mod render;

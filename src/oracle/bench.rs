@@ -1,0 +1,240 @@
+//! The oracle's benchmark (`rtoracle bench oracle`, `cargo bench --bench oracle`): the
+//! reference against the exact oracle on random cases across scales and distances, the naive
+//! course formula's wrong decisions near the silhouette of far spheres, the classification rate
+//! and the suite's generation time, each beside a baseline measured in the same run.
+
+use std::fmt::Write;
+use std::time::Instant;
+
+use super::classify::{analyse, classify};
+use super::exact::{self, Decision};
+use super::generate::{CAMERA, Stream, random_plane, random_sphere};
+use super::suite::default_suite;
+use super::variants::honest;
+use super::vectors::{Class, ShapeKind, ShapeSpec};
+use crate::geometry::{Interval, Shape};
+
+/// What to run.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Random sphere cases for the agreement figure (10^6 in the issue).
+    pub sphere_cases: usize,
+    /// Random quad and triangle cases (each).
+    pub plane_cases: usize,
+    /// Near-silhouette rays per distance.
+    pub silhouette_cases: usize,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            sphere_cases: 1_000_000,
+            plane_cases: 200_000,
+            silhouette_cases: 100_000,
+            seed: 1,
+        }
+    }
+}
+
+/// Reference-versus-exact figures over random cases.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Agreement {
+    /// Cases run.
+    pub cases: usize,
+    /// Definite cases among them.
+    pub definite: usize,
+    /// Definite cases where the reference's decision differs from the exact one.
+    pub wrong: usize,
+    /// Largest `|t_ref - t_exact| / |t_exact|` over definite hits.
+    pub max_rel_t: f64,
+    /// Cases the interval filter decided without big integers.
+    pub by_filter: usize,
+    /// Definite cases where the course's naive formula decides differently from the exact one.
+    pub naive_wrong: usize,
+}
+
+/// Runs the reference and the oracle on `n` random cases of `kind`.
+pub fn agreement(kind: ShapeKind, n: usize, seed: u64) -> Agreement {
+    let mut r = Stream::new(seed, &format!("bench-{kind}"));
+    let naive = honest()
+        .into_iter()
+        .find(|v| v.shape == kind)
+        .expect("an honest variant per shape");
+    let mut a = Agreement::default();
+    for _ in 0..n {
+        let c = match kind {
+            ShapeKind::Sphere => random_sphere(&mut r, 1e8, None),
+            ShapeKind::Quad => random_plane(&mut r, false),
+            ShapeKind::Triangle => random_plane(&mut r, true),
+        };
+        a.cases += 1;
+        let an = analyse(&c.shape, &c.ray, c.interval);
+        a.by_filter += usize::from(an.by_filter);
+        if !an.class.is_definite() {
+            continue;
+        }
+        a.definite += 1;
+        let hit = c
+            .shape
+            .object()
+            .intersect(&c.ray.ray(), Interval::new(c.interval[0], c.interval[1]));
+        let exact_hit = an.class == Class::Hit;
+        if hit.is_some() != exact_hit {
+            a.wrong += 1;
+        }
+        if let (Some(h), Some(e)) = (hit, an.hit) {
+            let rel = ((h.t - e.t) / e.t).abs();
+            a.max_rel_t = a.max_rel_t.max(rel);
+        }
+        let n = (naive.run)(&c.shape, &c.ray, c.interval);
+        if matches!(n, Ok(Some(_))) != exact_hit {
+            a.naive_wrong += 1;
+        }
+    }
+    a
+}
+
+/// Wrong-decision shares on near-silhouette rays at `ratio` radii: `(naive, reference)`, as
+/// fractions of all the rays (the exact decision is the truth; no band is applied).
+pub fn silhouette(ratio: f64, n: usize, seed: u64) -> (f64, f64, usize) {
+    let mut r = Stream::new(seed, &format!("silhouette-{ratio}"));
+    let naive = honest()[0];
+    let (mut nw, mut rw) = (0usize, 0usize);
+    for _ in 0..n {
+        let c = silhouette_case(&mut r, ratio);
+        let (decision, _) = exact::decide(&c.shape, &c.ray, CAMERA);
+        let exact_hit = matches!(decision, Decision::SphereHit(_));
+        let n_hit = matches!((naive.run)(&c.shape, &c.ray, CAMERA), Ok(Some(_)));
+        let r_hit = c
+            .shape
+            .object()
+            .intersect(&c.ray.ray(), Interval::CAMERA)
+            .is_some();
+        nw += usize::from(n_hit != exact_hit);
+        rw += usize::from(r_hit != exact_hit);
+    }
+    (nw as f64 / n as f64, rw as f64 / n as f64, n)
+}
+
+/// A sphere at a log-uniform scale seen from exactly `ratio` radii, the ray aimed at a point
+/// `0.9 .. 1.1` radii from the centre, perpendicular to the line of sight.
+pub fn silhouette_case(r: &mut Stream, ratio: f64) -> super::generate::Raw {
+    use super::generate::{add, cross, dot, raw_parts, scale, sub};
+    let s = r.log_scale(-20.0, 20.0);
+    let radius = s * r.uniform(0.5, 2.0);
+    let center = scale(r.unit(), s * r.uniform(0.0, 8.0));
+    let from = r.unit();
+    let origin = add(center, scale(from, ratio * radius));
+    let mut p = cross(from, r.unit());
+    p = scale(p, 1.0 / dot(p, p).sqrt());
+    let target = add(center, scale(p, radius * r.uniform(0.9, 1.1)));
+    raw_parts(
+        ShapeSpec::Sphere { center, radius },
+        origin,
+        sub(target, origin),
+        CAMERA,
+    )
+}
+
+/// Runs the benchmark and returns its report.
+pub fn run(opts: Options) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "rtoracle bench oracle (seed {})", opts.seed);
+    let _ = writeln!(
+        s,
+        "\n1. reference vs exact on random cases (scales 2^-20..2^20, spheres seen from up to 1e8 radii)"
+    );
+    let _ = writeln!(
+        s,
+        "   {:<9} {:>9} {:>9} {:>11} {:>13} {:>10} {:>13}",
+        "shape", "cases", "definite", "ref wrong", "max rel t err", "filter", "naive wrong"
+    );
+    for (kind, n) in [
+        (ShapeKind::Sphere, opts.sphere_cases),
+        (ShapeKind::Quad, opts.plane_cases),
+        (ShapeKind::Triangle, opts.plane_cases),
+    ] {
+        if n == 0 {
+            continue;
+        }
+        let a = agreement(kind, n, opts.seed);
+        let _ = writeln!(
+            s,
+            "   {:<9} {:>9} {:>9} {:>11} {:>13.2e} {:>9.2}% {:>13}",
+            kind.name(),
+            a.cases,
+            a.definite,
+            a.wrong,
+            a.max_rel_t,
+            100.0 * a.by_filter as f64 / a.cases as f64,
+            a.naive_wrong
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n2. wrong decisions on near-silhouette rays (aimed 0.9..1.1 radii from the centre), against the exact answer"
+    );
+    let _ = writeln!(
+        s,
+        "   {:<16} {:>8} {:>22} {:>22}",
+        "distance/radius", "rays", "naive course formula", "reference (RTG ch. 7)"
+    );
+    for ratio in [1e7, 1e8] {
+        let (nw, rw, n) = silhouette(ratio, opts.silhouette_cases, opts.seed);
+        let _ = writeln!(
+            s,
+            "   {:<16e} {:>8} {:>21.2}% {:>21.2}%",
+            ratio,
+            n,
+            100.0 * nw,
+            100.0 * rw
+        );
+    }
+    // 3. Classification rate against the naive course formula on the same vectors.
+    let t0 = Instant::now();
+    let suite = default_suite(opts.seed);
+    let gen_s = t0.elapsed().as_secs_f64();
+    let passes = 5;
+    let t0 = Instant::now();
+    let mut n_hit = 0usize;
+    for _ in 0..passes {
+        for c in &suite {
+            n_hit += usize::from(classify(&c.shape, &c.ray, c.interval).class == Class::Hit);
+        }
+    }
+    let classify_s = t0.elapsed().as_secs_f64();
+    let variants = honest();
+    let t0 = Instant::now();
+    let mut n_naive = 0usize;
+    for _ in 0..passes {
+        for c in &suite {
+            let v = variants
+                .iter()
+                .find(|v| v.shape == c.shape.kind())
+                .expect("variant");
+            n_naive += usize::from(matches!((v.run)(&c.shape, &c.ray, c.interval), Ok(Some(_))));
+        }
+    }
+    let naive_s = t0.elapsed().as_secs_f64().max(1e-9);
+    let rate = (passes * suite.len()) as f64 / classify_s;
+    let naive_rate = (passes * suite.len()) as f64 / naive_s;
+    let _ = writeln!(s, "\n3. speed (one thread)");
+    let _ = writeln!(
+        s,
+        "   classification: {:.0} vectors/s ({} vectors x {passes}); the naive course formula alone: {:.0}/s; ratio {:.1}x",
+        rate,
+        suite.len(),
+        naive_rate,
+        naive_rate / rate
+    );
+    let _ = writeln!(
+        s,
+        "   default suite ({} vectors) generated and classified in {:.3} s",
+        suite.len(),
+        gen_s
+    );
+    let _ = (n_hit, n_naive);
+    s
+}

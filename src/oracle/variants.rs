@@ -1,0 +1,463 @@
+//! Rust transcriptions of the course's intersection code: the naive formulas, each honest
+//! variant `COURSE_API.md` lists, and a catalogue of buggy ones.
+//!
+//! They follow Python's float semantics: a float division by zero raises (here
+//! [`Answer::Err`]), comparisons with NaN are false, and nothing is fused. The fairness tests
+//! require every honest variant to pass every definite vector, and the power tests require every
+//! buggy variant to fail at least one; [`judge`] is the rule both use, and the checking code can
+//! reuse it.
+
+use super::generate::{add, cross, dot, scale, sub};
+use super::vectors::{Class, Expect, RaySpec, ShapeKind, ShapeSpec};
+use crate::geometry::Shape;
+
+/// A hit as a variant reports it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VHit {
+    /// The ray parameter.
+    pub t: f64,
+    /// The normal facing the ray.
+    pub normal: [f64; 3],
+    /// Whether the ray arrives from the outside.
+    pub front_face: bool,
+}
+
+/// A variant's answer: a hit, a miss (`None`), or a raised error (Python's `ZeroDivisionError`).
+pub type Answer = Result<Option<VHit>, &'static str>;
+
+/// One transcription.
+#[derive(Clone, Copy)]
+pub struct Variant {
+    /// A short name (`"sphere-course"`, `"quad-no-parallel-test"`, ...).
+    pub name: &'static str,
+    /// The shape it intersects.
+    pub shape: ShapeKind,
+    /// Whether a fair grader must accept it.
+    pub honest: bool,
+    /// The intersection routine.
+    pub run: fn(&ShapeSpec, &RaySpec, [f64; 2]) -> Answer,
+}
+
+impl std::fmt::Debug for Variant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+/// Whether `answer` is right for a definite `expect` (`Ok`), or why not. Non-definite classes
+/// accept anything.
+pub fn judge(expect: &Expect, answer: &Answer) -> Result<(), String> {
+    match (expect.class, answer) {
+        (Class::Ambiguous | Class::Any, _) => Ok(()),
+        (_, Err(e)) => Err(format!("raised {e}")),
+        (Class::Miss, Ok(None)) => Ok(()),
+        (Class::Miss, Ok(Some(h))) => Err(format!("hit at t = {} where the ray misses", h.t)),
+        (Class::Hit, Ok(None)) => Err("missed where the ray hits".into()),
+        (Class::Hit, Ok(Some(h))) => {
+            let (t, tol) = (expect.t.unwrap_or(f64::NAN), expect.t_tol.unwrap_or(0.0));
+            if (h.t - t).abs().is_nan() || (h.t - t).abs() > tol {
+                return Err(format!("t = {} but expected {t} +- {tol:e}", h.t));
+            }
+            if let Some(n) = expect.normal {
+                let off = (0..3)
+                    .map(|i| (h.normal[i] - n[i]).abs())
+                    .fold(0.0, f64::max);
+                if h.normal.iter().any(|x| !x.is_finite()) || off > 1e-6 {
+                    return Err(format!("normal {:?} but expected {n:?}", h.normal));
+                }
+            }
+            if expect.front_face.is_some_and(|f| f != h.front_face) {
+                return Err(format!("front_face = {} is wrong", h.front_face));
+            }
+            Ok(())
+        }
+    }
+}
+
+fn div(a: f64, b: f64) -> Result<f64, &'static str> {
+    if b == 0.0 {
+        Err("ZeroDivisionError")
+    } else {
+        Ok(a / b)
+    }
+}
+
+fn vdiv(v: [f64; 3], s: f64) -> Result<[f64; 3], &'static str> {
+    Ok([div(v[0], s)?, div(v[1], s)?, div(v[2], s)?])
+}
+
+fn unit(v: [f64; 3]) -> Result<[f64; 3], &'static str> {
+    vdiv(v, dot(v, v).sqrt())
+}
+
+fn face(d: [f64; 3], outward: [f64; 3], t: f64, reversed: bool) -> VHit {
+    let mut front_face = dot(d, outward) < 0.0;
+    let normal = if front_face {
+        outward
+    } else {
+        outward.map(|x| -x)
+    };
+    if reversed {
+        front_face = !front_face;
+    }
+    VHit {
+        t,
+        normal,
+        front_face,
+    }
+}
+
+/// Knobs of the sphere transcription.
+#[derive(Clone, Copy, Default)]
+struct SphereOpts {
+    closed: bool,
+    disc_le: bool,
+    full_b: bool,
+    normalise: bool,
+    far_first: bool,
+    no_interval: bool,
+    raw_normal: bool,
+    abs_radius: bool,
+    r_not_squared: bool,
+    b_sign: bool,
+    no_a_in_disc: bool,
+    front_reversed: bool,
+}
+
+fn sphere_with(o: SphereOpts, shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let ShapeSpec::Sphere { center, radius } = *shape else {
+        return Ok(None);
+    };
+    let (orig, mut d) = (ray.origin, ray.direction);
+    let len = dot(d, d).sqrt();
+    if o.normalise {
+        d = unit(d)?;
+    }
+    let oc = sub(orig, center);
+    let a = dot(d, d);
+    let r2 = if o.r_not_squared {
+        radius
+    } else {
+        radius * radius
+    };
+    let c = dot(oc, oc) - r2;
+    let (half_b, disc) = if o.full_b {
+        let b = 2.0 * dot(oc, d);
+        (b, b * b - 4.0 * a * c)
+    } else {
+        let hb = dot(oc, d);
+        let disc = if o.no_a_in_disc {
+            hb * hb - c
+        } else {
+            hb * hb - a * c
+        };
+        (hb, disc)
+    };
+    if disc < 0.0 || (o.disc_le && disc <= 0.0) {
+        return Ok(None);
+    }
+    let sq = disc.sqrt();
+    let den = if o.full_b { 2.0 * a } else { a };
+    let hb = if o.b_sign { -half_b } else { half_b };
+    let mut roots = [div(-hb - sq, den)?, div(-hb + sq, den)?];
+    if o.far_first {
+        roots.swap(0, 1);
+    }
+    let to_t = |t: f64| if o.normalise { t / len } else { t };
+    let inside = |t: f64| {
+        o.no_interval
+            || if o.closed {
+                iv[0] <= t && t <= iv[1]
+            } else {
+                iv[0] < t && t < iv[1]
+            }
+    };
+    let Some(root) = roots.into_iter().map(to_t).find(|&t| inside(t)) else {
+        return Ok(None);
+    };
+    let p = add(orig, scale(ray.direction, root));
+    let outward = if o.raw_normal {
+        sub(p, center)
+    } else if o.abs_radius {
+        vdiv(sub(p, center), radius.abs())?
+    } else {
+        vdiv(sub(p, center), radius)?
+    };
+    Ok(Some(face(ray.direction, outward, root, o.front_reversed)))
+}
+
+/// Knobs of the quad / course-style triangle transcription.
+#[derive(Clone, Copy, Default)]
+struct QuadOpts {
+    triangle: bool,
+    open_interval: bool,
+    strict_edges: bool,
+    exact_zero: bool,
+    normalise: bool,
+    alpha_sign: bool,
+    w_is_normal: bool,
+    no_parallel: bool,
+    wrong_d: bool,
+    front_reversed: bool,
+    no_interval: bool,
+    no_third_edge: bool,
+    swap_uv_in_beta: bool,
+}
+
+fn quad_with(o: QuadOpts, shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let (q, u, v) = match *shape {
+        ShapeSpec::Quad { q, u, v } => (q, u, v),
+        ShapeSpec::Triangle { a, b, c } => (a, sub(b, a), sub(c, a)),
+        _ => return Ok(None),
+    };
+    // The constructor.
+    let uxv = cross(u, v);
+    let normal = unit(uxv)?;
+    let big_d = if o.wrong_d {
+        dot(uxv, q)
+    } else {
+        dot(normal, q)
+    };
+    let w = if o.w_is_normal {
+        normal
+    } else {
+        vdiv(uxv, dot(uxv, uxv))?
+    };
+    // intersect
+    let (orig, mut d) = (ray.origin, ray.direction);
+    let len = dot(d, d).sqrt();
+    if o.normalise {
+        d = unit(d)?;
+    }
+    let denom = dot(normal, d);
+    if !o.no_parallel
+        && (if o.exact_zero {
+            denom == 0.0
+        } else {
+            denom.abs() < 1e-8
+        })
+    {
+        return Ok(None);
+    }
+    let mut t = div(big_d - dot(normal, orig), denom)?;
+    if o.normalise {
+        t /= len;
+    }
+    let in_iv = if o.open_interval {
+        iv[0] < t && t < iv[1]
+    } else {
+        iv[0] <= t && t <= iv[1]
+    };
+    if !o.no_interval && !in_iv {
+        return Ok(None);
+    }
+    let p = sub(add(orig, scale(ray.direction, t)), q);
+    let alpha = if o.alpha_sign {
+        dot(w, cross(v, p))
+    } else {
+        dot(w, cross(p, v))
+    };
+    let beta = if o.swap_uv_in_beta {
+        dot(w, cross(p, u))
+    } else {
+        dot(w, cross(u, p))
+    };
+    let within = |x: f64| {
+        if o.strict_edges {
+            0.0 < x && x < 1.0
+        } else {
+            (0.0..=1.0).contains(&x)
+        }
+    };
+    let interior = if o.triangle && !o.no_third_edge {
+        let ge = |x: f64| if o.strict_edges { x > 0.0 } else { x >= 0.0 };
+        let s = alpha + beta;
+        ge(alpha) && ge(beta) && (if o.strict_edges { s < 1.0 } else { s <= 1.0 })
+    } else {
+        within(alpha) && within(beta)
+    };
+    if !interior {
+        return Ok(None);
+    }
+    Ok(Some(face(ray.direction, normal, t, o.front_reversed)))
+}
+
+/// Möller–Trumbore without an epsilon (`det == 0` is a miss), closed edges and interval.
+fn moller_trumbore(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let ShapeSpec::Triangle { a, b, c } = *shape else {
+        return Ok(None);
+    };
+    let (e1, e2) = (sub(b, a), sub(c, a));
+    let d = ray.direction;
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if det == 0.0 {
+        return Ok(None);
+    }
+    let inv = div(1.0, det)?;
+    let s = sub(ray.origin, a);
+    let bu = dot(s, p) * inv;
+    if !(0.0..=1.0).contains(&bu) {
+        return Ok(None);
+    }
+    let qv = cross(s, e1);
+    let bv = dot(d, qv) * inv;
+    if !(bv >= 0.0 && bu + bv <= 1.0) {
+        return Ok(None);
+    }
+    let t = dot(e2, qv) * inv;
+    if !(iv[0] <= t && t <= iv[1]) {
+        return Ok(None);
+    }
+    Ok(Some(face(d, unit(cross(e1, e2))?, t, false)))
+}
+
+/// The reference tracer (`rtoracle::geometry`).
+fn reference(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let interval = crate::geometry::Interval::new(iv[0], iv[1]);
+    Ok(shape
+        .object()
+        .intersect(&ray.ray(), interval)
+        .map(|h| VHit {
+            t: h.t,
+            normal: h.normal.to_array(),
+            front_face: h.front_face,
+        }))
+}
+
+macro_rules! sphere_variant {
+    ($name:literal, $honest:expr, { $($k:ident),* }) => {
+        Variant {
+            name: $name,
+            shape: ShapeKind::Sphere,
+            honest: $honest,
+            run: |s, r, i| sphere_with(SphereOpts { $($k: true,)* ..Default::default() }, s, r, i),
+        }
+    };
+}
+
+macro_rules! plane_variant {
+    ($name:literal, $kind:expr, $honest:expr, { $($k:ident),* }) => {
+        Variant {
+            name: $name,
+            shape: $kind,
+            honest: $honest,
+            run: |s, r, i| quad_with(QuadOpts { $($k: true,)* ..Default::default() }, s, r, i),
+        }
+    };
+}
+
+/// The honest variants: the course's formulas and every variation a fair grader must accept.
+pub fn honest() -> Vec<Variant> {
+    use ShapeKind::{Quad, Triangle};
+    vec![
+        sphere_variant!("sphere-course", true, {}),
+        sphere_variant!("sphere-closed-interval", true, { closed }),
+        sphere_variant!("sphere-disc-le-zero", true, { disc_le }),
+        sphere_variant!("sphere-full-quadratic", true, { full_b }),
+        sphere_variant!("sphere-normalised-direction", true, { normalise }),
+        sphere_variant!("sphere-full-quadratic-closed", true, { full_b, closed }),
+        Variant {
+            name: "sphere-reference",
+            shape: ShapeKind::Sphere,
+            honest: true,
+            run: reference,
+        },
+        plane_variant!("quad-course", Quad, true, {}),
+        plane_variant!("quad-open-interval", Quad, true, { open_interval }),
+        plane_variant!("quad-strict-edges", Quad, true, { strict_edges }),
+        plane_variant!("quad-denom-eq-zero", Quad, true, { exact_zero }),
+        plane_variant!("quad-normalised-direction", Quad, true, { normalise }),
+        Variant {
+            name: "quad-reference",
+            shape: Quad,
+            honest: true,
+            run: reference,
+        },
+        plane_variant!("triangle-course-style", Triangle, true, { triangle, exact_zero }),
+        plane_variant!("triangle-course-style-strict", Triangle, true, { triangle, exact_zero, strict_edges, open_interval }),
+        Variant {
+            name: "triangle-moller-trumbore",
+            shape: Triangle,
+            honest: true,
+            run: moller_trumbore,
+        },
+        Variant {
+            name: "triangle-reference",
+            shape: Triangle,
+            honest: true,
+            run: reference,
+        },
+    ]
+}
+
+/// The buggy variants: each must fail at least one definite vector of the default suite.
+pub fn buggy() -> Vec<Variant> {
+    use ShapeKind::{Quad, Triangle};
+    vec![
+        sphere_variant!("sphere-far-root-first", false, { far_first }),
+        sphere_variant!("sphere-no-interval-check", false, { no_interval }),
+        sphere_variant!("sphere-unnormalised-normal", false, { raw_normal }),
+        sphere_variant!("sphere-abs-radius-in-normal", false, { abs_radius }),
+        sphere_variant!("sphere-r-instead-of-r-squared", false, { r_not_squared }),
+        sphere_variant!("sphere-sign-error-in-b", false, { b_sign }),
+        sphere_variant!("sphere-disc-without-a", false, { no_a_in_disc }),
+        sphere_variant!("sphere-front-face-reversed", false, { front_reversed }),
+        plane_variant!("quad-sign-error-in-alpha", Quad, false, { alpha_sign }),
+        plane_variant!("quad-w-is-unit-normal", Quad, false, { w_is_normal }),
+        plane_variant!("quad-no-parallel-test", Quad, false, { no_parallel }),
+        plane_variant!("quad-wrong-d", Quad, false, { wrong_d }),
+        plane_variant!("quad-front-face-reversed", Quad, false, { front_reversed }),
+        plane_variant!("quad-no-interval-check", Quad, false, { no_interval }),
+        plane_variant!("quad-u-v-swapped-in-beta", Quad, false, { swap_uv_in_beta }),
+        plane_variant!("triangle-missing-third-edge", Triangle, false, { triangle, exact_zero, no_third_edge }),
+        plane_variant!("triangle-no-parallel-test", Triangle, false, { triangle, no_parallel }),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::oracle::default_suite;
+
+    fn failures(v: &Variant, suite: &[crate::oracle::vectors::Case]) -> Vec<String> {
+        suite
+            .iter()
+            .filter(|c| c.shape.kind() == v.shape && c.expect.class.is_definite())
+            .filter_map(|c| {
+                judge(&c.expect, &(v.run)(&c.shape, &c.ray, c.interval))
+                    .err()
+                    .map(|e| format!("{}: {e}", c.id))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_honest_variant_passes_every_definite_vector() {
+        let suite: Vec<_> = (0..3).flat_map(default_suite).collect();
+        let mut bad = vec![];
+        for v in honest() {
+            let f = failures(&v, &suite);
+            if !f.is_empty() {
+                bad.push(format!(
+                    "{} fails {} vectors, e.g. {:?}",
+                    v.name,
+                    f.len(),
+                    &f[..f.len().min(3)]
+                ));
+            }
+        }
+        assert!(bad.is_empty(), "{bad:#?}");
+    }
+
+    #[test]
+    fn every_buggy_variant_fails_a_definite_vector() {
+        let suite = default_suite(0);
+        let list = buggy();
+        assert!(list.len() >= 12);
+        for v in list {
+            let f = failures(&v, &suite);
+            assert!(!f.is_empty(), "{} passes every definite vector", v.name);
+        }
+    }
+}
