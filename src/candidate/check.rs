@@ -176,7 +176,7 @@ mod tests {
     use super::*;
 
     fn sphere_hit() -> Case {
-        crate::oracle::default_suite(0).remove(0)
+        crate::candidate::test_cases::basic_cases().remove(0)
     }
 
     #[test]

@@ -21,6 +21,8 @@ pub mod protocol;
 pub mod report;
 pub mod rust;
 pub mod shrink;
+#[cfg(test)]
+pub(crate) mod test_cases;
 
 pub use check::{FailureKind, Verdict, judge};
 pub use process::{CandidateCommand, HarnessError, Limits, Outcome, RunOptions, Session};

@@ -358,7 +358,7 @@ mod tests {
 
     #[test]
     fn requests_use_the_vector_number_syntax() {
-        let case = crate::oracle::default_suite(0).remove(0);
+        let case = crate::candidate::test_cases::basic_cases().remove(0);
         let line = Request::for_case(&case).to_line();
         assert!(line.starts_with("{\"id\":\"sphere-basic-0000\",\"op\":\"intersect\""));
         assert!(

@@ -379,7 +379,7 @@ mod tests {
 
     #[test]
     fn counts_add_up_per_group_and_overall() {
-        let cases = crate::oracle::default_suite(0);
+        let cases = crate::candidate::test_cases::basic_cases();
         let mut outcomes: Vec<Outcome> = cases
             .iter()
             .map(|c| Outcome::Answered {

@@ -141,7 +141,7 @@ mod tests {
 
     #[test]
     fn panics_wrong_answers_and_unsupported_shapes_are_reported_by_group() {
-        let suite = crate::oracle::default_suite(0);
+        let suite = crate::candidate::test_cases::basic_cases();
         let report = check_candidate(&mut FarRoot, &suite);
         assert_eq!(report.by_shape[&ShapeKind::Sphere].failed, 1);
         assert_eq!(report.by_shape[&ShapeKind::Sphere].passed, 1);
