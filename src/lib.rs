@@ -15,9 +15,11 @@
 //!   embedded in the library, and their pixel comparison.
 //! - [`oracle`]: the vector format and the exact intersection oracle.
 //! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
-//!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
+//!   JUnit, Markdown), and the Gradescope autograder package.
 //! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
 //!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
+//! - [`sandbox`]: how untrusted code (candidates, students' submissions) is started: a fresh
+//!   folder, a cleared environment, limits, its own process group, no network, never as root.
 #![warn(missing_docs)]
 
 pub mod candidate;
@@ -27,4 +29,5 @@ pub mod grade;
 pub mod image_io;
 pub mod oracle;
 pub mod render;
+pub mod sandbox;
 pub mod scene;

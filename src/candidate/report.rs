@@ -4,14 +4,15 @@
 //! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
 //! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
 //! `errors` counts raised errors, dead processes and protocol errors. `ambiguous` counts the
-//! `ambiguous` and `any` vectors, which are run and reported but never scored.
+//! `ambiguous` and `any` vectors, which are run and reported but never scored; `ambiguous_passed`
+//! counts the `ambiguous` ones answered with the exact answer.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use super::check::{FailureKind, Verdict, judge};
+use super::check::{FailureKind, Verdict, judge, judge_exact};
 use super::process::Outcome;
 use super::protocol::{Answer, CandidateError};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
@@ -33,6 +34,8 @@ pub struct Counts {
     pub not_run: usize,
     /// `ambiguous` and `any` vectors (not scored).
     pub ambiguous: usize,
+    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`](super::check::judge_exact)).
+    pub ambiguous_passed: usize,
 }
 
 impl Counts {
@@ -138,11 +141,13 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
     let mut failures = Vec::new();
     for (case, outcome) in cases.iter().zip(outcomes) {
         let verdict = judge(case, outcome);
+        let group = by_shape.get_mut(&case.shape.kind()).expect("every kind");
         counts.add(&verdict);
-        by_shape
-            .get_mut(&case.shape.kind())
-            .expect("every kind")
-            .add(&verdict);
+        group.add(&verdict);
+        if judge_exact(case, outcome) == Verdict::Pass {
+            counts.ambiguous_passed += 1;
+            group.ambiguous_passed += 1;
+        }
         if let Verdict::Fail { kind, message } = verdict {
             let actual = match outcome {
                 Outcome::Answered { answer, .. } => Some(answer.clone()),

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::grade::{
-    Format, Rubric, StandinCodeChecker, StandinImageChecker, batch, grade_to_dir,
+    CourseCodeChecker, Format, Rubric, StandinImageChecker, batch, grade_to_dir,
 };
 
 /// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--out DIR] [--format all|json,gradescope,junit,markdown]`
@@ -56,8 +56,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.case_timeout_ms == 0 {
         anyhow::bail!("--case-timeout-ms 0: the limit must be at least 1 ms");
     }
-    // STAND-INS until `check` and `compare` are wired in (see rtoracle::grade::standin).
-    let code = StandinCodeChecker {
+    // The image checker is a STAND-IN until `compare` is wired in (see rtoracle::grade::standin).
+    let code = CourseCodeChecker {
         seed: rubric.seed,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
         ..Default::default()
