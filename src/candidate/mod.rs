@@ -22,8 +22,8 @@ pub mod report;
 pub mod rust;
 pub mod shrink;
 
-pub use check::{FailureKind, Verdict, judge};
 pub use crate::sandbox::SandboxPolicy;
+pub use check::{FailureKind, Verdict, judge};
 pub use process::{CandidateCommand, HarnessError, Outcome, RunOptions, Session};
 pub use protocol::{Answer, CandidateError, Hello};
 pub use report::{CheckReport, Counts, Failure, RunInfo, build_report};

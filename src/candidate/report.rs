@@ -34,7 +34,7 @@ pub struct Counts {
     pub not_run: usize,
     /// `ambiguous` and `any` vectors (not scored).
     pub ambiguous: usize,
-    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`](super::check::judge_exact)).
+    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`]).
     pub ambiguous_passed: usize,
 }
 

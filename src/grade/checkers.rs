@@ -106,7 +106,10 @@ fn grade_failure(
         // A dead interpreter is counted with the time-outs: "timed out or crashed Python".
         (CheckKind::Error, Outcome::Died { .. }) => (
             FailureKind::Timeout,
-            message.replace("the candidate died on this case", "Python died on this vector"),
+            message.replace(
+                "the candidate died on this case",
+                "Python died on this vector",
+            ),
         ),
         (CheckKind::Error, _) => (FailureKind::Error, message),
         (CheckKind::Timeout, _) => (
@@ -337,12 +340,19 @@ mod tests {
             CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
         assert_eq!(out.fatal, None);
         let s = &out.per_group[&ShapeKind::Sphere];
-        assert!(s.failed > 0 && s.passed + s.failed == s.definite_total, "{s:?}");
+        assert!(
+            s.failed > 0 && s.passed + s.failed == s.definite_total,
+            "{s:?}"
+        );
         let q = &out.per_group[&ShapeKind::Quad];
         assert_eq!(q.passed, q.definite_total);
         let f = &out.failures[0];
         assert!(f.definite && f.shape == ShapeKind::Sphere && f.kind == FailureKind::Mismatch);
-        assert!(f.repro.contains("from RT_object import Sphere"), "{}", f.repro);
+        assert!(
+            f.repro.contains("from RT_object import Sphere"),
+            "{}",
+            f.repro
+        );
     }
 
     #[test]
@@ -365,7 +375,11 @@ mod tests {
             CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
         assert_eq!(out.fatal, None);
         assert!(out.failures.is_empty(), "{:?}", out.failures);
-        assert!(out.stderr_tail.contains("debug: root"), "{}", out.stderr_tail);
+        assert!(
+            out.stderr_tail.contains("debug: root"),
+            "{}",
+            out.stderr_tail
+        );
     }
 
     #[test]

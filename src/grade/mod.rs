@@ -32,6 +32,7 @@ pub mod rubric;
 mod run;
 pub mod standin;
 
+pub use checkers::CourseCodeChecker;
 pub use inputs::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
     ImageVerdict,
@@ -42,5 +43,4 @@ pub use run::{
     ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,
     write_reports,
 };
-pub use checkers::CourseCodeChecker;
 pub use standin::StandinImageChecker;
