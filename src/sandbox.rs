@@ -419,6 +419,31 @@ mod tests {
     }
 
     #[test]
+    fn an_adapter_the_drop_user_cannot_reach_makes_the_sandbox_keep_the_current_user() {
+        if !running_as_root() || lookup_user("nobody").is_none() {
+            eprintln!("skipped: needs root and the user nobody");
+            return;
+        }
+        // A program in a folder only root may enter.
+        let private = tempfile::tempdir().unwrap();
+        std::fs::set_permissions(private.path(), std::fs::Permissions::from_mode(0o700)).unwrap();
+        let program = private.path().join("adapter.sh");
+        std::fs::write(&program, "#!/bin/sh\n").unwrap();
+        std::fs::set_permissions(&program, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let mut sandbox = Sandbox::new(SandboxPolicy::default(), &[]).unwrap();
+        sandbox.probe_access(&program, &[]);
+        assert!(!sandbox.drops_user());
+        let note = sandbox.facts(None).note.unwrap_or_default();
+        assert!(note.contains("cannot run"), "{note}");
+        // A system program it can run, with a file it cannot read on its command line.
+        let mut sandbox = Sandbox::new(SandboxPolicy::default(), &[]).unwrap();
+        sandbox.probe_access(Path::new("sh"), &[]);
+        assert!(sandbox.drops_user());
+        sandbox.probe_access(Path::new("sh"), &[program.into_os_string()]);
+        assert!(!sandbox.drops_user());
+    }
+
+    #[test]
     fn a_killed_group_takes_its_grandchildren_with_it() {
         let sandbox = Sandbox::new(SandboxPolicy::default(), &[]).unwrap();
         let mut child = sandbox

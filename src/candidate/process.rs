@@ -911,6 +911,60 @@ enum CountKind {
 mod tests {
     use super::*;
 
+    /// A submission whose import writes a file into its working folder and reports who and
+    /// where it is on stderr.
+    fn nosy_submission() -> tempfile::TempDir {
+        let dir = super::super::bench::assemble_fixture("honest_reference").unwrap();
+        let object = dir.path().join("RT_object.py");
+        let mut text = std::fs::read_to_string(&object).unwrap();
+        text.push_str(
+            "\nimport os, sys\nopen('written-by-import', 'w').write('x')\n\
+             print('uid', os.getuid(), 'cwd', os.getcwd(), 'home', os.environ.get('HOME'), file=sys.stderr)\n",
+        );
+        std::fs::write(&object, text).unwrap();
+        dir
+    }
+
+    #[test]
+    fn the_course_adapter_runs_on_a_copy_in_the_sandbox_as_the_sandbox_user() {
+        let sub = nosy_submission();
+        // /usr/bin/python3 can be run by `nobody`; elsewhere the default interpreter.
+        let system = Path::new("/usr/bin/python3");
+        let python = system.is_file().then_some(system);
+        let command = CandidateCommand::python_course_with(sub.path(), python, true).unwrap();
+        let mut session = Session::start(command, RunOptions::default()).unwrap();
+        let cases: Vec<Case> = crate::oracle::default_suite(0)
+            .into_iter()
+            .filter(|c| c.shape.kind() == ShapeKind::Sphere)
+            .collect();
+        let report = super::super::check_session(&mut session, &cases).unwrap();
+        assert!(report.passed(), "{}", report.to_text(3));
+        let dir = session.sandbox_dir().canonicalize().unwrap();
+        let tail = session.stderr_tail();
+        // It ran in the sandbox folder, with HOME there, and wrote there, not in the submission.
+        assert!(
+            tail.contains(&format!("cwd {} home {}", dir.display(), dir.display())),
+            "{tail}"
+        );
+        assert!(dir.join("written-by-import").is_file());
+        assert!(!sub.path().join("written-by-import").exists());
+        let facts = session.sandbox_facts();
+        assert!(tail.contains(&format!("uid {} ", facts.uid)), "{tail}");
+        if crate::sandbox::running_as_root()
+            && python.is_some()
+            && crate::sandbox::lookup_user("nobody").is_some()
+        {
+            assert_ne!(facts.uid, 0, "{facts:?}");
+            assert_eq!(facts.note, None);
+            assert_eq!(facts.network_isolated, Some(true));
+        }
+        drop(session);
+        assert!(
+            !dir.exists(),
+            "the sandbox folder is removed with the session"
+        );
+    }
+
     #[test]
     fn words_split_like_a_shell() {
         assert_eq!(
