@@ -27,6 +27,9 @@ use crate::oracle::vectors::{Case, Class, ShapeKind};
 pub struct CourseCodeChecker {
     /// Seed of the built-in suite.
     pub seed: u64,
+    /// Vectors to run instead of the built-in suite (a vector file the course pinned), with a
+    /// label for the report (e.g. its path).
+    pub vectors: Option<(String, Vec<Case>)>,
     /// Wall-clock limit per vector.
     pub case_timeout: Duration,
     /// Wall-clock limit for starting Python and importing the submission.
@@ -44,6 +47,7 @@ impl Default for CourseCodeChecker {
     fn default() -> Self {
         CourseCodeChecker {
             seed: 0,
+            vectors: None,
             case_timeout: Duration::from_secs(2),
             import_timeout: Duration::from_secs(5),
             max_timeouts_per_group: 2,
@@ -81,7 +85,10 @@ fn strip_dir(text: &str, dir: &Path) -> String {
 
 impl CourseCodeChecker {
     fn suite(&self) -> Vec<Case> {
-        default_suite(self.seed)
+        match &self.vectors {
+            Some((_, cases)) => cases.clone(),
+            None => default_suite(self.seed),
+        }
     }
 
     fn options(&self) -> RunOptions {
@@ -127,9 +134,12 @@ fn grade_failure(
 
 impl CodeChecker for CourseCodeChecker {
     fn describe(&self) -> String {
+        let suite = match &self.vectors {
+            Some((label, cases)) => format!("{} vectors from {label}", cases.len()),
+            None => format!("built-in suite seed {}", self.seed),
+        };
         format!(
-            "course adapter (as `rtoracle check --python-course`), built-in suite seed {}, {} ms per vector",
-            self.seed,
+            "course adapter (as `rtoracle check --python-course`), {suite}, {} ms per vector",
             self.case_timeout.as_millis()
         )
     }
