@@ -32,10 +32,10 @@ use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Limits and switches of the sandbox.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SandboxPolicy {
     /// CPU seconds per process (`RLIMIT_CPU`; a restart starts afresh).
     pub cpu_seconds: u64,
@@ -93,7 +93,7 @@ pub struct Sandbox {
 }
 
 /// What the sandbox did, for the report.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SandboxFacts {
     /// The policy.
     pub policy: SandboxPolicy,

@@ -43,6 +43,7 @@ pub fn check_session(session: &mut Session, cases: &[Case]) -> Result<CheckRepor
             start_failure: session.start_failure().map(str::to_string),
             stderr_tail: session.stderr_tail(),
             restarts: session.restarts(),
+            sandbox: Some(session.sandbox_facts()),
         },
     ))
 }

@@ -949,6 +949,7 @@ mod tests {
         assert!(dir.join("written-by-import").is_file());
         assert!(!sub.path().join("written-by-import").exists());
         let facts = session.sandbox_facts();
+        assert_eq!(report.sandbox.as_ref(), Some(&facts));
         assert!(tail.contains(&format!("uid {} ", facts.uid)), "{tail}");
         if crate::sandbox::running_as_root()
             && python.is_some()

@@ -16,6 +16,7 @@ use super::check::{FailureKind, Verdict, judge, judge_exact};
 use super::process::Outcome;
 use super::protocol::{Answer, CandidateError};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
+use crate::sandbox::SandboxFacts;
 
 /// Counts of one group (or of the whole run).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -113,6 +114,10 @@ pub struct CheckReport {
     pub stderr_tail: String,
     /// How many times the candidate's process was restarted.
     pub restarts: u32,
+    /// What the [sandbox](crate::sandbox) did: limits, the user the candidate ran as (and why
+    /// not the drop user, if so), network isolation. `None` for in-process candidates.
+    #[serde(default)]
+    pub sandbox: Option<SandboxFacts>,
 }
 
 /// Extra facts about a run for [`build_report`].
@@ -128,6 +133,8 @@ pub struct RunInfo {
     pub stderr_tail: String,
     /// Restarts.
     pub restarts: u32,
+    /// The sandbox's facts, for a candidate run as a process.
+    pub sandbox: Option<SandboxFacts>,
 }
 
 /// Judges every outcome and builds the report.
@@ -175,6 +182,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         start_failure: info.start_failure,
         stderr_tail: info.stderr_tail,
         restarts: info.restarts,
+        sandbox: info.sandbox,
     }
 }
 
@@ -235,6 +243,9 @@ impl CheckReport {
         );
         if self.restarts > 0 {
             let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
+        }
+        if let Some(note) = self.sandbox.as_ref().and_then(|f| f.note.as_ref()) {
+            let _ = writeln!(s, "sandbox: {note}");
         }
         // Vectors not run: one line per reason.
         let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();
