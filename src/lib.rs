@@ -17,9 +17,11 @@
 //! - [`compare`]: the noise-aware image comparison against goldens, with its diagnosis of
 //!   common mistakes, heatmaps and reports.
 //! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
-//!   JUnit, Markdown), the sandbox for student code, and the Gradescope autograder package.
+//!   JUnit, Markdown), and the Gradescope autograder package.
 //! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
 //!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
+//! - [`sandbox`]: how untrusted code (candidates, students' submissions) is started: a fresh
+//!   folder, a cleared environment, limits, its own process group, no network, never as root.
 #![warn(missing_docs)]
 
 pub mod candidate;
@@ -30,4 +32,5 @@ pub mod grade;
 pub mod image_io;
 pub mod oracle;
 pub mod render;
+pub mod sandbox;
 pub mod scene;

@@ -102,6 +102,23 @@ pub fn judge(case: &Case, outcome: &Outcome) -> Verdict {
     }
 }
 
+/// Judges an `ambiguous` case against its exact answer, as if it were definite (a hit when the
+/// vector records an exact `t`, else a miss): [`Verdict::Pass`] when the candidate gave the
+/// exact answer. Other cases are [`Verdict::NotScored`]. Reported, never scored by `check`;
+/// grading scores it when the rubric says so.
+pub fn judge_exact(case: &Case, outcome: &Outcome) -> Verdict {
+    if case.expect.class != Class::Ambiguous {
+        return Verdict::NotScored;
+    }
+    let mut exact = case.clone();
+    exact.expect.class = if exact.expect.t.is_some() {
+        Class::Hit
+    } else {
+        Class::Miss
+    };
+    judge(&exact, outcome)
+}
+
 /// Judges a well-delivered answer for a definite `case`.
 pub fn judge_answer(case: &Case, answer: &super::protocol::Answer) -> Verdict {
     let expect = &case.expect;
@@ -262,5 +279,20 @@ mod tests {
         let mut miss = case.clone();
         miss.expect.class = Class::Miss;
         assert_eq!(judge_answer(&miss, &Answer::miss()), Verdict::Pass);
+        // An ambiguous case with an exact t is judged as that hit by judge_exact only.
+        let right = Outcome::Answered {
+            answer: good.clone(),
+            junk: vec![],
+        };
+        assert_eq!(judge(&amb, &right), Verdict::NotScored);
+        assert_eq!(judge_exact(&amb, &right), Verdict::Pass);
+        let missed = Outcome::Answered {
+            answer: Answer::miss(),
+            junk: vec![],
+        };
+        assert!(matches!(judge_exact(&amb, &missed), Verdict::Fail { .. }));
+        amb.expect.t = None;
+        assert_eq!(judge_exact(&amb, &missed), Verdict::Pass);
+        assert_eq!(judge_exact(&case, &right), Verdict::NotScored);
     }
 }

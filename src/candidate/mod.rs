@@ -4,8 +4,8 @@
 //!
 //! - [`protocol`]: request and answer lines, the hello (`docs/PROTOCOL.md`).
 //! - [`process`]: [`Session`] runs a [`CandidateCommand`] (an `--adapter` command line or the
-//!   course adapter on a submission folder) with pipelined requests, per-case timeouts, restarts
-//!   after crashes and the process group killed on drop.
+//!   course adapter on a submission folder) in the [sandbox](crate::sandbox) with pipelined
+//!   requests, per-case timeouts, restarts after crashes and the process group killed on drop.
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and its text.
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
 //! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
@@ -24,8 +24,9 @@ pub mod shrink;
 #[cfg(test)]
 pub(crate) mod test_cases;
 
+pub use crate::sandbox::SandboxPolicy;
 pub use check::{FailureKind, Verdict, judge};
-pub use process::{CandidateCommand, HarnessError, Limits, Outcome, RunOptions, Session};
+pub use process::{CandidateCommand, HarnessError, Outcome, RunOptions, Session};
 pub use protocol::{Answer, CandidateError, Hello};
 pub use report::{CheckReport, Counts, Failure, RunInfo, build_report};
 pub use rust::{Candidate, Reference, check_candidate};
@@ -44,6 +45,7 @@ pub fn check_session(session: &mut Session, cases: &[Case]) -> Result<CheckRepor
             start_failure: session.start_failure().map(str::to_string),
             stderr_tail: session.stderr_tail(),
             restarts: session.restarts(),
+            sandbox: Some(session.sandbox_facts()),
         },
     ))
 }

@@ -1,12 +1,12 @@
-//! Running a candidate as a child process: spawn with limits, hello, pipelined requests,
-//! per-case timeouts, restart after a crash, kill the whole process group on drop.
+//! Running a candidate as a child process: spawn in the [sandbox](crate::sandbox), hello,
+//! pipelined requests, per-case timeouts, restart after a crash, kill the whole process group on
+//! drop.
 //!
-//! The child runs in a fresh temporary working folder, in its own session and process group
-//! (`setsid`), with a cleared environment (`PATH`, `LANG`, `LC_ALL`, `HOME` and `TMPDIR` set to
-//! the working folder, `PYTHONIOENCODING=utf-8`, `PYTHONDONTWRITEBYTECODE=1`,
-//! `PYTHONHASHSEED=0`), limits on CPU time, address space, open files and file size, no core
-//! dumps, a new network namespace without any interface up where the harness may create one,
-//! and `SIGKILL` when the harness thread that started it dies (Linux).
+//! A [`Session`] makes one [`Sandbox`] (a fresh temporary folder, a cleared environment,
+//! limits, its own process group, no network where allowed, never root when a drop user exists;
+//! see [`crate::sandbox`] for what is done where) and starts every process of the candidate,
+//! restarts included, through it. The course adapter's submission files are copied into that
+//! folder, so the candidate never runs in (or writes to) the submission itself.
 //!
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
 //! takes them while the session reads answers. Candidates may batch their answers; after the
@@ -16,9 +16,9 @@
 //! never charged for them.
 
 use std::collections::{BTreeMap, VecDeque};
-use std::ffi::OsString;
+use std::ffi::{OsStr, OsString};
 use std::io::{BufRead, BufReader, Read, Write};
-use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, SyncSender};
@@ -27,6 +27,10 @@ use std::time::{Duration, Instant};
 
 use super::protocol::{Answer, HELLO_LINE, Hello, ParsedLine, Request, parse_answer_line};
 use crate::oracle::vectors::{Case, ShapeKind};
+use crate::sandbox::{Sandbox, SandboxFacts, SandboxPolicy};
+
+/// The name the course adapter has in the sandbox folder.
+const ADAPTER_NAME: &str = "rtoracle_python_course.py";
 
 /// How many bytes of the candidate's stderr are kept for the report.
 pub const STDERR_TAIL_BYTES: usize = 4096;
@@ -40,34 +44,6 @@ const JUNK_QUOTE: usize = 200;
 /// The embedded adapter for the course's Python API.
 pub const PYTHON_COURSE_ADAPTER: &str = include_str!("python_course.py");
 
-/// Resource limits applied to the candidate with `setrlimit` before `exec`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Limits {
-    /// CPU seconds per process (a restart starts afresh).
-    pub cpu_seconds: u64,
-    /// Address space in bytes.
-    pub memory_bytes: u64,
-    /// Open file descriptors.
-    pub open_files: u64,
-    /// Largest file the candidate may write, in bytes.
-    pub file_size_bytes: u64,
-    /// Run the candidate in a new, empty network namespace (Linux, when the harness is
-    /// allowed to create one: as root or with `CAP_SYS_ADMIN`; silently skipped otherwise).
-    pub isolate_network: bool,
-}
-
-impl Default for Limits {
-    fn default() -> Self {
-        Limits {
-            cpu_seconds: 600,
-            memory_bytes: 2 << 30,
-            open_files: 64,
-            file_size_bytes: 64 << 20,
-            isolate_network: true,
-        }
-    }
-}
-
 /// How a candidate is run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunOptions {
@@ -79,8 +55,8 @@ pub struct RunOptions {
     pub max_timeouts_per_group: u32,
     /// After this many crashes in a shape group the rest of the group is not run.
     pub max_crashes_per_group: u32,
-    /// Resource limits.
-    pub limits: Limits,
+    /// The sandbox's limits and switches.
+    pub limits: SandboxPolicy,
 }
 
 impl Default for RunOptions {
@@ -90,7 +66,7 @@ impl Default for RunOptions {
             hello_timeout: Duration::from_secs(10),
             max_timeouts_per_group: 3,
             max_crashes_per_group: 50,
-            limits: Limits::default(),
+            limits: SandboxPolicy::default(),
         }
     }
 }
@@ -186,8 +162,11 @@ pub struct CandidateCommand {
     /// protocol), `false` reports it as an error on every case (a submission whose import hangs
     /// or kills the interpreter).
     pub hello_failure_is_fatal: bool,
-    /// Keeps the embedded adapter's temporary file alive.
-    _files: Option<Arc<tempfile::TempDir>>,
+    /// The submission folder whose top-level `.py` files are copied into the sandbox (course
+    /// adapter only).
+    submission: Option<PathBuf>,
+    /// Whether the bundled course adapter is written into the sandbox folder.
+    course_adapter: bool,
 }
 
 impl CandidateCommand {
@@ -216,13 +195,28 @@ impl CandidateCommand {
             args: words.collect(),
             label: command_line.to_string(),
             hello_failure_is_fatal: true,
-            _files: None,
+            submission: None,
+            course_adapter: false,
         })
     }
 
     /// The bundled adapter for the course's Python API run on the submission folder `dir`. The
-    /// interpreter is `$RTORACLE_PYTHON` or `python3`, resolved once to its real path.
+    /// interpreter is `$RTORACLE_PYTHON` or `python3`, resolved once to its real path. The
+    /// top-level `.py` files of `dir` are copied into the sandbox folder when the session starts,
+    /// and the adapter imports them from there. Anything the submission prints is a protocol
+    /// error of its case.
     pub fn python_course(dir: &Path) -> Result<Self, HarnessError> {
+        Self::python_course_with(dir, None, false)
+    }
+
+    /// [`CandidateCommand::python_course`] with a chosen interpreter (`None`: as there), and with
+    /// the submission's prints sent to stderr instead (`prints_to_stderr`: what grading wants,
+    /// since nothing a student prints may change a grade but the answers).
+    pub fn python_course_with(
+        dir: &Path,
+        python: Option<&Path>,
+        prints_to_stderr: bool,
+    ) -> Result<Self, HarnessError> {
         if !dir.is_dir() {
             return Err(HarnessError::Submission {
                 path: dir.display().to_string(),
@@ -234,26 +228,76 @@ impl CandidateCommand {
             context: dir.display().to_string(),
             source,
         })?;
-        let python = resolve_python()?;
-        let files = tempfile::Builder::new()
-            .prefix("rtoracle-adapter-")
-            .tempdir()
-            .map_err(|source| HarnessError::Io {
-                context: "creating a temporary folder for the adapter".into(),
-                source,
-            })?;
-        let script = files.path().join("rtoracle_python_course.py");
-        std::fs::write(&script, PYTHON_COURSE_ADAPTER).map_err(|source| HarnessError::Io {
-            context: script.display().to_string(),
-            source,
-        })?;
+        let python = match python {
+            Some(p) => p.to_path_buf(),
+            None => resolve_python()?,
+        };
+        let label = format!("python-course {}", dir.display());
+        let mut args: Vec<OsString> = vec![
+            "-I".into(),
+            "-B".into(),
+            ADAPTER_NAME.into(),
+            ".".into(),
+            "--name".into(),
+            label.clone().into(),
+        ];
+        if prints_to_stderr {
+            args.push("--prints-to-stderr".into());
+        }
         Ok(CandidateCommand {
             program: python,
-            args: vec!["-I".into(), "-B".into(), script.into(), dir.clone().into()],
-            label: format!("python-course {}", dir.display()),
+            args,
+            label,
             hello_failure_is_fatal: false,
-            _files: Some(Arc::new(files)),
+            submission: Some(dir),
+            course_adapter: true,
         })
+    }
+
+    /// The files to copy into the sandbox: the submission's top-level `.py` files (regular
+    /// files only: links are not followed out of the folder).
+    fn staged_files(&self) -> Result<Vec<(PathBuf, String)>, HarnessError> {
+        let Some(dir) = &self.submission else {
+            return Ok(Vec::new());
+        };
+        let entries = std::fs::read_dir(dir).map_err(|source| HarnessError::Io {
+            context: dir.display().to_string(),
+            source,
+        })?;
+        let mut files = Vec::new();
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().to_string();
+            let is_file = entry.file_type().map(|t| t.is_file()).unwrap_or(false);
+            if is_file && name.ends_with(".py") && name != ADAPTER_NAME {
+                files.push((entry.path(), name));
+            }
+        }
+        files.sort();
+        Ok(files)
+    }
+
+    /// Makes the sandbox for this command: the staged files, the adapter, and the drop user
+    /// checked before any untrusted code runs.
+    fn sandbox(&self, policy: SandboxPolicy) -> Result<Sandbox, HarnessError> {
+        let io = |source| HarnessError::Io {
+            context: "preparing the candidate's sandbox folder".into(),
+            source,
+        };
+        let mut sandbox = Sandbox::new(policy, &self.staged_files()?).map_err(io)?;
+        if self.course_adapter {
+            sandbox
+                .add_file(ADAPTER_NAME, PYTHON_COURSE_ADAPTER.as_bytes())
+                .map_err(io)?;
+            if sandbox.drops_user() {
+                let args = [OsStr::new("-I"), OsStr::new("-S"), OsStr::new("-c")];
+                let mut args = args.to_vec();
+                args.push(OsStr::new("pass"));
+                sandbox.probe(&self.program, &args);
+            }
+        } else {
+            sandbox.probe_access(&self.program, &self.args);
+        }
+        Ok(sandbox)
     }
 }
 
@@ -336,70 +380,19 @@ struct Proc {
     writer: Option<Sender<Vec<u8>>>,
     lines: Receiver<Line>,
     stderr_done: std::thread::JoinHandle<()>,
-    _workdir: tempfile::TempDir,
 }
 
 impl Proc {
     fn spawn(
         command: &CandidateCommand,
-        limits: Limits,
+        sandbox: &Sandbox,
         stderr: Arc<Mutex<Tail>>,
     ) -> Result<Proc, HarnessError> {
-        let io = |context: &str| {
-            let context = context.to_string();
-            move |source| HarnessError::Io { context, source }
-        };
-        let workdir = tempfile::Builder::new()
-            .prefix("rtoracle-run-")
-            .tempdir()
-            .map_err(io("creating the candidate's working folder"))?;
-        let mut cmd = Command::new(&command.program);
+        let mut cmd = sandbox.command(&command.program);
         cmd.args(&command.args)
-            .env_clear()
-            .env(
-                "PATH",
-                std::env::var_os("PATH").unwrap_or_else(|| "/usr/local/bin:/usr/bin:/bin".into()),
-            )
-            .env("LANG", "C.UTF-8")
-            .env("LC_ALL", "C.UTF-8")
-            .env("HOME", workdir.path())
-            .env("TMPDIR", workdir.path())
-            .env("PYTHONIOENCODING", "utf-8")
-            .env("PYTHONDONTWRITEBYTECODE", "1")
-            .env("PYTHONHASHSEED", "0")
-            .current_dir(workdir.path())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
-        // SAFETY: the closure only makes async-signal-safe system calls and allocates nothing.
-        unsafe {
-            cmd.pre_exec(move || {
-                if libc::setsid() < 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                #[cfg(target_os = "linux")]
-                {
-                    libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL as libc::c_ulong);
-                    if limits.isolate_network {
-                        // No network: fails without privileges, which is fine.
-                        libc::unshare(libc::CLONE_NEWNET);
-                    }
-                }
-                let set = |resource, value: u64| {
-                    let lim = libc::rlimit {
-                        rlim_cur: value as libc::rlim_t,
-                        rlim_max: value as libc::rlim_t,
-                    };
-                    libc::setrlimit(resource, &lim);
-                };
-                set(libc::RLIMIT_CPU, limits.cpu_seconds);
-                set(libc::RLIMIT_AS, limits.memory_bytes);
-                set(libc::RLIMIT_NOFILE, limits.open_files);
-                set(libc::RLIMIT_FSIZE, limits.file_size_bytes);
-                set(libc::RLIMIT_CORE, 0);
-                Ok(())
-            });
-        }
         let mut child = cmd.spawn().map_err(|source| HarnessError::Spawn {
             program: command.program.display().to_string(),
             source,
@@ -441,7 +434,6 @@ impl Proc {
             writer: Some(wtx),
             lines: lrx,
             stderr_done,
-            _workdir: workdir,
         })
     }
 
@@ -593,12 +585,15 @@ pub struct Session {
     restarts: u32,
     broken: Option<String>,
     sync: bool,
+    sandbox: Sandbox,
+    facts: Option<SandboxFacts>,
 }
 
 impl Session {
     /// Starts the candidate and does the hello. A hello failure is an error when
     /// [`CandidateCommand::hello_failure_is_fatal`], else every case will report it.
     pub fn start(command: CandidateCommand, options: RunOptions) -> Result<Session, HarnessError> {
+        let sandbox = command.sandbox(options.limits.clone())?;
         let mut session = Session {
             command,
             options,
@@ -616,6 +611,8 @@ impl Session {
             restarts: 0,
             broken: None,
             sync: false,
+            sandbox,
+            facts: None,
         };
         match session.launch()? {
             Ok(hello) => session.hello = hello,
@@ -662,9 +659,25 @@ impl Session {
         &self.command
     }
 
+    /// What the sandbox did: limits, the user the candidate ran as (and why not the drop user,
+    /// if so), and whether its first process was seen in a network namespace of its own.
+    pub fn sandbox_facts(&self) -> SandboxFacts {
+        self.facts
+            .clone()
+            .unwrap_or_else(|| self.sandbox.facts(None))
+    }
+
+    /// The sandbox's folder (where the candidate runs; file names in its tracebacks start here).
+    pub fn sandbox_dir(&self) -> &Path {
+        self.sandbox.dir()
+    }
+
     /// Spawns and does the hello: `Ok(Err(message))` when the hello failed.
     fn launch(&mut self) -> Result<Result<Hello, String>, HarnessError> {
-        let proc = Proc::spawn(&self.command, self.options.limits, self.stderr.clone())?;
+        let proc = Proc::spawn(&self.command, &self.sandbox, self.stderr.clone())?;
+        if self.facts.is_none() {
+            self.facts = Some(self.sandbox.facts(Some(proc.pid as u32)));
+        }
         proc.send(format!("{HELLO_LINE}\n").into_bytes());
         let deadline = Instant::now() + self.options.hello_timeout;
         let mut junk = Vec::new();
@@ -897,6 +910,61 @@ enum CountKind {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A submission whose import writes a file into its working folder and reports who and
+    /// where it is on stderr.
+    fn nosy_submission() -> tempfile::TempDir {
+        let dir = super::super::bench::assemble_fixture("honest_reference").unwrap();
+        let object = dir.path().join("RT_object.py");
+        let mut text = std::fs::read_to_string(&object).unwrap();
+        text.push_str(
+            "\nimport os, sys\nopen('written-by-import', 'w').write('x')\n\
+             print('uid', os.getuid(), 'cwd', os.getcwd(), 'home', os.environ.get('HOME'), file=sys.stderr)\n",
+        );
+        std::fs::write(&object, text).unwrap();
+        dir
+    }
+
+    #[test]
+    fn the_course_adapter_runs_on_a_copy_in_the_sandbox_as_the_sandbox_user() {
+        let sub = nosy_submission();
+        // /usr/bin/python3 can be run by `nobody`; elsewhere the default interpreter.
+        let system = Path::new("/usr/bin/python3");
+        let python = system.is_file().then_some(system);
+        let command = CandidateCommand::python_course_with(sub.path(), python, true).unwrap();
+        let mut session = Session::start(command, RunOptions::default()).unwrap();
+        let cases: Vec<Case> = crate::oracle::default_suite(0)
+            .into_iter()
+            .filter(|c| c.shape.kind() == ShapeKind::Sphere)
+            .collect();
+        let report = super::super::check_session(&mut session, &cases).unwrap();
+        assert!(report.passed(), "{}", report.to_text(3));
+        let dir = session.sandbox_dir().canonicalize().unwrap();
+        let tail = session.stderr_tail();
+        // It ran in the sandbox folder, with HOME there, and wrote there, not in the submission.
+        assert!(
+            tail.contains(&format!("cwd {} home {}", dir.display(), dir.display())),
+            "{tail}"
+        );
+        assert!(dir.join("written-by-import").is_file());
+        assert!(!sub.path().join("written-by-import").exists());
+        let facts = session.sandbox_facts();
+        assert_eq!(report.sandbox.as_ref(), Some(&facts));
+        assert!(tail.contains(&format!("uid {} ", facts.uid)), "{tail}");
+        if crate::sandbox::running_as_root()
+            && python.is_some()
+            && crate::sandbox::lookup_user("nobody").is_some()
+        {
+            assert_ne!(facts.uid, 0, "{facts:?}");
+            assert_eq!(facts.note, None);
+            assert_eq!(facts.network_isolated, Some(true));
+        }
+        drop(session);
+        assert!(
+            !dir.exists(),
+            "the sandbox folder is removed with the session"
+        );
+    }
 
     #[test]
     fn words_split_like_a_shell() {

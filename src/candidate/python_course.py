@@ -1,8 +1,9 @@
 """rtoracle's adapter for the course's Python API (protocol 1, JSON lines, stdlib only).
 
-Usage: python3 -I -B python_course.py SUBMISSION_DIR
+Usage: python3 -I -B python_course.py SUBMISSION_DIR [--name NAME] [--prints-to-stderr]
 
-Imports RT_utility, RT_ray and RT_object from SUBMISSION_DIR, builds the course's objects with
+Imports RT_utility, RT_ray and RT_object from SUBMISSION_DIR (rtoracle runs it in its sandbox
+folder, where the submission's .py files are copied, with SUBMISSION_DIR "."), builds the course's objects with
 their constructors and answers one request line with one answer line, in order. Answers are
 written in batches (see _Channel), or one by one when a request says "sync": true (the harness
 asks for that after a crash or timeout, since a crash loses the answers not yet written).
@@ -58,7 +59,8 @@ class _Channel:
     encoding = "utf-8"
     errors = "replace"
 
-    def __init__(self):
+    def __init__(self, fd=1):
+        self.fd = fd
         self.pending = []
         self.lock = threading.Lock()
         self.busy_since = 0.0
@@ -86,7 +88,7 @@ class _Channel:
             self.pending.clear()
             view = memoryview(data)
             while view:
-                n = os.write(1, view)
+                n = os.write(self.fd, view)
                 view = view[n:]
 
     def watchdog(self):
@@ -117,12 +119,24 @@ def lines(chan):
 
 
 def main():
-    submission = sys.argv[1] if len(sys.argv) > 1 else "."
-    sys.path.insert(0, submission)
-    chan = _Channel()
-    # Prints of the submission keep their place among the answers (the harness reports them),
-    # and it cannot read (steal) the requests: they are read from the descriptor directly.
-    sys.stdout = chan
+    args = sys.argv[1:]
+    submission = args[0] if args and not args[0].startswith("--") else "."
+    name = "python-course " + submission
+    if "--name" in args[:-1]:
+        name = args[args.index("--name") + 1]
+    sys.path.insert(0, os.path.abspath(submission))
+    if "--prints-to-stderr" in args:
+        # Grading: what the submission prints (even from C or a child process) goes to stderr,
+        # never among the answers, which keep a descriptor of their own.
+        chan = _Channel(os.dup(1))
+        os.dup2(2, 1)
+        sys.stdout = sys.stderr
+    else:
+        # Prints of the submission keep their place among the answers (the harness reports
+        # them as protocol errors).
+        chan = _Channel()
+        sys.stdout = chan
+    # It cannot read (steal) the requests: they are read from the descriptor directly.
     sys.stdin = open(os.devnull)
     out = chan
     loads = json.loads
@@ -130,7 +144,7 @@ def main():
 
     if next(requests, None) is None:
         return
-    hello = {"name": "python-course " + submission, "protocol": 1, "shapes": ["sphere", "quad"]}
+    hello = {"name": name, "protocol": 1, "shapes": ["sphere", "quad"]}
     try:
         import RT_utility
         import RT_ray

@@ -4,17 +4,19 @@
 //! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
 //! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
 //! `errors` counts raised errors, dead processes and protocol errors. `ambiguous` counts the
-//! `ambiguous` and `any` vectors, which are run and reported but never scored.
+//! `ambiguous` and `any` vectors, which are run and reported but never scored; `ambiguous_passed`
+//! counts the `ambiguous` ones answered with the exact answer.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use super::check::{FailureKind, Verdict, judge};
+use super::check::{FailureKind, Verdict, judge, judge_exact};
 use super::process::Outcome;
 use super::protocol::{Answer, CandidateError};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
+use crate::sandbox::SandboxFacts;
 
 /// Counts of one group (or of the whole run).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -33,6 +35,8 @@ pub struct Counts {
     pub not_run: usize,
     /// `ambiguous` and `any` vectors (not scored).
     pub ambiguous: usize,
+    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`]).
+    pub ambiguous_passed: usize,
 }
 
 impl Counts {
@@ -110,6 +114,10 @@ pub struct CheckReport {
     pub stderr_tail: String,
     /// How many times the candidate's process was restarted.
     pub restarts: u32,
+    /// What the [sandbox](crate::sandbox) did: limits, the user the candidate ran as (and why
+    /// not the drop user, if so), network isolation. `None` for in-process candidates.
+    #[serde(default)]
+    pub sandbox: Option<SandboxFacts>,
 }
 
 /// Extra facts about a run for [`build_report`].
@@ -125,6 +133,8 @@ pub struct RunInfo {
     pub stderr_tail: String,
     /// Restarts.
     pub restarts: u32,
+    /// The sandbox's facts, for a candidate run as a process.
+    pub sandbox: Option<SandboxFacts>,
 }
 
 /// Judges every outcome and builds the report.
@@ -138,11 +148,13 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
     let mut failures = Vec::new();
     for (case, outcome) in cases.iter().zip(outcomes) {
         let verdict = judge(case, outcome);
+        let group = by_shape.get_mut(&case.shape.kind()).expect("every kind");
         counts.add(&verdict);
-        by_shape
-            .get_mut(&case.shape.kind())
-            .expect("every kind")
-            .add(&verdict);
+        group.add(&verdict);
+        if judge_exact(case, outcome) == Verdict::Pass {
+            counts.ambiguous_passed += 1;
+            group.ambiguous_passed += 1;
+        }
         if let Verdict::Fail { kind, message } = verdict {
             let actual = match outcome {
                 Outcome::Answered { answer, .. } => Some(answer.clone()),
@@ -170,6 +182,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         start_failure: info.start_failure,
         stderr_tail: info.stderr_tail,
         restarts: info.restarts,
+        sandbox: info.sandbox,
     }
 }
 
@@ -230,6 +243,9 @@ impl CheckReport {
         );
         if self.restarts > 0 {
             let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
+        }
+        if let Some(note) = self.sandbox.as_ref().and_then(|f| f.note.as_ref()) {
+            let _ = writeln!(s, "sandbox: {note}");
         }
         // Vectors not run: one line per reason.
         let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();

@@ -4,10 +4,11 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::grade::{
-    Format, Rubric, StandinCodeChecker, StandinImageChecker, batch, grade_to_dir,
+    CourseCodeChecker, Format, Rubric, StandinImageChecker, batch, grade_to_dir,
 };
+use rtoracle::oracle::vectors::read_vectors;
 
-/// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--out DIR] [--format all|json,gradescope,junit,markdown]`
+/// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--vectors FILE.jsonl] [--out DIR] [--format all|json,gradescope,junit,markdown]`
 /// or `rtoracle grade --batch DIR --out OUT`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -26,6 +27,9 @@ pub struct Args {
     /// Which reports: all, or a comma list of json, gradescope, junit, markdown.
     #[arg(long, value_name = "LIST", default_value = "all")]
     format: String,
+    /// A vector file (as `rtoracle vectors` writes) to run instead of the built-in suite.
+    #[arg(long, value_name = "FILE.jsonl")]
+    vectors: Option<PathBuf>,
     /// Wall-clock limit per test vector, in milliseconds.
     #[arg(long, value_name = "MS", default_value_t = 2000)]
     case_timeout_ms: u64,
@@ -56,9 +60,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.case_timeout_ms == 0 {
         anyhow::bail!("--case-timeout-ms 0: the limit must be at least 1 ms");
     }
-    // STAND-INS until `check` and `compare` are wired in (see rtoracle::grade::standin).
-    let code = StandinCodeChecker {
+    // The image checker is a STAND-IN until `compare` is wired in (see rtoracle::grade::standin).
+    let vectors = match &args.vectors {
+        Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
+        None => None,
+    };
+    let code = CourseCodeChecker {
         seed: rubric.seed,
+        vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
         ..Default::default()
     };

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
-use super::{Format, Rubric, StandinCodeChecker, StandinImageChecker, batch, grade_to_dir};
+use super::{CourseCodeChecker, Format, Rubric, StandinImageChecker, batch, grade_to_dir};
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 
@@ -58,6 +58,18 @@ pub fn fixture_names() -> Vec<String> {
 /// own, and its images rendered by the reference renderer (20 spp, the fixture's seed and
 /// width). Returns the rubric groups it is meant to lose points in.
 pub fn materialize(name: &str, dest: &Path) -> Result<Vec<String>, String> {
+    let spec = materialize_spec(name, dest)?;
+    render_images(name, &spec, dest)?;
+    Ok(spec.loses)
+}
+
+/// Makes fixture `name` a submission in `dest` (created) without its images: the `.py` files
+/// of its `base` then its own. Returns the rubric groups it is meant to lose points in.
+pub fn materialize_code(name: &str, dest: &Path) -> Result<Vec<String>, String> {
+    Ok(materialize_spec(name, dest)?.loses)
+}
+
+fn materialize_spec(name: &str, dest: &Path) -> Result<FixtureSpec, String> {
     let dir = fixtures_dir().join(name);
     let spec_path = dir.join("fixture.toml");
     let text =
@@ -81,6 +93,10 @@ pub fn materialize(name: &str, dest: &Path) -> Result<Vec<String>, String> {
         copy_py(&fixtures_dir().join(base))?;
     }
     copy_py(&dir)?;
+    Ok(spec)
+}
+
+fn render_images(name: &str, spec: &FixtureSpec, dest: &Path) -> Result<(), String> {
     for img in &spec.image {
         let d = crate::scene::builtin(&img.scene).map_err(|e| e.to_string())?;
         let options = RenderOptions {
@@ -107,7 +123,7 @@ pub fn materialize(name: &str, dest: &Path) -> Result<Vec<String>, String> {
         )
         .map_err(|e| e.to_string())?;
     }
-    Ok(spec.loses)
+    Ok(())
 }
 
 fn secs(d: Duration) -> f64 {
@@ -127,7 +143,7 @@ pub fn run() -> (f64, f64) {
     materialize("honest", &honest).expect("the honest fixture");
 
     // Baseline: starting the interpreter once, as the grader must at least do.
-    let python = ["/usr/bin/python3", "python3"]
+    let python = ["/usr/bin/python3", "/usr/local/bin/python3", "python3"]
         .into_iter()
         .find(|p| {
             std::process::Command::new(p)
@@ -159,7 +175,7 @@ pub fn run() -> (f64, f64) {
         grade_to_dir(
             &honest,
             &rubric,
-            &StandinCodeChecker::default(),
+            &CourseCodeChecker::default(),
             &StandinImageChecker::default(),
             &work.path().join("one"),
             &Format::ALL,
@@ -172,7 +188,7 @@ pub fn run() -> (f64, f64) {
         let entries = batch::grade_batch(
             &subs,
             &rubric,
-            &StandinCodeChecker::default(),
+            &CourseCodeChecker::default(),
             &StandinImageChecker::default(),
             &work.path().join("batch"),
             &Format::ALL,

@@ -4,15 +4,16 @@
 //! with a gradebook; and a Gradescope autograder package.
 //!
 //! Grading sees the code under test only through [`CodeChecker`] and the images only through
-//! [`ImageChecker`] ([`inputs`]); [`standin`] holds simple implementations of both until the
-//! real checking and comparison modules are wired in.
+//! [`ImageChecker`] ([`inputs`]). The code checker is [`CourseCodeChecker`] ([`checkers`]): the
+//! `check` harness running the course adapter in the [sandbox](crate::sandbox); [`standin`]
+//! holds a simple image checker until the real comparison module is wired in.
 //!
 //! ```no_run
-//! use rtoracle::grade::{Format, Rubric, StandinCodeChecker, StandinImageChecker, grade_to_dir};
+//! use rtoracle::grade::{CourseCodeChecker, Format, Rubric, StandinImageChecker, grade_to_dir};
 //! let report = grade_to_dir(
 //!     "submission".as_ref(),
 //!     &Rubric::week04(),
-//!     &StandinCodeChecker::default(),
+//!     &CourseCodeChecker::default(),
 //!     &StandinImageChecker::default(),
 //!     "grade-report".as_ref(),
 //!     &Format::ALL,
@@ -24,13 +25,14 @@
 pub mod autograder;
 pub mod batch;
 pub mod bench;
+pub mod checkers;
 pub mod inputs;
 pub mod report;
 pub mod rubric;
 mod run;
-pub mod sandbox;
 pub mod standin;
 
+pub use checkers::CourseCodeChecker;
 pub use inputs::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
     ImageVerdict,
@@ -41,4 +43,4 @@ pub use run::{
     ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,
     write_reports,
 };
-pub use standin::{StandinCodeChecker, StandinImageChecker};
+pub use standin::StandinImageChecker;

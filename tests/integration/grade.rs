@@ -36,6 +36,10 @@ fn batch() -> &'static Batch {
             .collect();
         assert!(fixtures.len() >= 8, "{fixtures:?}");
         let out = root.join("out");
+        // A vector file of these tests' own, so the snapshots of the feedback do not change
+        // with the built-in suite (which the unit tests of the checker and
+        // `one_submission_writes_the_chosen_formats_and_exits_0` run).
+        let vectors = rtoracle::grade::bench::fixtures_dir().join("vectors.jsonl");
         let output = run_in(
             &root,
             &[
@@ -46,6 +50,8 @@ fn batch() -> &'static Batch {
                 "out",
                 "--case-timeout-ms",
                 "1000",
+                "--vectors",
+                vectors.to_str().unwrap(),
             ],
         );
         Batch {
@@ -443,6 +449,11 @@ fn grading_that_cannot_run_exits_2_with_one_line_and_writes_nothing() {
     assert_bad_input(&out, "--format \"pdf\"");
     let out = run_in(dir.path(), &["grade", "--batch", "nowhere"]);
     assert_bad_input(&out, "nowhere: no such submission folder");
+    let out = run_in(dir.path(), &["grade", "sub", "--vectors", "none.jsonl"]);
+    assert_bad_input(&out, "none.jsonl: cannot read");
+    std::fs::write(dir.path().join("bad.jsonl"), "{\"id\": 1}\n").unwrap();
+    let out = run_in(dir.path(), &["grade", "sub", "--vectors", "bad.jsonl"]);
+    assert_bad_input(&out, "bad.jsonl:1: not a valid vector");
     assert!(!dir.path().join("grade-report").exists());
     // An empty folder is a submission with nothing in it: graded 0, exit 0.
     let out = run_in(dir.path(), &["grade", "sub"]);

@@ -1,0 +1,419 @@
+//! The real [`CodeChecker`]: the `check` harness ([`crate::candidate`]) running the bundled
+//! course adapter on the submission, in the [sandbox](crate::sandbox), against the built-in
+//! suite filtered to the rubric's groups.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use serde_json::Value;
+
+use crate::candidate::check::{FailureKind as CheckKind, Verdict, judge, judge_exact};
+use crate::candidate::report::python_repro;
+use crate::candidate::{
+    CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
+};
+use crate::grade::inputs::{CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts};
+use crate::grade::rubric::sha256_hex;
+use crate::oracle::default_suite;
+use crate::oracle::vectors::{Case, Class, ShapeKind};
+
+/// Checks a submission's `RT_object.py` with the course adapter of `rtoracle check
+/// --python-course`: one sandboxed interpreter per submission, restarted after a crash; a
+/// vector that hangs costs [`case_timeout`](Self::case_timeout), and after
+/// [`max_timeouts_per_group`](Self::max_timeouts_per_group) of them the rest of the group is
+/// not run. What the submission prints goes to its stderr (shown in the report), never among
+/// the answers.
+#[derive(Clone, Debug)]
+pub struct CourseCodeChecker {
+    /// Seed of the built-in suite.
+    pub seed: u64,
+    /// Vectors to run instead of the built-in suite (a vector file the course pinned), with a
+    /// label for the report (e.g. its path).
+    pub vectors: Option<(String, Vec<Case>)>,
+    /// Wall-clock limit per vector.
+    pub case_timeout: Duration,
+    /// Wall-clock limit for starting Python and importing the submission.
+    pub import_timeout: Duration,
+    /// After this many timeouts in a group, the rest of the group is not run.
+    pub max_timeouts_per_group: u32,
+    /// The sandbox's limits.
+    pub policy: SandboxPolicy,
+    /// The interpreter (default: `$RTORACLE_PYTHON`, else `/usr/bin/python3` or
+    /// `/usr/local/bin/python3`, which a drop user can run, else `python3` on `PATH`).
+    pub python: Option<PathBuf>,
+}
+
+impl Default for CourseCodeChecker {
+    fn default() -> Self {
+        CourseCodeChecker {
+            seed: 0,
+            vectors: None,
+            case_timeout: Duration::from_secs(2),
+            import_timeout: Duration::from_secs(5),
+            max_timeouts_per_group: 2,
+            policy: SandboxPolicy::grading(),
+            python: None,
+        }
+    }
+}
+
+/// The interpreter to use: `None` lets the harness resolve `python3` on `PATH`.
+fn find_python(explicit: Option<&Path>) -> Option<PathBuf> {
+    if let Some(p) = explicit {
+        return Some(p.to_path_buf());
+    }
+    if let Some(p) = std::env::var_os("RTORACLE_PYTHON") {
+        return Some(PathBuf::from(p));
+    }
+    ["/usr/bin/python3", "/usr/local/bin/python3"]
+        .into_iter()
+        .map(PathBuf::from)
+        .find(|p| p.is_file())
+}
+
+/// Removes the sandbox folder from file names, which means nothing to the student.
+fn strip_dir(text: &str, dir: &Path) -> String {
+    let mut text = text.to_string();
+    let canonical = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    for d in [canonical.as_path(), dir] {
+        for prefix in [format!("{}/./", d.display()), format!("{}/", d.display())] {
+            text = text.replace(&prefix, "");
+        }
+    }
+    text
+}
+
+impl CourseCodeChecker {
+    fn suite(&self) -> Vec<Case> {
+        match &self.vectors {
+            Some((_, cases)) => cases.clone(),
+            None => default_suite(self.seed),
+        }
+    }
+
+    fn options(&self) -> RunOptions {
+        RunOptions {
+            timeout: self.case_timeout,
+            hello_timeout: self.import_timeout,
+            max_timeouts_per_group: self.max_timeouts_per_group,
+            limits: self.policy.clone(),
+            ..RunOptions::default()
+        }
+    }
+}
+
+/// The grade's failure kind and message for a definite case that did not pass.
+fn grade_failure(
+    kind: CheckKind,
+    message: String,
+    outcome: &Outcome,
+    timeout: Duration,
+) -> (FailureKind, String) {
+    match (kind, outcome) {
+        // A dead interpreter is counted with the time-outs: "timed out or crashed Python".
+        (CheckKind::Error, Outcome::Died { .. }) => (
+            FailureKind::Timeout,
+            message.replace(
+                "the candidate died on this case",
+                "Python died on this vector",
+            ),
+        ),
+        (CheckKind::Error, _) => (FailureKind::Error, message),
+        (CheckKind::Timeout, _) => (
+            FailureKind::Timeout,
+            format!(
+                "no answer within {} s (an infinite loop?)",
+                timeout.as_secs_f64()
+            ),
+        ),
+        (CheckKind::NotRun, _) => (FailureKind::NotRun, message),
+        (CheckKind::Mismatch, _) => (FailureKind::Mismatch, message),
+        (CheckKind::Protocol, _) => (FailureKind::Protocol, message),
+    }
+}
+
+impl CodeChecker for CourseCodeChecker {
+    fn describe(&self) -> String {
+        let suite = match &self.vectors {
+            Some((label, cases)) => format!("{} vectors from {label}", cases.len()),
+            None => format!("built-in suite seed {}", self.seed),
+        };
+        format!(
+            "course adapter (as `rtoracle check --python-course`), {suite}, {} ms per vector",
+            self.case_timeout.as_millis()
+        )
+    }
+
+    fn vectors_sha256(&self) -> String {
+        let text: String = self
+            .suite()
+            .iter()
+            .map(|c| c.to_json_line() + "\n")
+            .collect();
+        sha256_hex(text.as_bytes())
+    }
+
+    fn check(&self, submission: &Path, groups: &[ShapeKind]) -> CodeOutcome {
+        let cases: Vec<Case> = self
+            .suite()
+            .into_iter()
+            .filter(|c| groups.contains(&c.shape.kind()))
+            .collect();
+        let mut out = CodeOutcome {
+            per_group: groups
+                .iter()
+                .map(|&g| (g, GroupCounts::default()))
+                .collect(),
+            ..Default::default()
+        };
+        for c in &cases {
+            let counts = out.per_group.get_mut(&c.shape.kind()).expect("asked for");
+            if c.expect.class.is_definite() {
+                counts.definite_total += 1;
+            }
+        }
+        let fatal = |out: &mut CodeOutcome, msg: String| {
+            for counts in out.per_group.values_mut() {
+                counts.not_run = counts.definite_total;
+            }
+            out.fatal = Some(msg);
+        };
+        let has_object = std::fs::symlink_metadata(submission.join("RT_object.py"))
+            .map(|m| m.is_file())
+            .unwrap_or(false);
+        if !has_object {
+            fatal(&mut out, "RT_object.py is not in the submission".into());
+            return out;
+        }
+        let started = CandidateCommand::python_course_with(
+            submission,
+            find_python(self.python.as_deref()).as_deref(),
+            true,
+        )
+        .and_then(|command| Session::start(command, self.options()));
+        let mut session = match started {
+            Ok(s) => s,
+            Err(HarnessError::Python(e)) => {
+                fatal(&mut out, format!("cannot run the Python interpreter: {e}"));
+                return out;
+            }
+            Err(e) => {
+                fatal(&mut out, e.to_string());
+                return out;
+            }
+        };
+        let dir = session.sandbox_dir().to_path_buf();
+        out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
+        let finish = |out: &mut CodeOutcome, session: &Session| {
+            out.stderr_tail = strip_dir(&session.stderr_tail(), &dir);
+            out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
+        };
+        if let Some(e) = &session.hello().error {
+            let text = if e.traceback.trim().is_empty() {
+                e.to_string()
+            } else {
+                e.traceback.trim_end().to_string()
+            };
+            let msg = format!(
+                "importing the submission failed:\n{}",
+                strip_dir(&text, &dir)
+            );
+            fatal(&mut out, msg);
+            finish(&mut out, &session);
+            return out;
+        }
+        if let Some(why) = session.start_failure() {
+            let msg = format!(
+                "Python could not import the submission: {}",
+                strip_dir(why, &dir)
+            );
+            fatal(&mut out, msg);
+            finish(&mut out, &session);
+            return out;
+        }
+        let outcomes = match session.run(&cases) {
+            Ok(o) => o,
+            Err(e) => {
+                fatal(&mut out, e.to_string());
+                finish(&mut out, &session);
+                return out;
+            }
+        };
+
+        let mut definite_failures = Vec::new();
+        let mut ambiguous_failures = Vec::new();
+        for (case, outcome) in cases.iter().zip(&outcomes) {
+            let kind = case.shape.kind();
+            let definite = case.expect.class.is_definite();
+            let counts = out.per_group.get_mut(&kind).expect("asked for");
+            let verdict = if definite {
+                judge(case, outcome)
+            } else if case.expect.class == Class::Ambiguous {
+                counts.ambiguous += 1;
+                judge_exact(case, outcome)
+            } else {
+                continue;
+            };
+            let (failure_kind, message) = match verdict {
+                Verdict::Pass => {
+                    if definite {
+                        counts.passed += 1;
+                    } else {
+                        counts.ambiguous_passed += 1;
+                    }
+                    continue;
+                }
+                Verdict::NotScored => continue,
+                Verdict::Fail { kind: k, message } => {
+                    grade_failure(k, message, outcome, self.case_timeout)
+                }
+            };
+            if definite {
+                match failure_kind {
+                    FailureKind::Error => counts.errors += 1,
+                    FailureKind::Timeout => counts.timeouts += 1,
+                    FailureKind::NotRun => counts.not_run += 1,
+                    FailureKind::Mismatch | FailureKind::Protocol => counts.failed += 1,
+                }
+            }
+            let actual = match outcome {
+                Outcome::Answered { answer, .. } => {
+                    serde_json::to_value(answer).unwrap_or(Value::Null)
+                }
+                _ => Value::Null,
+            };
+            let summary = FailureSummary {
+                id: case.id.clone(),
+                shape: kind,
+                tags: case.expect.tags.clone(),
+                kind: failure_kind,
+                definite,
+                expected: serde_json::to_value(&case.expect).unwrap_or_default(),
+                actual,
+                message: strip_dir(&message, &dir),
+                repro: python_repro(case),
+            };
+            if definite {
+                definite_failures.push(summary);
+            } else {
+                ambiguous_failures.push(summary);
+            }
+        }
+        definite_failures.sort_by_key(|f| f.shape);
+        ambiguous_failures.sort_by_key(|f| f.shape);
+        out.failures = definite_failures;
+        out.failures.extend(ambiguous_failures);
+        finish(&mut out, &session);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture(name: &str) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        crate::grade::bench::materialize_code(name, dir.path()).unwrap();
+        dir
+    }
+
+    fn definite(kind: ShapeKind) -> usize {
+        default_suite(0)
+            .iter()
+            .filter(|c| c.shape.kind() == kind && c.expect.class.is_definite())
+            .count()
+    }
+
+    #[test]
+    fn the_honest_fixture_passes_every_vector_in_the_sandbox() {
+        let sub = fixture("honest");
+        let out =
+            CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
+        assert_eq!(out.fatal, None, "{}", out.stderr_tail);
+        for kind in [ShapeKind::Sphere, ShapeKind::Quad] {
+            let n = definite(kind);
+            let c = &out.per_group[&kind];
+            assert_eq!((c.definite_total, c.passed), (n, n), "{kind}");
+        }
+        assert!(out.failures.is_empty(), "{:?}", out.failures);
+        // Never root when the drop user exists and can run Python.
+        if crate::sandbox::running_as_root() && out.sandbox["note"].is_null() {
+            assert_ne!(out.sandbox["uid"], 0, "{}", out.sandbox);
+        }
+    }
+
+    #[test]
+    fn a_sphere_bug_costs_sphere_vectors_only_and_comes_with_a_repro() {
+        let sub = fixture("sphere-bug");
+        let out =
+            CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
+        assert_eq!(out.fatal, None);
+        let s = &out.per_group[&ShapeKind::Sphere];
+        assert!(
+            s.failed > 0 && s.passed + s.failed == s.definite_total,
+            "{s:?}"
+        );
+        let q = &out.per_group[&ShapeKind::Quad];
+        assert_eq!(q.passed, q.definite_total);
+        let f = &out.failures[0];
+        assert!(f.definite && f.shape == ShapeKind::Sphere && f.kind == FailureKind::Mismatch);
+        assert!(
+            f.repro.contains("from RT_object import Sphere"),
+            "{}",
+            f.repro
+        );
+    }
+
+    #[test]
+    fn an_unimportable_submission_is_fatal_with_python_s_message_and_no_sandbox_path() {
+        let sub = fixture("unimportable");
+        let out = CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere]);
+        let fatal = out.fatal.expect("fatal");
+        assert!(fatal.contains("SyntaxError"), "{fatal}");
+        assert!(fatal.contains("File \"RT_object.py\""), "{fatal}");
+        assert!(!fatal.contains("rtoracle-sandbox"), "{fatal}");
+        let s = &out.per_group[&ShapeKind::Sphere];
+        assert_eq!(s.not_run, s.definite_total);
+    }
+
+    #[test]
+    fn prints_do_not_change_the_answers_and_land_in_stderr() {
+        // It prints an answer-looking line on every quad it checks and a debug line on spheres.
+        let sub = fixture("chatty");
+        let out =
+            CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
+        assert_eq!(out.fatal, None);
+        assert!(out.failures.is_empty(), "{:?}", out.failures);
+        assert!(
+            out.stderr_tail.contains("debug: root"),
+            "{}",
+            out.stderr_tail
+        );
+    }
+
+    #[test]
+    fn an_interpreter_the_drop_user_cannot_run_falls_back_and_says_so() {
+        // Python under /root (mode 0700) cannot be run by `nobody`.
+        let private = Path::new("/root/.pyenv/versions/3.11.7/bin/python3");
+        if !crate::sandbox::running_as_root()
+            || !private.exists()
+            || crate::sandbox::lookup_user("nobody").is_none()
+        {
+            eprintln!("skipped: needs root, nobody and a Python under /root");
+            return;
+        }
+        let checker = CourseCodeChecker {
+            python: Some(private.to_path_buf()),
+            ..Default::default()
+        };
+        let sub = fixture("honest");
+        let out = checker.check(sub.path(), &[ShapeKind::Sphere]);
+        assert_eq!(out.fatal, None);
+        let s = &out.per_group[&ShapeKind::Sphere];
+        assert_eq!(s.passed, s.definite_total);
+        let note = out.sandbox["note"].as_str().unwrap_or("");
+        assert!(note.contains("cannot run"), "{}", out.sandbox);
+        assert_eq!(out.sandbox["uid"], 0);
+    }
+}
