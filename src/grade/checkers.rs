@@ -336,7 +336,14 @@ mod tests {
             let c = &out.per_group[&kind];
             assert_eq!((c.definite_total, c.passed), (n, n), "{kind}");
         }
-        assert!(out.failures.is_empty(), "{:?}", out.failures);
+        // Ambiguous vectors are reported (not scored); no definite one may fail.
+        let definite: Vec<_> = out
+            .failures
+            .iter()
+            .filter(|f| f.definite)
+            .map(|f| &f.id)
+            .collect();
+        assert!(definite.is_empty(), "{definite:?}");
         // Never root when the drop user exists and can run Python.
         if crate::sandbox::running_as_root() && out.sandbox["note"].is_null() {
             assert_ne!(out.sandbox["uid"], 0, "{}", out.sandbox);
@@ -384,9 +391,19 @@ mod tests {
         let out =
             CourseCodeChecker::default().check(sub.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
         assert_eq!(out.fatal, None);
-        assert!(out.failures.is_empty(), "{:?}", out.failures);
+        // Ambiguous vectors are reported (not scored); no definite one may fail.
+        let definite: Vec<_> = out
+            .failures
+            .iter()
+            .filter(|f| f.definite)
+            .map(|f| &f.id)
+            .collect();
+        assert!(definite.is_empty(), "{definite:?}");
+        // The answer-shaped print went to stderr (the tail keeps the last 4 KB, which the quad
+        // prints, coming last, fill).
         assert!(
-            out.stderr_tail.contains("debug: root"),
+            out.stderr_tail
+                .contains(r#"{"id": "quad-basic-0000", "hit": false}"#),
             "{}",
             out.stderr_tail
         );
