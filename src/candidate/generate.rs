@@ -2,157 +2,20 @@
 //! aimed so that about half hit, with negative radii, rays from inside, primitives behind the
 //! origin, finite intervals and rays exactly parallel to a quad.
 //!
-//! Classification goes through one function, [`oracle_expect`]. Until the exact oracle
-//! (`rtoracle::oracle` generators and classification) is merged it is a *stand-in*: the
-//! reference tracer's answer, accepted as definite only when every perturbation of the inputs
-//! by a relative 1e-7 gives the same decision (so the case is far from any tangent, edge,
-//! interval end or grazing angle), and `None` otherwise. Swap its body for the exact oracle.
+//! Classification goes through one function, [`oracle_expect`]: the exact oracle's class
+//! ([`crate::oracle::classify`]), keeping only the definite cases (a candidate is judged on
+//! nothing floating point cannot settle).
 
 use rand_core::Rng;
 use rand_pcg::Pcg64;
 
-use crate::geometry::{Interval, Shape};
-use crate::oracle::vectors::{Case, Class, Expect, RaySpec, ShapeKind, ShapeSpec};
+use crate::oracle::vectors::{Case, Expect, RaySpec, ShapeKind, ShapeSpec};
 
-/// Relative size of the perturbations [`oracle_expect`] uses.
-const MARGIN: f64 = 1e-7;
-
-/// The expected answer for a case when it is definite, `None` when it is not (degenerate,
-/// non-finite, or too close to a decision boundary). Stand-in for the exact oracle: see the
-/// module docs.
+/// The exact oracle's expected answer for a case when it is definite, `None` when it is not
+/// (degenerate, non-finite, or within the error band of a decision boundary).
 pub fn oracle_expect(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Option<Expect> {
-    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    let usable = finite(&shape.numbers())
-        && finite(&ray.origin)
-        && finite(&ray.direction)
-        && finite(&interval)
-        && interval[0] < interval[1];
-    if !usable {
-        return None;
-    }
-    let d = glam::DVec3::from(ray.direction);
-    let dlen = d.length();
-    if dlen == 0.0 {
-        return None;
-    }
-    let mut tags = Vec::new();
-    match *shape {
-        ShapeSpec::Sphere { radius, .. } => {
-            if radius == 0.0 {
-                return None;
-            }
-            if radius < 0.0 {
-                tags.push("negative-radius".to_string());
-            }
-        }
-        ShapeSpec::Quad { q, u, v } => {
-            let n = glam::DVec3::from(u).cross(glam::DVec3::from(v));
-            if n.length() == 0.0 {
-                return None;
-            }
-            let nd = n.normalize().dot(d);
-            if nd == 0.0 {
-                // A parallel ray in the plane is degenerate (`any`); off the plane, a miss.
-                let off = n.dot(glam::DVec3::from(ray.origin) - glam::DVec3::from(q));
-                if off.abs() <= 1e-9 * n.length() * (1.0 + glam::DVec3::from(ray.origin).length()) {
-                    return None;
-                }
-                tags.push("parallel".to_string());
-            } else if nd.abs() < 1e-6 * dlen || nd.abs() < 1e-7 {
-                // Near parallel: honest variants (near_zero or == 0) disagree.
-                return None;
-            }
-        }
-        ShapeSpec::Triangle { a, b, c } => {
-            let (a, b, c) = (
-                glam::DVec3::from(a),
-                glam::DVec3::from(b),
-                glam::DVec3::from(c),
-            );
-            let n = (b - a).cross(c - a);
-            if n.length() == 0.0 {
-                return None;
-            }
-            if n.normalize().dot(d).abs() < 1e-6 * dlen {
-                return None;
-            }
-        }
-    }
-    let answer = |s: &ShapeSpec, r: &RaySpec, i: [f64; 2]| {
-        s.object().intersect(&r.ray(), Interval::new(i[0], i[1]))
-    };
-    let base = answer(shape, ray, interval);
-    // Perturb every input by a relative MARGIN in both directions.
-    let scale = shape
-        .numbers()
-        .iter()
-        .chain(&ray.origin)
-        .fold(1.0f64, |m, x| m.max(x.abs()));
-    let mut agree = true;
-    let mut check = |s: &ShapeSpec, r: &RaySpec, i: [f64; 2]| {
-        if answer(s, r, i).is_some() != base.is_some() {
-            agree = false;
-        }
-    };
-    for k in 0..3 {
-        for sign in [-1.0, 1.0] {
-            let mut r = *ray;
-            r.origin[k] += sign * MARGIN * scale;
-            check(shape, &r, interval);
-            let mut r = *ray;
-            r.direction[k] += sign * MARGIN * dlen;
-            check(shape, &r, interval);
-        }
-    }
-    for sign in [-1.0, 1.0] {
-        for end in 0..2 {
-            let mut i = interval;
-            if i[end].abs() < 1e300 {
-                i[end] += sign * MARGIN * i[end].abs().max(1.0);
-                check(shape, ray, i);
-            }
-        }
-        let s = match *shape {
-            ShapeSpec::Sphere { center, radius } => ShapeSpec::Sphere {
-                center,
-                radius: radius * (1.0 + sign * MARGIN),
-            },
-            ShapeSpec::Quad { q, u, v } => ShapeSpec::Quad {
-                q,
-                u: u.map(|x| x * (1.0 + sign * MARGIN)),
-                v: v.map(|x| x * (1.0 + sign * MARGIN)),
-            },
-            ShapeSpec::Triangle { a, b, c } => ShapeSpec::Triangle {
-                a: a.map(|x| x + sign * MARGIN * scale),
-                b,
-                c: c.map(|x| x - sign * MARGIN * scale),
-            },
-        };
-        check(&s, ray, interval);
-    }
-    if !agree {
-        return None;
-    }
-    Some(match base {
-        None => Expect {
-            class: Class::Miss,
-            tags,
-            t: None,
-            t_tol: None,
-            point: None,
-            normal: None,
-            front_face: None,
-        },
-        Some(h) => Expect {
-            class: Class::Hit,
-            tags,
-            t: Some(h.t),
-            t_tol: Some(1e-9 * h.t.abs().max(1.0)),
-            point: Some(h.point.to_array()),
-            normal: Some(h.normal.to_array()),
-            front_face: Some(h.front_face),
-        },
-    })
+    let expect = crate::oracle::classify::classify(shape, ray, interval);
+    expect.class.is_definite().then_some(expect)
 }
 
 /// A seeded stream of random inputs.
@@ -368,6 +231,7 @@ pub fn random_cases(seed: u64, stream: u64, n: usize, kinds: &[ShapeKind]) -> Ve
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::oracle::vectors::Class;
 
     #[test]
     fn cases_are_deterministic_mixed_and_mostly_definite() {

@@ -25,11 +25,56 @@ enum Area {
     /// The reference tracer: primary rays per second on one thread against a plain C loop
     /// doing the same work, the speedup on all threads, and peak memory per pixel.
     Render(render::Args),
+    /// The intersection oracle: reference against exact decisions on random cases across scales
+    /// and distances, the naive course formula beside it, classification rate, suite generation.
+    Oracle {
+        /// Random sphere cases (planes get a fifth as many).
+        #[arg(long, default_value_t = 1_000_000)]
+        cases: usize,
+    },
+    /// Checking candidates: vectors per second through the Python adapter against the in-process
+    /// reference and an echo adapter.
+    Candidate,
+    /// The image comparison: one 400x400 comparison and the whole command, against a plain
+    /// per-pixel difference.
+    Compare,
+    /// Grading: one submission and a batch of 30 against starting Python once.
+    Grade,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.area {
         Area::Render(args) => render::run(args),
+        Area::Oracle { cases } => {
+            let mut opts = rtoracle::oracle::bench::Options::default();
+            if cases != opts.sphere_cases {
+                opts.sphere_cases = cases;
+                opts.plane_cases = cases / 5;
+                opts.silhouette_cases = (cases / 10).max(1000);
+            }
+            print!("{}", rtoracle::oracle::bench::run(opts));
+            Ok(ExitCode::SUCCESS)
+        }
+        Area::Candidate => {
+            print!("{}", rtoracle::candidate::bench::run()?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Area::Compare => {
+            print!("{}", rtoracle::compare::bench::run());
+            Ok(ExitCode::SUCCESS)
+        }
+        Area::Grade => {
+            let fixtures =
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/submissions");
+            if !fixtures.is_dir() {
+                anyhow::bail!(
+                    "{}: the grade benchmark needs the repository's fixture submissions; run it from a checkout",
+                    fixtures.display()
+                );
+            }
+            rtoracle::grade::bench::run();
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 

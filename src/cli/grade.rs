@@ -3,9 +3,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::grade::{
-    CourseCodeChecker, Format, Rubric, StandinImageChecker, batch, grade_to_dir,
-};
+use rtoracle::grade::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
 use rtoracle::oracle::vectors::read_vectors;
 
 /// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--vectors FILE.jsonl] [--out DIR] [--format all|json,gradescope,junit,markdown]`
@@ -60,7 +58,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.case_timeout_ms == 0 {
         anyhow::bail!("--case-timeout-ms 0: the limit must be at least 1 ms");
     }
-    // The image checker is a STAND-IN until `compare` is wired in (see rtoracle::grade::standin).
     let vectors = match &args.vectors {
         Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
         None => None,
@@ -71,7 +68,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         case_timeout: Duration::from_millis(args.case_timeout_ms),
         ..Default::default()
     };
-    let images = StandinImageChecker::default();
+    let images = rtoracle::compare::CompareImageChecker::default();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()

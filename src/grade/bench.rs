@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
-use super::{CourseCodeChecker, Format, Rubric, StandinImageChecker, batch, grade_to_dir};
+use super::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
+use crate::compare::CompareImageChecker;
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 
@@ -176,7 +177,7 @@ pub fn run() -> (f64, f64) {
             &honest,
             &rubric,
             &CourseCodeChecker::default(),
-            &StandinImageChecker::default(),
+            &CompareImageChecker::default(),
             &work.path().join("one"),
             &Format::ALL,
         )
@@ -189,7 +190,7 @@ pub fn run() -> (f64, f64) {
             &subs,
             &rubric,
             &CourseCodeChecker::default(),
-            &StandinImageChecker::default(),
+            &CompareImageChecker::default(),
             &work.path().join("batch"),
             &Format::ALL,
         )

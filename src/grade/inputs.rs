@@ -1,9 +1,10 @@
 //! The two narrow interfaces grading is built on: one checks a submission's code against the
 //! intersection vectors, the other compares one of its images with the reference.
 //!
-//! [`grade`](super::grade) only ever talks to a [`CodeChecker`] and an [`ImageChecker`], so the
-//! real `check` and `compare` modules plug in by implementing these two traits; the stand-ins in
-//! [`standin`](super::standin) and the fakes of the tests implement them too.
+//! [`grade`](super::grade) only ever talks to a [`CodeChecker`] and an [`ImageChecker`]: the
+//! `check` harness ([`CourseCodeChecker`](super::CourseCodeChecker)), the noise-aware comparison
+//! ([`CompareImageChecker`](crate::compare::CompareImageChecker)) and the fakes of the tests
+//! implement them.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

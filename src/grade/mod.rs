@@ -5,16 +5,18 @@
 //!
 //! Grading sees the code under test only through [`CodeChecker`] and the images only through
 //! [`ImageChecker`] ([`inputs`]). The code checker is [`CourseCodeChecker`] ([`checkers`]): the
-//! `check` harness running the course adapter in the [sandbox](crate::sandbox); [`standin`]
-//! holds a simple image checker until the real comparison module is wired in.
+//! `check` harness running the course adapter in the [sandbox](crate::sandbox); the image
+//! checker is [`CompareImageChecker`](crate::compare::CompareImageChecker), the noise-aware
+//! comparison against the embedded goldens.
 //!
 //! ```no_run
-//! use rtoracle::grade::{CourseCodeChecker, Format, Rubric, StandinImageChecker, grade_to_dir};
+//! use rtoracle::compare::CompareImageChecker;
+//! use rtoracle::grade::{CourseCodeChecker, Format, Rubric, grade_to_dir};
 //! let report = grade_to_dir(
 //!     "submission".as_ref(),
 //!     &Rubric::week04(),
 //!     &CourseCodeChecker::default(),
-//!     &StandinImageChecker::default(),
+//!     &CompareImageChecker::default(),
 //!     "grade-report".as_ref(),
 //!     &Format::ALL,
 //! )?;
@@ -30,7 +32,6 @@ pub mod inputs;
 pub mod report;
 pub mod rubric;
 mod run;
-pub mod standin;
 
 pub use checkers::CourseCodeChecker;
 pub use inputs::{
@@ -43,4 +44,3 @@ pub use run::{
     ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,
     write_reports,
 };
-pub use standin::StandinImageChecker;
