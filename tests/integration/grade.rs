@@ -324,7 +324,7 @@ fn report_json_holds_checks_repros_metrics_pictures_and_hashes() {
     assert!(printed.starts_with("(6.0,"), "the far root: {printed}");
     // Images: metrics, and the heatmap on disk.
     let image = &r["checks"][2]["image"];
-    assert!(image["metrics"]["off_fraction"].as_f64().unwrap() <= 0.02);
+    assert_eq!(image["metrics"]["verdict"], "pass", "{}", image["metrics"]);
     assert!(dir.join(image["heatmap"].as_str().unwrap()).is_file());
     // Reproducibility.
     let rep = &r["reproducibility"];
@@ -510,7 +510,13 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
         String::from_utf8_lossy(&run.stderr)
     );
     let results = read_json(&root.join("results/results.json"));
-    let tests = results["tests"].as_array().unwrap();
+    // The four scored checks (the report of ambiguous vectors, worth no points, aside).
+    let tests: Vec<_> = results["tests"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|t| t["max_score"].as_f64().unwrap() > 0.0)
+        .collect();
     assert_eq!(tests.len(), 4);
     assert_eq!(tests[0]["status"], "failed");
     assert!(tests[1..].iter().all(|t| t["status"] == "passed"));
