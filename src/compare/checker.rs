@@ -83,7 +83,11 @@ impl ImageChecker for CompareImageChecker {
             Err(e) => return ImageOutcome::unusable(format!("no golden for {scene}: {e}")),
         };
         if let Err(e) = check_size(candidate_png, &candidate, golden.width, golden.height) {
-            return ImageOutcome::unusable(e.to_string());
+            // Name the file as the student knows it, not by the grader's path.
+            let why = e
+                .to_string()
+                .replace(&format!("{}: ", candidate_png.display()), "");
+            return ImageOutcome::unusable(format!("{name} {why}"));
         }
         let comparison = match compare_image(&candidate, &golden, &self.options) {
             Ok(c) => c,

@@ -50,7 +50,7 @@ impl Default for CourseCodeChecker {
             vectors: None,
             case_timeout: Duration::from_secs(2),
             import_timeout: Duration::from_secs(5),
-            max_timeouts_per_group: 2,
+            max_timeouts_per_group: 3,
             policy: SandboxPolicy::grading(),
             python: None,
         }

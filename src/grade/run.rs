@@ -190,14 +190,22 @@ pub enum GradeError {
 /// The failure a student should look at first: one that ran (not a time-out or not run when
 /// another exists), with the fewest edge-case tags, then the shortest reproduction.
 pub fn smallest_failure(failures: &[FailureSummary]) -> Option<&FailureSummary> {
-    failures.iter().filter(|f| f.definite).min_by_key(|f| {
-        (
-            matches!(f.kind, FailureKind::NotRun | FailureKind::Timeout),
-            f.tags.len(),
-            f.repro.len(),
-            f.id.clone(),
-        )
-    })
+    failures
+        .iter()
+        .filter(|f| f.definite)
+        .min_by_key(|f| simplicity(f))
+}
+
+/// What makes a failure easy to show a student, smallest first: an answer (not a timeout),
+/// definite, few edge-case tags, a short reproduction (small numbers), then the id.
+fn simplicity(f: &FailureSummary) -> (bool, bool, usize, usize, String) {
+    (
+        matches!(f.kind, FailureKind::NotRun | FailureKind::Timeout),
+        !f.definite,
+        f.tags.len(),
+        f.repro.len(),
+        f.id.clone(),
+    )
 }
 
 /// Rounds to 1/100 of a point.
@@ -208,13 +216,15 @@ pub fn round2(x: f64) -> f64 {
 fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
     let shape = group.shape.expect("validated: code groups have a shape");
     let counts = outcome.per_group.get(&shape).cloned().unwrap_or_default();
-    let failures: Vec<FailureSummary> = outcome
+    // The simplest failures of the group are the ones shown (and reproduced in the feedback).
+    let mut failures: Vec<FailureSummary> = outcome
         .failures
         .iter()
         .filter(|f| f.shape == shape && (f.definite || group.score_ambiguous))
-        .take(FAILURES_SHOWN)
         .cloned()
         .collect();
+    failures.sort_by_cached_key(simplicity);
+    failures.truncate(FAILURES_SHOWN);
     let (passed, total) = if group.score_ambiguous {
         (
             counts.passed + counts.ambiguous_passed,
@@ -337,12 +347,16 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
         ImageVerdict::Fail => (
             0.0,
             CheckStatus::Failed,
-            format!(
-                "{file} differs from the reference of {scene}. {}",
-                outcome.diagnosis.clone().unwrap_or_default()
-            )
-            .trim_end()
-            .to_string(),
+            match outcome.diagnosis.as_deref().map(str::trim) {
+                Some(d) if !d.is_empty() => {
+                    let mut chars = d.chars();
+                    let first = chars.next().map(|c| c.to_uppercase().collect::<String>());
+                    let d = format!("{}{}", first.unwrap_or_default(), chars.as_str());
+                    let end = if d.ends_with('.') { "" } else { "." };
+                    format!("{file} differs from the reference of {scene}. {d}{end}")
+                }
+                _ => format!("{file} differs from the reference of {scene}."),
+            },
         ),
         ImageVerdict::Unusable(why) => (
             0.0,

@@ -95,7 +95,7 @@ pub fn render(report: &GradeReport) -> String {
             if img.heatmap.is_some() {
                 let _ = writeln!(
                     md,
-                    "\nRed in the heatmap of {} below marks where it differs from the reference.",
+                    "\nIn the heatmap of {} below, red marks pixels brighter than the reference allows, blue darker ones, and green boxes outline the regions that fail.",
                     img.file
                 );
             }
@@ -120,7 +120,7 @@ pub fn render(report: &GradeReport) -> String {
         .filter_map(|i| i.heatmap.as_deref().map(|h| (i.file.as_str(), h)))
         .collect();
     if !heatmaps.is_empty() {
-        md.push_str("\n## Heatmaps\n\nYour images against the reference: grey where they agree, red where a pixel differs by more than the noise allows.\n");
+        md.push_str("\n## Heatmaps\n\nYour images against the reference, as signed z-scores: white where they agree up to sampling noise, red where yours is brighter, blue where darker; green boxes outline the regions that fail.\n");
         for (file, h) in heatmaps {
             let _ = writeln!(md, "\n![{file} against the reference]({h})");
         }
