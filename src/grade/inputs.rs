@@ -63,34 +63,8 @@ pub struct GroupCounts {
     pub ambiguous_passed: usize,
 }
 
-/// How one vector went wrong.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FailureKind {
-    /// An answer that differs from the expected one.
-    Mismatch,
-    /// The code raised an exception.
-    Error,
-    /// No answer within the per-case time limit (or the interpreter died on it).
-    Timeout,
-    /// Not run.
-    NotRun,
-    /// The answer could not be read (stray output, junk).
-    Protocol,
-}
-
-impl FailureKind {
-    /// The snake_case name.
-    pub fn name(self) -> &'static str {
-        match self {
-            FailureKind::Mismatch => "mismatch",
-            FailureKind::Error => "error",
-            FailureKind::Timeout => "timeout",
-            FailureKind::NotRun => "not_run",
-            FailureKind::Protocol => "protocol",
-        }
-    }
-}
+/// How one vector went wrong: the `check` harness's own kinds.
+pub use crate::candidate::FailureKind;
 
 /// One failing vector, ready to be shown to a student.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
