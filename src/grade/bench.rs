@@ -55,8 +55,8 @@ pub fn fixture_names() -> Vec<String> {
     names
 }
 
-/// Makes fixture `name` a submission in `dest` (created): the `.py` files of its `base` then its
-/// own, and its images rendered by the reference renderer (20 spp, the fixture's seed and
+/// Makes fixture `name` a submission in `dest` (created): the shared course modules of
+/// `tests/fixtures/python/common`, the `.py` files of its `base`, then its own, and its images rendered by the reference renderer (20 spp, the fixture's seed and
 /// width). Returns the rubric groups it is meant to lose points in.
 pub fn materialize(name: &str, dest: &Path) -> Result<Vec<String>, String> {
     let spec = materialize_spec(name, dest)?;
@@ -90,6 +90,9 @@ fn materialize_spec(name: &str, dest: &Path) -> Result<FixtureSpec, String> {
         }
         Ok(())
     };
+    // The course's shared modules (RT_utility, RT_ray, RT_material) are the ones the `check`
+    // fixtures use; a fixture's `base` and its own files come on top.
+    copy_py(&fixtures_dir().join("../python/common"))?;
     if let Some(base) = &spec.base {
         copy_py(&fixtures_dir().join(base))?;
     }
