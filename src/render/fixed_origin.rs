@@ -7,10 +7,19 @@
 //! The decisions themselves are the very functions the shapes' [`Shape`](crate::geometry::Shape)
 //! implementations call, fed the same values, so the closest hit is the same, bit for bit, as
 //! [`Scene::closest`]'s (a test checks it on millions of rays).
+//!
+//! The renderer asks for packets of [`WIDTH`] rays at once ([`FixedOrigin::closest_packet`]):
+//! in a scene of spheres only or quads only, each object is decided for all the lanes in
+//! straight-line code (vector instructions, no branch per ray), operation for operation as the
+//! scalar functions do it, and each lane keeps its own closest hit, as the scalar loop does. A
+//! sphere the pre-filter rules out for every lane, or a quad whose plane no lane meets within its
+//! interval, is skipped for the packet. Lanes whose intermediates over- or underflow, and scenes of
+//! mixed kinds, take the scalar path, lane by lane.
 
 use glam::DVec3;
 
-use crate::geometry::{Interval, Quad, Ray};
+use super::packet::{Directions, Lanes, NO_HIT, WIDTH};
+use crate::geometry::{Interval, PARALLEL_EPSILON, Quad, Ray};
 use crate::geometry::{Shape, Sphere, Triangle, pick_root, roots_of};
 use crate::scene::{Object, Scene};
 
@@ -85,6 +94,128 @@ impl PreparedSphere {
             // Over- or underflow: the sphere's own path rescales.
             Err(()) => self.sphere.hit_t(&Ray::new(origin, d), within),
         }
+    }
+
+    /// [`Self::hit_t`] for each lane's direction, against each lane's interval
+    /// `(min, closest[k])`: where it hits, `closest[k]` becomes its `t` and `index[k]` becomes
+    /// `me`. The same operations in the same order as the scalar path, so the same bits; `Err`
+    /// (with the lanes half updated) when a lane's intermediates over- or underflow, which only
+    /// the scalar path handles.
+    #[inline(always)]
+    // Lane loops index several arrays in step.
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+    fn hit_lanes(
+        &self,
+        d: &Directions,
+        a: &Lanes,
+        a_margin: &Lanes,
+        min: f64,
+        closest: &mut Lanes,
+        index: &mut [u64; WIDTH],
+        me: u64,
+    ) -> Result<(), ()> {
+        // Masks are kept as all-ones or zero words (not `bool`s), which stay in vector registers.
+        let mut half_b = [0.0; WIDTH];
+        let mut wanted = [0u64; WIDTH];
+        for k in 0..WIDTH {
+            half_b[k] = self.f.x * d.x[k] + self.f.y * d.y[k] + self.f.z * d.z[k];
+            let sure_miss = half_b[k] * half_b[k] - a[k] * self.c < -(a_margin[k] * self.scale);
+            wanted[k] = if sure_miss { 0 } else { u64::MAX };
+        }
+        if wanted.iter().fold(0, |any, &w| any | w) == 0 {
+            return Ok(());
+        }
+        let constants_sane = self.c.is_finite() && self.r2 < 1e300;
+        let mut overflow = [0u64; WIDTH];
+        for k in 0..WIDTH {
+            let (hb, ak) = (half_b[k], a[k]);
+            // `roots_of`, lane by lane.
+            let sane = ak.is_normal() & (ak < 1e300) & constants_sane & hb.is_finite();
+            let s = hb / ak;
+            let px = self.f.x - d.x[k] * s;
+            let py = self.f.y - d.y[k] * s;
+            let pz = self.f.z - d.z[k] * s;
+            let disc = ak * (self.r2 - (px * px + py * py + pz * pz));
+            overflow[k] = wanted[k] & if sane & disc.is_finite() { 0 } else { u64::MAX };
+            let q = -(hb + disc.sqrt().copysign(hb));
+            let t0 = self.c / q;
+            let t1 = q / ak;
+            let double = -hb / ak;
+            let (near, far) = if q == 0.0 {
+                (double, double)
+            } else if t0 <= t1 {
+                (t0, t1)
+            } else {
+                (t1, t0)
+            };
+            // `pick_root` against `(min, closest[k])`.
+            let within = Interval::new(min, closest[k]);
+            let (near_in, far_in) = (within.surrounds(near), within.surrounds(far));
+            let hit = (wanted[k] != 0) & (disc >= 0.0) & (near_in | far_in);
+            let t = if near_in { near } else { far };
+            closest[k] = if hit { t } else { closest[k] };
+            index[k] = if hit { me } else { index[k] };
+        }
+        if overflow.iter().fold(0, |any, &o| any | o) != 0 {
+            return Err(());
+        }
+        Ok(())
+    }
+}
+
+/// `Quad::solve_from` for each lane's direction from `origin`, against each lane's interval
+/// `[min, closest[k]]`: where it hits, `closest[k]` becomes its `t` and `index[k]` becomes `me`.
+/// The same operations in the same order as the scalar path, so the same bits.
+#[inline(always)]
+// Lane loops index several arrays in step.
+#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+fn quad_hit_lanes(
+    quad: &Quad,
+    offset: f64,
+    origin: DVec3,
+    d: &Directions,
+    min: f64,
+    closest: &mut Lanes,
+    index: &mut [u64; WIDTH],
+    me: u64,
+) {
+    let (n, q, u, v, w) = (quad.normal, quad.q, quad.u, quad.v, quad.w);
+    // The plane first: when no lane meets it within its interval (behind the eye, or beyond
+    // what a lane has already hit), the quad is skipped for the whole packet.
+    let mut denoms = [0.0; WIDTH];
+    let mut ts = [0.0; WIDTH];
+    let mut inside = [0u64; WIDTH];
+    for k in 0..WIDTH {
+        denoms[k] = n.x * d.x[k] + n.y * d.y[k] + n.z * d.z[k];
+        ts[k] = offset / denoms[k];
+        inside[k] = if (min <= ts[k]) & (ts[k] <= closest[k]) {
+            u64::MAX
+        } else {
+            0
+        };
+    }
+    if inside.iter().fold(0, |any, &i| any | i) == 0 {
+        return;
+    }
+    for k in 0..WIDTH {
+        let (denom, t) = (denoms[k], ts[k]);
+        // `ray.at(t) - q`.
+        let px = (origin.x + d.x[k] * t) - q.x;
+        let py = (origin.y + d.y[k] * t) - q.y;
+        let pz = (origin.z + d.z[k] * t) - q.z;
+        // `w . (planar x v)` and `w . (u x planar)`.
+        let alpha =
+            w.x * (py * v.z - v.y * pz) + w.y * (pz * v.x - v.z * px) + w.z * (px * v.y - v.x * py);
+        let beta =
+            w.x * (u.y * pz - py * u.z) + w.y * (u.z * px - pz * u.x) + w.z * (u.x * py - px * u.y);
+        let hit = (denom.abs() >= PARALLEL_EPSILON)
+            & t.is_finite()
+            & (min <= t)
+            & (t <= closest[k])
+            & (0.0..=1.0).contains(&alpha)
+            & (0.0..=1.0).contains(&beta);
+        closest[k] = if hit { t } else { closest[k] };
+        index[k] = if hit { me } else { index[k] };
     }
 }
 
@@ -176,6 +307,65 @@ impl FixedOrigin {
             Layout::Quads(quads) => self.closest_quad(quads, d, interval),
             Layout::Mixed(objects) => self.closest_mixed(objects, d, interval),
         }
+    }
+
+    /// The index of the closest hit along each lane's direction ([`NO_HIT`] for none): for every
+    /// lane, the same answer as [`Self::closest`].
+    #[inline(always)]
+    // Lane loops index several arrays in step.
+    #[allow(clippy::needless_range_loop)]
+    pub(crate) fn closest_packet(&self, d: &Directions, interval: Interval) -> [u64; WIDTH] {
+        let mut closest = [interval.max; WIDTH];
+        let mut index = [NO_HIT; WIDTH];
+        match &self.layout {
+            Layout::Spheres(spheres) => {
+                let mut a = [0.0; WIDTH];
+                let mut a_margin = [0.0; WIDTH];
+                for k in 0..WIDTH {
+                    a[k] = d.x[k] * d.x[k] + d.y[k] * d.y[k] + d.z[k] * d.z[k];
+                    a_margin[k] = Self::margin(a[k]);
+                }
+                for (me, sphere) in spheres.iter().enumerate() {
+                    let lanes = sphere.hit_lanes(
+                        d,
+                        &a,
+                        &a_margin,
+                        interval.min,
+                        &mut closest,
+                        &mut index,
+                        me as u64,
+                    );
+                    if lanes.is_err() {
+                        return self.closest_each(d, interval);
+                    }
+                }
+            }
+            Layout::Quads(quads) => {
+                for (me, (quad, offset)) in quads.iter().enumerate() {
+                    quad_hit_lanes(
+                        quad,
+                        *offset,
+                        self.origin,
+                        d,
+                        interval.min,
+                        &mut closest,
+                        &mut index,
+                        me as u64,
+                    );
+                }
+            }
+            Layout::Mixed(_) => return self.closest_each(d, interval),
+        }
+        index
+    }
+
+    /// [`Self::closest_packet`] one lane at a time.
+    #[inline(never)]
+    fn closest_each(&self, d: &Directions, interval: Interval) -> [u64; WIDTH] {
+        std::array::from_fn(|k| {
+            self.closest(d.lane(k), interval)
+                .map_or(NO_HIT, |(_, index)| index as u64)
+        })
     }
 
     /// `a * PREFILTER_MARGIN` for `a = d . d`, or NaN (pre-filter off) unless `a` is far from
@@ -308,7 +498,9 @@ mod tests {
                     }
                 }
             }
-            for target in targets {
+            let mut packet = Directions::default();
+            let mut expected_indices = [NO_HIT; WIDTH];
+            for (n, target) in targets.into_iter().enumerate() {
                 let d = target - camera.center;
                 let ray = Ray::new(camera.center, d);
                 let expected = scene.closest(&ray, Interval::CAMERA);
@@ -319,6 +511,17 @@ mod tests {
                     "{} along {d}",
                     builtin.name
                 );
+                // Packets of consecutive targets: neighbours in the image, or unrelated features.
+                packet.set(n % WIDTH, d);
+                expected_indices[n % WIDTH] = expected.map_or(NO_HIT, |(_, i)| i as u64);
+                if n % WIDTH == WIDTH - 1 {
+                    assert_eq!(
+                        fast.closest_packet(&packet, Interval::CAMERA),
+                        expected_indices,
+                        "{} along {packet:?}",
+                        builtin.name
+                    );
+                }
                 checked += 1;
             }
         }
@@ -346,6 +549,159 @@ mod tests {
                 expected.map(|(t, i)| (t.to_bits(), i)),
                 "{d}"
             );
+        }
+    }
+
+    /// A scene of `shapes`, all with one material.
+    fn scene_of(shapes: &[Object]) -> Scene {
+        Scene {
+            objects: shapes
+                .iter()
+                .map(|&shape| crate::scene::SceneObject { shape, material: 0 })
+                .collect(),
+            materials: vec![crate::scene::Material::Lambertian {
+                albedo: DVec3::splat(0.5),
+            }],
+        }
+    }
+
+    /// Exact cases the random rays above almost never meet, each with a known answer: equal
+    /// spheres keep the first (the open `surrounds`), equal quads the last (the closed
+    /// `contains`), a ray tangent to a sphere with a discriminant of exactly 0 hits it at `t = 5`,
+    /// a ray through a quad's corner hits it, a quad exactly at `t = 1e-6` is hit (closed) and one
+    /// at `t = 2^-20 < 1e-6` is not. Every lane of a packet gets the scene's answer, in any lane.
+    #[test]
+    fn packets_keep_ties_tangents_and_boundaries() {
+        let eye = DVec3::new(-5.0, 0.0, 0.0);
+        let sphere = Sphere::new(DVec3::new(0.0, 0.0, -1.0), 1.0);
+        // A square in the plane x = x0 facing -x (normal (1, 0, 0) from u x v = (4, 0, 0)), from
+        // (x0, 0, 0) to (x0, 2, -2).
+        let square_at = |x0: f64| {
+            Quad::new(
+                DVec3::new(x0, 0.0, 0.0),
+                DVec3::new(0.0, 0.0, -2.0),
+                DVec3::new(0.0, 2.0, 0.0),
+            )
+        };
+        let square = square_at(0.0);
+        let cases: [(&str, DVec3, Vec<Object>, DVec3, u64); 7] = [
+            (
+                "equal spheres",
+                eye,
+                vec![Object::Sphere(sphere), Object::Sphere(sphere)],
+                DVec3::new(5.0, 0.0, -1.0),
+                0,
+            ),
+            (
+                "equal quads",
+                eye,
+                vec![Object::Quad(square), Object::Quad(square)],
+                DVec3::new(5.0, 1.0, -1.0),
+                1,
+            ),
+            // f = (-5, 0, 1), a = 1, b' = -5: the perpendicular is (0, 0, 1) and the
+            // discriminant 1 * (1 - 1) = 0 exactly; q = 5, both roots 25 / 5 = 5 / 1 = 5.
+            (
+                "tangent sphere",
+                eye,
+                vec![Object::Sphere(sphere)],
+                DVec3::new(1.0, 0.0, 0.0),
+                0,
+            ),
+            (
+                "quad corner",
+                eye,
+                vec![Object::Quad(square)],
+                DVec3::new(5.0, 0.0, 0.0),
+                0,
+            ),
+            // offset = 1e-6 - 0 and t = 1e-6 / 1, both exact.
+            (
+                "quad at t = 1e-6",
+                DVec3::new(0.0, 1.0, -1.0),
+                vec![Object::Quad(square_at(1e-6))],
+                DVec3::new(1.0, 0.0, 0.0),
+                0,
+            ),
+            // -5 + 2^-20 is exact, so t = 2^-20 ~ 9.5e-7.
+            (
+                "quad at t = 2^-20",
+                DVec3::new(-5.0, 1.0, -1.0),
+                vec![Object::Quad(square_at(-5.0 + 2f64.powi(-20)))],
+                DVec3::new(1.0, 0.0, 0.0),
+                NO_HIT,
+            ),
+            (
+                "no hit behind",
+                eye,
+                vec![Object::Sphere(sphere), Object::Quad(square)],
+                DVec3::new(-1.0, 0.0, 0.0),
+                NO_HIT,
+            ),
+        ];
+        let filler = DVec3::new(0.0, 1.0, 0.0);
+        for (what, origin, shapes, d, answer) in cases {
+            let scene = scene_of(&shapes);
+            let expected = scene
+                .closest(&Ray::new(origin, d), Interval::CAMERA)
+                .map_or(NO_HIT, |(_, i)| i as u64);
+            assert_eq!(expected, answer, "{what}: the scene's own answer");
+            let fast = FixedOrigin::new(&scene, origin);
+            for slot in 0..WIDTH {
+                let mut packet = Directions::default();
+                for k in 0..WIDTH {
+                    packet.set(k, if k == slot { d } else { filler });
+                }
+                let got = fast.closest_packet(&packet, Interval::CAMERA);
+                assert_eq!(got[slot], answer, "{what} in lane {slot}");
+            }
+        }
+    }
+
+    /// A packet where one lane's intermediates overflow (a direction near `f64::MAX`, or one so
+    /// short its square underflows) takes the scalar path for all its lanes, and every lane still
+    /// gets the scene's answer; so does a lane with a NaN direction.
+    #[test]
+    fn packets_with_an_overflowing_lane_agree_with_the_scene() {
+        for name in ["week04-sphere", "week04-quad", "edge-cases", "triangles"] {
+            let description = crate::scene::builtin(name).unwrap();
+            let scene = description.scene();
+            let camera = description.camera(Some(32));
+            let fast = FixedOrigin::new(&scene, camera.center);
+            let ordinary = [
+                camera.pixel00 + 16.0 * camera.pixel_delta_u + 9.0 * camera.pixel_delta_v,
+                camera.pixel00 + 3.0 * camera.pixel_delta_u + 20.0 * camera.pixel_delta_v,
+                camera.pixel00 + 28.0 * camera.pixel_delta_u + 2.0 * camera.pixel_delta_v,
+            ]
+            .map(|target| target - camera.center);
+            for odd in [
+                DVec3::new(0.0, -1e300, -1e300),
+                DVec3::new(1e-200, -1e-200, -1e-200),
+                DVec3::new(f64::NAN, 0.0, -1.0),
+                DVec3::new(0.0, 0.0, f64::NEG_INFINITY),
+            ] {
+                for slot in 0..WIDTH {
+                    let mut packet = Directions::default();
+                    for k in 0..WIDTH {
+                        let d = if k == slot {
+                            odd
+                        } else {
+                            ordinary[k % ordinary.len()]
+                        };
+                        packet.set(k, d);
+                    }
+                    let expected: [u64; WIDTH] = std::array::from_fn(|k| {
+                        scene
+                            .closest(&Ray::new(camera.center, packet.lane(k)), Interval::CAMERA)
+                            .map_or(NO_HIT, |(_, i)| i as u64)
+                    });
+                    assert_eq!(
+                        fast.closest_packet(&packet, Interval::CAMERA),
+                        expected,
+                        "{name}: {odd} in lane {slot}"
+                    );
+                }
+            }
         }
     }
 }

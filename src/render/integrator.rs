@@ -7,7 +7,12 @@ use crate::scene::Scene;
 #[inline]
 pub fn sky(direction: DVec3) -> DVec3 {
     // `unit_vector(direction).y`, without the two divisions whose results are not used.
-    let a = 0.5 * (direction.y / direction.length() + 1.0);
+    sky_at(0.5 * (direction.y / direction.length() + 1.0))
+}
+
+/// The sky's colour at height `a = 0.5 (unit(d).y + 1)`: `(1 - a) (1, 1, 1) + a (0.5, 0.7, 1.0)`.
+#[inline(always)]
+pub(crate) fn sky_at(a: f64) -> DVec3 {
     (1.0 - a) * DVec3::ONE + a * DVec3::new(0.5, 0.7, 1.0)
 }
 

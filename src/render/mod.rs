@@ -4,6 +4,7 @@
 mod film;
 mod fixed_origin;
 mod integrator;
+mod packet;
 mod renderer;
 mod sampler;
 

@@ -5,7 +5,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use super::fixed_origin::FixedOrigin;
-use super::{Film, PixelSampler, radiance, sky};
+use super::integrator::sky_at;
+use super::packet::{Directions, WIDTH};
+use super::{Film, PixelSampler, radiance};
 use crate::geometry::{Interval, Ray};
 use crate::scene::{Camera, Scene};
 
@@ -78,33 +80,48 @@ fn strata(n: u32) -> (u32, u32) {
     (n / rows, rows)
 }
 
-/// The colour seen along a primary ray: the course's integrator, through the general scene or
-/// through the fixed-origin fast path (the same value, bit for bit).
+/// The colours seen along a packet of primary rays: the course's integrator, through the general
+/// scene or through the fixed-origin fast path (the same values, bit for bit).
 trait Trace: Sync {
-    fn trace(&self, ray: &Ray) -> DVec3;
+    fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH];
 }
 
 impl Trace for Scene {
     #[inline]
-    fn trace(&self, ray: &Ray) -> DVec3 {
-        radiance(self, ray)
+    fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH] {
+        rays.map(|ray| radiance(self, &ray))
     }
 }
 
 /// The fast path with the scene's materials.
-struct Pinhole<'a> {
+struct Pinhole {
     prepared: FixedOrigin,
-    scene: &'a Scene,
+    /// Each object's albedo.
+    albedos: Vec<DVec3>,
 }
 
-impl Trace for Pinhole<'_> {
+impl Trace for Pinhole {
     #[inline(always)]
-    fn trace(&self, ray: &Ray) -> DVec3 {
-        debug_assert_eq!(ray.origin, self.prepared.origin());
-        match self.prepared.closest(ray.direction, Interval::CAMERA) {
-            Some((_, index)) => self.scene.material_of(index).albedo(),
-            None => sky(ray.direction),
+    // Lane loops index several arrays in step.
+    #[allow(clippy::needless_range_loop)]
+    fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH] {
+        let mut d = Directions::default();
+        for (k, ray) in rays.iter().enumerate() {
+            debug_assert_eq!(ray.origin, self.prepared.origin());
+            d.set(k, ray.direction);
         }
+        let index = self.prepared.closest_packet(&d, Interval::CAMERA);
+        // The sky of every lane (as `sky` computes it), then the albedo where a lane hit: no
+        // branch per ray.
+        let mut height = [0.0; WIDTH];
+        for k in 0..WIDTH {
+            let length = (d.x[k] * d.x[k] + d.y[k] * d.y[k] + d.z[k] * d.z[k]).sqrt();
+            height[k] = 0.5 * (d.y[k] / length + 1.0);
+        }
+        std::array::from_fn(|k| match self.albedos.get(index[k] as usize) {
+            Some(&albedo) => albedo,
+            None => sky_at(height[k]),
+        })
     }
 }
 
@@ -119,9 +136,45 @@ struct Job<'a, T> {
 }
 
 impl<T: Trace> Job<'_, T> {
-    /// Renders row `j` into `means` (and `variances` when `VARIANCE`).
+    /// Renders row `j` into `means` (and `variances` when `VARIANCE`), with AVX2 where the
+    /// processor has it (four lanes per vector instead of two: the same operations, so the same
+    /// bits).
     #[inline]
     fn row<const VARIANCE: bool>(&self, j: usize, means: &mut [DVec3], variances: &mut [DVec3]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2, just checked.
+            unsafe { self.row_avx2::<VARIANCE>(j, means, variances) };
+            return;
+        }
+        self.row_any::<VARIANCE>(j, means, variances);
+    }
+
+    /// [`Self::row_any`] compiled for AVX2.
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2. (An `unsafe fn` rather than a safe one with the target
+    /// feature, which needs Rust 1.86, above the crate's minimum.)
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn row_avx2<const VARIANCE: bool>(
+        &self,
+        j: usize,
+        means: &mut [DVec3],
+        variances: &mut [DVec3],
+    ) {
+        self.row_any::<VARIANCE>(j, means, variances);
+    }
+
+    /// Renders row `j` with the jitter chosen.
+    #[inline(always)]
+    fn row_any<const VARIANCE: bool>(
+        &self,
+        j: usize,
+        means: &mut [DVec3],
+        variances: &mut [DVec3],
+    ) {
         match self.jitter {
             PixelJitter::Uniform => self.row_with::<VARIANCE, 0>(j, means, variances),
             PixelJitter::Stratified => self.row_with::<VARIANCE, 1>(j, means, variances),
@@ -140,6 +193,7 @@ impl<T: Trace> Job<'_, T> {
     ) {
         let width = self.camera.width;
         let (columns, rows_of_strata) = self.strata;
+        let no_ray = Ray::new(self.camera.center, DVec3::ZERO);
         for (i, mean) in means.iter_mut().enumerate() {
             let mut sampler = PixelSampler::new(self.seed, (j * width + i) as u64);
             let mut sum = DVec3::ZERO;
@@ -147,33 +201,47 @@ impl<T: Trace> Job<'_, T> {
             let mut highest = DVec3::NEG_INFINITY;
             let mut running_mean = DVec3::ZERO;
             let mut m2 = DVec3::ZERO;
-            for s in 0..self.spp {
-                let (ox, oy) = match JITTER {
-                    0 => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
-                    1 => {
-                        let (cx, cy) = ((s % columns) as f64, (s / columns) as f64);
-                        (
-                            (cx + sampler.next_f64()) / columns as f64 - 0.5,
-                            (cy + sampler.next_f64()) / rows_of_strata as f64 - 0.5,
-                        )
-                    }
-                    _ => (0.0, 0.0),
-                };
-                let disk = if self.camera.defocus {
-                    sampler.in_unit_disk()
-                } else {
-                    (0.0, 0.0)
-                };
-                let ray = self.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
-                let colour = self.tracer.trace(&ray);
-                sum += colour;
-                lowest = lowest.min(colour);
-                highest = highest.max(colour);
-                if VARIANCE {
-                    let delta = colour - running_mean;
-                    running_mean += delta / (s + 1) as f64;
-                    m2 += delta * (colour - running_mean);
+            // The samples in packets of `WIDTH`, drawn and accumulated in order; the lanes of a
+            // last, partial packet past the count repeat its first ray and are not used.
+            let mut first = 0;
+            while first < self.spp {
+                let count = (self.spp - first).min(WIDTH as u32) as usize;
+                let mut rays = [no_ray; WIDTH];
+                for (k, ray) in rays.iter_mut().enumerate().take(count) {
+                    let s = first + k as u32;
+                    let (ox, oy) = match JITTER {
+                        0 => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
+                        1 => {
+                            let (cx, cy) = ((s % columns) as f64, (s / columns) as f64);
+                            (
+                                (cx + sampler.next_f64()) / columns as f64 - 0.5,
+                                (cy + sampler.next_f64()) / rows_of_strata as f64 - 0.5,
+                            )
+                        }
+                        _ => (0.0, 0.0),
+                    };
+                    let disk = if self.camera.defocus {
+                        sampler.in_unit_disk()
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    *ray = self.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
                 }
+                for k in count..WIDTH {
+                    rays[k] = rays[0];
+                }
+                let colours = self.tracer.trace(&rays);
+                for (k, &colour) in colours.iter().enumerate().take(count) {
+                    sum += colour;
+                    lowest = lowest.min(colour);
+                    highest = highest.max(colour);
+                    if VARIANCE {
+                        let delta = colour - running_mean;
+                        running_mean += delta / (first + k as u32 + 1) as f64;
+                        m2 += delta * (colour - running_mean);
+                    }
+                }
+                first += count as u32;
             }
             // The sum over the count, except when every sample saw the same colour: then that
             // colour exactly (a sum of equal values over their count can be off by an ulp:
@@ -265,7 +333,9 @@ pub fn render(
     } else {
         let pinhole = Pinhole {
             prepared: FixedOrigin::new(scene, camera.center),
-            scene,
+            albedos: (0..scene.objects.len())
+                .map(|index| scene.material_of(index).albedo())
+                .collect(),
         };
         let job = Job {
             tracer: &pinhole,
@@ -290,6 +360,93 @@ pub fn render(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Renders every row of `job` with `row` (one of the dispatch's paths).
+    fn film_of<T: Trace>(
+        job: &Job<'_, T>,
+        row: impl Fn(&Job<'_, T>, usize, &mut [DVec3], &mut [DVec3]),
+    ) -> (Vec<u64>, Vec<u64>) {
+        let (width, height) = (job.camera.width, job.camera.height);
+        let mut mean = vec![DVec3::ZERO; width * height];
+        let mut variance = vec![DVec3::ZERO; width * height];
+        for (j, (means, variances)) in mean
+            .chunks_mut(width)
+            .zip(variance.chunks_mut(width))
+            .enumerate()
+        {
+            row(job, j, means, variances);
+        }
+        let bits = |v: &[DVec3]| {
+            v.iter()
+                .flat_map(|c| c.to_array().map(f64::to_bits))
+                .collect()
+        };
+        (bits(&mean), bits(&variance))
+    }
+
+    /// The pinhole fast path (ray packets, with and without AVX2) renders the film the general
+    /// path renders one ray at a time through `Scene::closest`, bit for bit: every built-in scene,
+    /// every jitter, sample counts that fill the packets and counts that leave a partial one.
+    #[test]
+    fn packets_render_the_general_paths_film() {
+        for builtin in crate::scene::BUILTIN_SCENES {
+            let description = builtin.description();
+            let scene = description.scene();
+            let camera = description.camera(Some(24));
+            assert!(
+                !camera.defocus,
+                "{}: the fast path needs a pinhole",
+                builtin.name
+            );
+            let pinhole = Pinhole {
+                prepared: FixedOrigin::new(&scene, camera.center),
+                albedos: (0..scene.objects.len())
+                    .map(|index| scene.material_of(index).albedo())
+                    .collect(),
+            };
+            for jitter in [
+                PixelJitter::Uniform,
+                PixelJitter::Stratified,
+                PixelJitter::Centre,
+            ] {
+                for spp in [1, 3, WIDTH as u32, 7, 20] {
+                    let general = Job {
+                        tracer: &scene,
+                        camera: &camera,
+                        spp,
+                        seed: 5,
+                        jitter,
+                        strata: strata(spp),
+                    };
+                    let fast = Job {
+                        tracer: &pinhole,
+                        camera: &camera,
+                        spp,
+                        seed: 5,
+                        jitter,
+                        strata: strata(spp),
+                    };
+                    let expected = film_of(&general, |job, j, m, v| job.row_any::<true>(j, m, v));
+                    let what = format!("{} {jitter:?} {spp} spp", builtin.name);
+                    assert_eq!(
+                        film_of(&fast, |job, j, m, v| job.row_any::<true>(j, m, v)),
+                        expected,
+                        "{what}"
+                    );
+                    #[cfg(target_arch = "x86_64")]
+                    if std::arch::is_x86_feature_detected!("avx2") {
+                        assert_eq!(
+                            film_of(&fast, |job, j, m, v| unsafe {
+                                job.row_avx2::<true>(j, m, v)
+                            }),
+                            expected,
+                            "{what}, AVX2"
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn strata_are_as_square_as_the_count_allows() {
