@@ -83,7 +83,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration, [f64; 2]) {
 pub fn run() -> Result<String, HarnessError> {
     let io = |context: &str| {
         let context = context.to_string();
-        move |source| HarnessError::Io { context, source }
+        move |reason| HarnessError::Io { context, reason }
     };
     let mut out = String::new();
     let n = 20_000;

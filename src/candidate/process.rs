@@ -105,12 +105,14 @@ pub enum Outcome {
 #[derive(Debug, thiserror::Error)]
 pub enum HarnessError {
     /// The program could not be started.
-    #[error("cannot start the candidate {program}: {source}")]
+    // Reasons are in the messages, not `#[source]`s, so a report of the whole chain prints each
+    // once.
+    #[error("cannot start the candidate {program}: {reason}")]
     Spawn {
         /// The program.
         program: String,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// The candidate did not complete the hello.
     #[error("the candidate {program} did not answer the hello: {message}")]
@@ -140,12 +142,12 @@ pub enum HarnessError {
     #[error("cannot find python3 to run the course adapter ({0}); set RTORACLE_PYTHON")]
     Python(String),
     /// An I/O error of the harness (temporary files, pipes).
-    #[error("{context}: {source}")]
+    #[error("{context}: {reason}")]
     Io {
         /// What the harness was doing.
         context: String,
         /// Why it failed.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
 }
 
@@ -224,9 +226,9 @@ impl CandidateCommand {
                     .into(),
             });
         }
-        let dir = std::path::absolute(dir).map_err(|source| HarnessError::Io {
+        let dir = std::path::absolute(dir).map_err(|reason| HarnessError::Io {
             context: dir.display().to_string(),
-            source,
+            reason,
         })?;
         let python = match python {
             Some(p) => p.to_path_buf(),
@@ -260,9 +262,9 @@ impl CandidateCommand {
         let Some(dir) = &self.submission else {
             return Ok(Vec::new());
         };
-        let entries = std::fs::read_dir(dir).map_err(|source| HarnessError::Io {
+        let entries = std::fs::read_dir(dir).map_err(|reason| HarnessError::Io {
             context: dir.display().to_string(),
-            source,
+            reason,
         })?;
         let mut files = Vec::new();
         for entry in entries.flatten() {
@@ -279,9 +281,9 @@ impl CandidateCommand {
     /// Makes the sandbox for this command: the staged files, the adapter, and the drop user
     /// checked before any untrusted code runs.
     fn sandbox(&self, policy: SandboxPolicy) -> Result<Sandbox, HarnessError> {
-        let io = |source| HarnessError::Io {
+        let io = |reason| HarnessError::Io {
             context: "preparing the candidate's sandbox folder".into(),
-            source,
+            reason,
         };
         let mut sandbox = Sandbox::new(policy, &self.staged_files()?).map_err(io)?;
         if self.course_adapter {
@@ -393,9 +395,9 @@ impl Proc {
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
-        let mut child = cmd.spawn().map_err(|source| HarnessError::Spawn {
+        let mut child = cmd.spawn().map_err(|reason| HarnessError::Spawn {
             program: command.program.display().to_string(),
-            source,
+            reason,
         })?;
         let pid = child.id() as i32;
         let stdin = child.stdin.take().expect("piped stdin");

@@ -235,12 +235,14 @@ impl Case {
 #[derive(Debug, thiserror::Error)]
 pub enum VectorFileError {
     /// The file could not be read.
-    #[error("{path}: cannot read: {source}")]
+    // The reason is in the message, not a `#[source]`, so a report of the whole chain prints it
+    // once.
+    #[error("{path}: cannot read: {reason}")]
     Read {
         /// The file.
         path: String,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// A line is not a valid case.
     #[error("{path}:{line}: not a valid vector: {message}")]
@@ -285,9 +287,9 @@ pub fn parse_vectors(text: &str, path: &str) -> Result<Vec<Case>, VectorFileErro
 /// Reads a vector file.
 pub fn read_vectors(path: &std::path::Path) -> Result<Vec<Case>, VectorFileError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| VectorFileError::Read {
+    let text = std::fs::read_to_string(path).map_err(|reason| VectorFileError::Read {
         path: name.clone(),
-        source,
+        reason,
     })?;
     parse_vectors(&text, &name)
 }

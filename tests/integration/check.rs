@@ -427,6 +427,19 @@ fn bad_inputs_and_broken_adapters_exit_2_with_one_line() {
     assert_bad_input(&out, "bad.jsonl:1");
     let out = run_in(tmp.path(), &["check", "--adapter", "/no/such/program"]);
     assert_bad_input(&out, "/no/such/program");
+    // The reason is said once, not once per layer of the error.
+    let out = run_in(
+        tmp.path(),
+        &["check", "--adapter", "cat", "--vectors", "missing.jsonl"],
+    );
+    assert_bad_input(&out, "missing.jsonl: cannot read");
+    for out in [
+        &out,
+        &run_in(tmp.path(), &["check", "--adapter", "/no/such/program"]),
+    ] {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
+    }
     // Speaks no protocol: prints junk and exits.
     let out = run_in(
         tmp.path(),
