@@ -10,5 +10,5 @@ mod sampler;
 
 pub use film::{Film, encode_course_png};
 pub use integrator::{radiance, sky};
-pub use renderer::{PixelJitter, RenderError, RenderOptions, render};
+pub use renderer::{PixelJitter, RenderError, RenderOptions, render, vector_instructions};
 pub use sampler::PixelSampler;

@@ -283,6 +283,23 @@ impl<T: Trace> Job<'_, T> {
     }
 }
 
+/// The vector instructions the renderer's fast path runs with on this processor: `"AVX2"` (four
+/// `f64` lanes per instruction) where it has them, else the target's baseline (`"SSE2"` on
+/// x86-64, two lanes). The film is the same either way.
+pub fn vector_instructions() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        return "AVX2";
+    }
+    if cfg!(target_arch = "x86_64") {
+        "SSE2"
+    } else if cfg!(target_arch = "aarch64") {
+        "NEON"
+    } else {
+        "the target's baseline"
+    }
+}
+
 /// Renders every pixel of `camera` over `scene`.
 ///
 /// Pixel `(i, j)` draws from [`PixelSampler::new(seed, j * width + i)`](PixelSampler::new): per

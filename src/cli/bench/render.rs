@@ -69,9 +69,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "rtoracle bench render: the course's week-4 scenes at {SPP} spp, seed 0, best of {} runs",
         args.runs
     );
+    let vector = rtoracle::render::vector_instructions();
     match load_average() {
-        Some(load) => println!("machine: {cores} cores, load average {load:.2}"),
-        None => println!("machine: {cores} cores"),
+        Some(load) => {
+            println!("machine: {cores} cores, load average {load:.2}, vector instructions {vector}")
+        }
+        None => println!("machine: {cores} cores, vector instructions {vector}"),
     }
 
     println!();
