@@ -7,4 +7,5 @@ mod golden;
 mod grade;
 mod oracle;
 mod oracle_props;
+mod readme;
 mod render;
