@@ -25,7 +25,9 @@ use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::protocol::{Answer, HELLO_LINE, Hello, ParsedLine, Request, parse_answer_line};
+use super::protocol::{
+    Answer, CandidateError, HELLO_LINE, Hello, ParsedLine, Request, parse_answer_line,
+};
 use crate::oracle::vectors::{Case, ShapeKind};
 use crate::sandbox::{Sandbox, SandboxFacts, SandboxPolicy};
 
@@ -674,6 +676,31 @@ impl Session {
         self.sandbox.dir()
     }
 
+    /// Names the submission's own files in a candidate's error: the course adapter runs a copy
+    /// of them in the sandbox folder, so its tracebacks say `<sandbox>/sphere.py` where the
+    /// student's file is `<submission>/sphere.py`.
+    fn localise(&self, error: &mut CandidateError) {
+        let Some(submission) = &self.command.submission else {
+            return;
+        };
+        let dir = self.sandbox.dir();
+        let mut seen = vec![dir.to_path_buf()];
+        if let Ok(real) = dir.canonicalize() {
+            seen.push(real);
+        }
+        // The longer first, in case one is inside the other (`/private/tmp/x` and `/tmp/x`).
+        seen.sort_by_key(|p| std::cmp::Reverse(p.as_os_str().len()));
+        seen.dedup();
+        for from in seen {
+            let (from, to) = (from.display().to_string(), submission.display().to_string());
+            for text in [&mut error.message, &mut error.traceback] {
+                if text.contains(&from) {
+                    *text = text.replace(&from, &to);
+                }
+            }
+        }
+    }
+
     /// Spawns and does the hello: `Ok(Err(message))` when the hello failed.
     fn launch(&mut self) -> Result<Result<Hello, String>, HarnessError> {
         let proc = Proc::spawn(&self.command, &self.sandbox, self.stderr.clone())?;
@@ -693,8 +720,11 @@ impl Session {
             };
             match next {
                 Ok(Line::Text(line)) => {
-                    if let Some(hello) = Hello::parse(&line) {
+                    if let Some(mut hello) = Hello::parse(&line) {
                         self.proc = Some(proc);
+                        if let Some(error) = &mut hello.error {
+                            self.localise(error);
+                        }
                         return Ok(Ok(hello));
                     }
                     push_junk(&mut junk, &line);
@@ -834,9 +864,12 @@ impl Session {
                     Ok(Line::Text(line)) => match parse_answer_line(&line) {
                         ParsedLine::Answer {
                             id,
-                            answer,
+                            mut answer,
                             junk: prefix,
                         } if id == case.id => {
+                            if let Some(error) = &mut answer.error {
+                                self.localise(error);
+                            }
                             if !prefix.is_empty() {
                                 push_junk(&mut junk, &prefix);
                             }
