@@ -71,13 +71,16 @@ fn find_python(explicit: Option<&Path>) -> Option<PathBuf> {
         .find(|p| p.is_file())
 }
 
-/// Removes the sandbox folder from file names, which means nothing to the student.
-fn strip_dir(text: &str, dir: &Path) -> String {
+/// Removes the sandbox folder, and the submission folder the harness names in its place, from
+/// file names: the student's feedback says `RT_object.py`, not where the grader kept it.
+fn strip_dirs(text: &str, dirs: &[&Path]) -> String {
     let mut text = text.to_string();
-    let canonical = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
-    for d in [canonical.as_path(), dir] {
-        for prefix in [format!("{}/./", d.display()), format!("{}/", d.display())] {
-            text = text.replace(&prefix, "");
+    for &dir in dirs {
+        let canonical = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+        for d in [canonical.as_path(), dir] {
+            for prefix in [format!("{}/./", d.display()), format!("{}/", d.display())] {
+                text = text.replace(&prefix, "");
+            }
         }
     }
     text
@@ -202,10 +205,13 @@ impl CodeChecker for CourseCodeChecker {
                 return out;
             }
         };
-        let dir = session.sandbox_dir().to_path_buf();
+        let sandbox_dir = session.sandbox_dir().to_path_buf();
+        let submission_dir =
+            std::path::absolute(submission).unwrap_or_else(|_| submission.to_path_buf());
+        let strip = |text: &str| strip_dirs(text, &[&sandbox_dir, &submission_dir]);
         out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
         let finish = |out: &mut CodeOutcome, session: &Session| {
-            out.stderr_tail = strip_dir(&session.stderr_tail(), &dir);
+            out.stderr_tail = strip(&session.stderr_tail());
             out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
         };
         if let Some(e) = &session.hello().error {
@@ -214,19 +220,13 @@ impl CodeChecker for CourseCodeChecker {
             } else {
                 e.traceback.trim_end().to_string()
             };
-            let msg = format!(
-                "importing the submission failed:\n{}",
-                strip_dir(&text, &dir)
-            );
+            let msg = format!("importing the submission failed:\n{}", strip(&text));
             fatal(&mut out, msg);
             finish(&mut out, &session);
             return out;
         }
         if let Some(why) = session.start_failure() {
-            let msg = format!(
-                "Python could not import the submission: {}",
-                strip_dir(why, &dir)
-            );
+            let msg = format!("Python could not import the submission: {}", strip(why));
             fatal(&mut out, msg);
             finish(&mut out, &session);
             return out;
@@ -290,7 +290,7 @@ impl CodeChecker for CourseCodeChecker {
                 definite,
                 expected: serde_json::to_value(&case.expect).unwrap_or_default(),
                 actual,
-                message: strip_dir(&message, &dir),
+                message: strip(&message),
                 repro: python_repro(case),
             };
             if definite {
