@@ -100,6 +100,18 @@ struct Pinhole {
     albedos: Vec<DVec3>,
 }
 
+impl Pinhole {
+    /// `scene` prepared for rays leaving `origin`.
+    fn new(scene: &Scene, origin: DVec3) -> Self {
+        Self {
+            prepared: FixedOrigin::new(scene, origin),
+            albedos: (0..scene.objects.len())
+                .map(|index| scene.material_of(index).albedo())
+                .collect(),
+        }
+    }
+}
+
 impl Trace for Pinhole {
     #[inline(always)]
     // Lane loops index several arrays in step.
@@ -135,7 +147,19 @@ struct Job<'a, T> {
     strata: (u32, u32),
 }
 
-impl<T: Trace> Job<'_, T> {
+impl<'a, T: Trace> Job<'a, T> {
+    /// A job of `spp` samples per pixel through `tracer`.
+    fn new(tracer: &'a T, camera: &'a Camera, spp: u32, seed: u64, jitter: PixelJitter) -> Self {
+        Self {
+            tracer,
+            camera,
+            spp,
+            seed,
+            jitter,
+            strata: strata(spp),
+        }
+    }
+
     /// Renders row `j` into `means` (and `variances` when `VARIANCE`), with AVX2 where the
     /// processor has it (four lanes per vector instead of two: the same operations, so the same
     /// bits).
@@ -336,33 +360,12 @@ pub fn render(
     } else {
         Vec::new()
     };
-    let strata = strata(spp);
+    let (seed, jitter) = (options.seed, options.jitter);
     if camera.defocus {
-        let job = Job {
-            tracer: scene,
-            camera,
-            spp,
-            seed: options.seed,
-            jitter: options.jitter,
-            strata,
-        };
-        job.run(&mut mean, &mut variance, &progress);
+        Job::new(scene, camera, spp, seed, jitter).run(&mut mean, &mut variance, &progress);
     } else {
-        let pinhole = Pinhole {
-            prepared: FixedOrigin::new(scene, camera.center),
-            albedos: (0..scene.objects.len())
-                .map(|index| scene.material_of(index).albedo())
-                .collect(),
-        };
-        let job = Job {
-            tracer: &pinhole,
-            camera,
-            spp,
-            seed: options.seed,
-            jitter: options.jitter,
-            strata,
-        };
-        job.run(&mut mean, &mut variance, &progress);
+        let pinhole = Pinhole::new(scene, camera.center);
+        Job::new(&pinhole, camera, spp, seed, jitter).run(&mut mean, &mut variance, &progress);
     }
     progress.finish_and_clear();
     Ok(Film {
@@ -415,34 +418,15 @@ mod tests {
                 "{}: the fast path needs a pinhole",
                 builtin.name
             );
-            let pinhole = Pinhole {
-                prepared: FixedOrigin::new(&scene, camera.center),
-                albedos: (0..scene.objects.len())
-                    .map(|index| scene.material_of(index).albedo())
-                    .collect(),
-            };
+            let pinhole = Pinhole::new(&scene, camera.center);
             for jitter in [
                 PixelJitter::Uniform,
                 PixelJitter::Stratified,
                 PixelJitter::Centre,
             ] {
                 for spp in [1, 3, WIDTH as u32, 7, 20] {
-                    let general = Job {
-                        tracer: &scene,
-                        camera: &camera,
-                        spp,
-                        seed: 5,
-                        jitter,
-                        strata: strata(spp),
-                    };
-                    let fast = Job {
-                        tracer: &pinhole,
-                        camera: &camera,
-                        spp,
-                        seed: 5,
-                        jitter,
-                        strata: strata(spp),
-                    };
+                    let general = Job::new(&scene, &camera, spp, 5, jitter);
+                    let fast = Job::new(&pinhole, &camera, spp, 5, jitter);
                     let expected = film_of(&general, |job, j, m, v| job.row_any::<true>(j, m, v));
                     let what = format!("{} {jitter:?} {spp} spp", builtin.name);
                     assert_eq!(
