@@ -104,7 +104,9 @@ impl Sphere {
 /// `half_b = f . d`, `r2 = radius^2` and `c = f . f - r2`, or `Err` when an intermediate over- or
 /// underflowed (then [`Sphere::roots`] rescales). [`Sphere::roots`] and the renderer's
 /// fixed-origin fast path (which computes `f`, `r2` and `c` once per render) both call it, so
-/// they agree bit for bit.
+/// they agree bit for bit. The fast path's ray packets repeat these operations lane by lane,
+/// without branches (`PreparedSphere::hit_lanes` in `render::fixed_origin`): a change here must be
+/// made there too, which the renderer's bit-for-bit tests check.
 #[inline(always)]
 #[allow(clippy::result_unit_err)]
 pub(crate) fn roots_of(

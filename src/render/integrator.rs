@@ -6,8 +6,14 @@ use crate::scene::Scene;
 /// The course's sky: `a = 0.5 (unit(d).y + 1)`, `(1 - a) (1, 1, 1) + a (0.5, 0.7, 1.0)`.
 #[inline]
 pub fn sky(direction: DVec3) -> DVec3 {
-    // `unit_vector(direction).y`, without the two divisions whose results are not used.
-    sky_at(0.5 * (direction.y / direction.length() + 1.0))
+    sky_at(sky_height(direction))
+}
+
+/// The sky's height coordinate along `direction`: `a = 0.5 (unit(d).y + 1)`, computing
+/// `unit_vector(direction).y` without the two divisions whose results are not used.
+#[inline(always)]
+pub(crate) fn sky_height(direction: DVec3) -> f64 {
+    0.5 * (direction.y / direction.length() + 1.0)
 }
 
 /// The sky's colour at height `a = 0.5 (unit(d).y + 1)`: `(1 - a) (1, 1, 1) + a (0.5, 0.7, 1.0)`.

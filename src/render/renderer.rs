@@ -5,7 +5,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use super::fixed_origin::FixedOrigin;
-use super::integrator::sky_at;
+use super::integrator::{sky_at, sky_height};
 use super::packet::{Directions, WIDTH};
 use super::{Film, PixelSampler, radiance};
 use crate::geometry::{Interval, Ray};
@@ -114,8 +114,6 @@ impl Pinhole {
 
 impl Trace for Pinhole {
     #[inline(always)]
-    // Lane loops index several arrays in step.
-    #[allow(clippy::needless_range_loop)]
     fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH] {
         let mut d = Directions::default();
         for (k, ray) in rays.iter().enumerate() {
@@ -123,13 +121,8 @@ impl Trace for Pinhole {
             d.set(k, ray.direction);
         }
         let index = self.prepared.closest_packet(&d, Interval::CAMERA);
-        // The sky of every lane (as `sky` computes it), then the albedo where a lane hit: no
-        // branch per ray.
-        let mut height = [0.0; WIDTH];
-        for k in 0..WIDTH {
-            let length = (d.x[k] * d.x[k] + d.y[k] * d.y[k] + d.z[k] * d.z[k]).sqrt();
-            height[k] = 0.5 * (d.y[k] / length + 1.0);
-        }
+        // The sky of every lane, then the albedo where a lane hit: no branch per ray.
+        let height: [f64; WIDTH] = std::array::from_fn(|k| sky_height(d.lane(k)));
         std::array::from_fn(|k| match self.albedos.get(index[k] as usize) {
             Some(&albedo) => albedo,
             None => sky_at(height[k]),
