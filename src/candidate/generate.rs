@@ -3,7 +3,7 @@
 //! origin, finite intervals and rays exactly parallel to a quad.
 //!
 //! Classification goes through one function, [`oracle_expect`]: the exact oracle's class
-//! ([`crate::oracle::classify`]), keeping only the definite cases (a candidate is judged on
+//! ([`crate::oracle::classify()`]), keeping only the definite cases (a candidate is judged on
 //! nothing floating point cannot settle).
 
 use rand_core::Rng;

@@ -1,8 +1,8 @@
 //! The intersection oracle: exact decisions ([`exact`]), the error bands of the course's naive
-//! formulas ([`band`]), the classification of a case ([`classify`]), edge-case generators
+//! formulas ([`band`]), the classification of a case ([`classify`](mod@classify)), edge-case generators
 //! ([`generate`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
 //! transcriptions of the course's code ([`variants`]), fuzzing entry points ([`fuzzing`]), the
-//! benchmark ([`bench`]) and the language-agnostic vector format ([`vectors`]).
+//! benchmark ([`bench`](mod@bench)) and the language-agnostic vector format ([`vectors`]).
 
 pub mod band;
 pub mod bench;
