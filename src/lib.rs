@@ -20,16 +20,20 @@
 //!   JUnit, Markdown), and the Gradescope autograder package.
 //! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
 //!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
+//! - [`escape`]: untrusted text kept as text in every format (terminal, Markdown, HTML, CSV).
+//! - [`interrupt`]: Ctrl-C and SIGTERM clean up what was started or half-written.
 //! - [`sandbox`]: how untrusted code (candidates, students' submissions) is started: a fresh
 //!   folder, a cleared environment, limits, its own process group, no network, never as root.
 #![warn(missing_docs)]
 
 pub mod candidate;
 pub mod compare;
+pub mod escape;
 pub mod geometry;
 pub mod golden;
 pub mod grade;
 pub mod image_io;
+pub mod interrupt;
 pub mod oracle;
 pub mod render;
 pub mod sandbox;

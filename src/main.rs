@@ -6,6 +6,10 @@ mod cli;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    if let Err(err) = rtoracle::interrupt::install() {
+        eprintln!("rtoracle: cannot install the signal handlers: {err}");
+        return ExitCode::from(2);
+    }
     match cli::run() {
         Ok(code) => code,
         Err(err) => {
