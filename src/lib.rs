@@ -22,6 +22,7 @@
 //!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
 //! - [`escape`]: untrusted text kept as text in every format (terminal, Markdown, HTML, CSV).
 //! - [`interrupt`]: Ctrl-C and SIGTERM clean up what was started or half-written.
+//! - [`output`]: output files and folders checked before the work, written whole or not at all.
 //! - [`sandbox`]: how untrusted code (candidates, students' submissions) is started: a fresh
 //!   folder, a cleared environment, limits, its own process group, no network, never as root.
 #![warn(missing_docs)]
@@ -35,6 +36,7 @@ pub mod grade;
 pub mod image_io;
 pub mod interrupt;
 pub mod oracle;
+pub mod output;
 pub mod render;
 pub mod sandbox;
 pub mod scene;

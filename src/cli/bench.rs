@@ -52,15 +52,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 opts.plane_cases = cases / 5;
                 opts.silhouette_cases = (cases / 10).max(1000);
             }
-            print!("{}", rtoracle::oracle::bench::run(opts));
+            out!("{}", rtoracle::oracle::bench::run(opts))?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Candidate => {
-            print!("{}", rtoracle::candidate::bench::run()?);
+            out!("{}", rtoracle::candidate::bench::run()?)?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Compare => {
-            print!("{}", rtoracle::compare::bench::run());
+            out!("{}", rtoracle::compare::bench::run())?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Grade => {

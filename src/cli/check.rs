@@ -78,7 +78,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         report.to_text(args.show)
     };
-    println!("{}", text.trim_end());
+    outln!("{}", text.trim_end())?;
     Ok(ExitCode::from(if report.passed() {
         0
     } else {

@@ -153,9 +153,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         write_report(r, &comparison, &candidate, &golden, encoding)?;
     }
     if args.json {
-        println!("{}", report::to_json(&comparison));
+        outln!("{}", report::to_json(&comparison))?;
     } else {
-        print!("{}", summary(&comparison, &args.candidate));
+        out!("{}", summary(&comparison, &args.candidate))?;
     }
     Ok(ExitCode::from(if comparison.passed() { 0 } else { 1 }))
 }

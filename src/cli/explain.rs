@@ -65,6 +65,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .find(|c| c.id == text)
             .with_context(|| format!("no vector with id {text:?} in {source}"))?
     };
-    print!("{}", explain(&case));
+    out!("{}", explain(&case))?;
     Ok(ExitCode::SUCCESS)
 }

@@ -100,9 +100,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         rtoracle::image_io::write_atomically(path, text.as_bytes())?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?)?;
     } else {
-        print!("{}", report.to_text());
+        out!("{}", report.to_text())?;
     }
     Ok(ExitCode::from(if report.failed == 0 {
         0

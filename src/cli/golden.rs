@@ -58,12 +58,12 @@ fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
         let start = Instant::now();
         let bytes = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
         write_atomically(&path, &bytes)?;
-        println!(
+        outln!(
             "wrote {} ({spp} spp, seed {GOLDEN_SEED}, {} bytes) in {:.1} s",
             path.display(),
             bytes.len(),
             start.elapsed().as_secs_f64()
-        );
+        )?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -82,24 +82,24 @@ fn check(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
     for (scene, (path, bytes, expected)) in scenes.iter().zip(committed) {
         let fresh = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
         if fresh == bytes {
-            println!("{}: identical bytes", path.display());
+            outln!("{}: identical bytes", path.display())?;
             continue;
         }
         let actual = decode_exr(&fresh, &path)?;
         let diff = compare_goldens(&expected, &actual, &Tolerance::default());
         let pixels = expected.width * expected.height;
         if diff.is_match() {
-            println!(
+            outln!(
                 "{}: equal within tolerance (the bytes differ)",
                 path.display()
-            );
+            )?;
         } else {
             all_equal = false;
-            println!(
+            outln!(
                 "{}: differs from a fresh render: {}",
                 path.display(),
                 diff.summary(pixels)
-            );
+            )?;
         }
     }
     Ok(if all_equal {

@@ -46,8 +46,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     if args.print_rubric {
         match &args.rubric {
-            Some(path) => print!("{}", std::fs::read_to_string(path)?),
-            None => print!("{}", rtoracle::grade::rubric::WEEK04_RUBRIC),
+            Some(path) => out!("{}", std::fs::read_to_string(path)?)?,
+            None => out!("{}", rtoracle::grade::rubric::WEEK04_RUBRIC)?,
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -80,8 +80,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let graded = entries.iter().filter(|e| e.result.is_ok()).count();
         for e in &entries {
             match &e.result {
-                Ok(r) => println!("{}: {} / {}", e.name, r.score, r.max_score),
-                Err(msg) => println!("{}: not graded: {msg}", e.name),
+                Ok(r) => outln!("{}: {} / {}", e.name, r.score, r.max_score)?,
+                Err(msg) => outln!("{}: not graded: {msg}", e.name)?,
             }
         }
         eprintln!(
@@ -96,18 +96,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let report =
         pool.install(|| grade_to_dir(submission, &rubric, &code, &images, &args.out, &formats))?;
     for c in &report.checks {
-        println!(
+        outln!(
             "{:<24} {:>6} / {:<6} {}",
             c.id,
             c.score,
             c.max_score,
             c.status.name()
-        );
+        )?;
     }
-    println!(
+    outln!(
         "{:<24} {:>6} / {:<6}",
-        "total", report.score, report.max_score
-    );
+        "total",
+        report.score,
+        report.max_score
+    )?;
     eprintln!(
         "graded {} in {:.2} s; reports in {}",
         report.submission,

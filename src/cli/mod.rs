@@ -1,5 +1,8 @@
 //! The command line: one module per subcommand, each with its clap arguments and a `run`.
 
+#[macro_use]
+mod out;
+
 mod autograder;
 mod bench;
 mod check;

@@ -12,7 +12,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.dump {
-        Some(name) => print!("{}", builtin(&name)?.to_toml()),
+        Some(name) => out!("{}", builtin(&name)?.to_toml())?,
         None => {
             let width = BUILTIN_SCENES
                 .iter()
@@ -20,7 +20,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .max()
                 .unwrap_or(0);
             for s in BUILTIN_SCENES {
-                println!("{:width$}  {}", s.name, s.summary);
+                outln!("{:width$}  {}", s.name, s.summary)?;
             }
         }
     }

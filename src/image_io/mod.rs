@@ -1,4 +1,5 @@
-//! Reading and writing images: PNG (8-bit) and OpenEXR (linear `f32`), written atomically.
+//! Reading and writing images: PNG (8-bit) and OpenEXR (linear `f32`), written atomically
+//! (through [`crate::output`]: the whole file or nothing, also on Ctrl-C).
 
 mod exr_file;
 mod png_file;
@@ -6,7 +7,6 @@ mod png_file;
 pub use exr_file::{ExrImage, decode_exr, encode_exr, read_exr, write_exr};
 pub use png_file::{Rgb8Image, read_png, write_png};
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// What can go wrong reading or writing an image (one line, naming the file).
@@ -45,42 +45,15 @@ impl ImageError {
     }
 }
 
-/// Checks that `path` can be written: its folder exists. Call before long work, so a bad output
-/// path fails at once.
+/// Checks that `path` can be written (see [`crate::output::check_output_file`]). Call before
+/// long work, so a bad output path fails at once.
 pub fn check_writable(path: &Path) -> Result<(), ImageError> {
-    let dir = parent_dir(path);
-    if !dir.is_dir() {
-        return Err(ImageError::io(
-            path,
-            format!("the output folder '{}' does not exist", dir.display()),
-        ));
-    }
-    Ok(())
-}
-
-fn parent_dir(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
+    crate::output::check_output_file(path, "").map_err(|e| ImageError::io(path, e.message))
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder renamed into place, so a
-/// failure never leaves a half-written file behind.
+/// failure or an interruption never leaves a half-written file behind (see
+/// [`crate::output::OutputFile`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
-    check_writable(path)?;
-    let mut tmp =
-        tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(|e| ImageError::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| ImageError::io(path, e))?;
-    // Temporary files are created private (0600); an output is an ordinary file.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(|e| ImageError::io(path, e))?;
-    }
-    tmp.persist(path)
-        .map_err(|e| ImageError::io(path, e.error))?;
-    Ok(())
+    crate::output::write_file(path, "", bytes).map_err(|e| ImageError::io(path, e.message))
 }

@@ -65,104 +65,104 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--memory-width 0: the width must be at least 1 pixel");
     }
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    println!(
+    outln!(
         "rtoracle bench render: the course's week-4 scenes at {SPP} spp, seed 0, best of {} runs",
         args.runs
-    );
+    )?;
     let vector = rtoracle::render::vector_instructions();
     match load_average() {
         Some(load) => {
-            println!("machine: {cores} cores, load average {load:.2}, vector instructions {vector}")
+            outln!("machine: {cores} cores, load average {load:.2}, vector instructions {vector}")?
         }
-        None => println!("machine: {cores} cores, vector instructions {vector}"),
+        None => outln!("machine: {cores} cores, vector instructions {vector}")?,
     }
 
-    println!();
-    println!("one thread (CPU time of the process):");
+    outln!()?;
+    outln!("one thread (CPU time of the process):")?;
     let counts: Vec<usize> = if cores > 1 { vec![1, cores] } else { vec![1] };
     let mut timings = time_scenes(&counts, args.runs)?.into_iter();
     let one = timings.next().expect("one thread timed");
     for t in &one {
-        print_row(t.name, Some((t.width, t.height)), t.rays(), t.cpu);
+        print_row(t.name, Some((t.width, t.height)), t.rays(), t.cpu)?;
     }
     let (rays, cpu1, wall1) = totals(&one);
     let rate1 = rays / cpu1.as_secs_f64();
-    print_row("both", None, rays, cpu1);
-    println!(
+    print_row("both", None, rays, cpu1)?;
+    outln!(
         "  goal: at least {:.1}M primary rays/s on one core: {}",
         GOAL_RAYS_PER_SECOND / 1e6,
         verdict(rate1 >= GOAL_RAYS_PER_SECOND)
-    );
+    )?;
 
-    println!();
+    outln!()?;
     match c_baseline(&args.cc, args.runs) {
         Ok(c) => {
-            println!(
+            outln!(
                 "baseline: bench/baseline.c, a plain C loop doing the same work ({} -O3):",
                 args.cc
-            );
+            )?;
             let mut c_cpu = Duration::ZERO;
             let mut same = true;
             for (name, seconds, checksum) in &c {
                 let ours = one.iter().find(|t| t.name == name);
                 let rays = ours.map_or(0.0, Timing::rays);
                 let cpu = Duration::from_secs_f64(*seconds);
-                print_row(name, None, rays, cpu);
+                print_row(name, None, rays, cpu)?;
                 c_cpu += cpu;
                 same &= ours.is_some_and(|t| t.checksum == *checksum);
             }
-            print_row("both", None, rays, c_cpu);
-            println!(
+            print_row("both", None, rays, c_cpu)?;
+            outln!(
                 "  same film, bit for bit: {}",
                 if same && c.len() == SCENES.len() {
                     "yes (checksums equal)"
                 } else {
                     "NO: the baseline does not do the same work"
                 }
-            );
-            println!(
+            )?;
+            outln!(
                 "  rtoracle / C: {:.2}x the baseline's primary rays per second",
                 c_cpu.as_secs_f64() / cpu1.as_secs_f64()
-            );
+            )?;
         }
-        Err(why) => println!("baseline: skipped: {why}"),
+        Err(why) => outln!("baseline: skipped: {why}")?,
     }
 
-    println!();
+    outln!()?;
     if cores > 1 {
-        println!("all {cores} threads (wall clock):");
+        outln!("all {cores} threads (wall clock):")?;
         let all = timings.next().expect("all threads timed");
         let (_, _, wall_all) = totals(&all);
-        print_row("both", None, rays, wall_all);
+        print_row("both", None, rays, wall_all)?;
         let speedup = wall1.as_secs_f64() / wall_all.as_secs_f64();
-        println!(
+        outln!(
             "  speedup over one thread ({:.4} s wall): {speedup:.2}x; goal at least {GOAL_SPEEDUP}x on 2 threads: {}",
             wall1.as_secs_f64(),
             verdict(speedup >= GOAL_SPEEDUP)
-        );
+        )?;
         let (_, cpu_all, _) = totals(&all);
-        println!(
+        outln!(
             "  CPU time on {cores} threads: {:.4} s, {:.2}x one thread's (the extra work of running in parallel)",
             cpu_all.as_secs_f64(),
             cpu_all.as_secs_f64() / cpu1.as_secs_f64()
-        );
+        )?;
         if let Some(load) = load_average().filter(|&l| l > 0.5) {
             if load > cores as f64 - 1.0 {
-                println!(
+                outln!(
                     "  note: the machine is busy (load average {load:.2} on {cores} cores): the wall-clock speedup measures the other programs too"
-                );
+                )?;
             }
         }
         let identical = all.iter().zip(&one).all(|(a, b)| a.checksum == b.checksum);
-        println!(
+        outln!(
             "  same film as on one thread: {}",
             if identical { "yes" } else { "NO" }
-        );
+        )?;
     } else {
-        println!("all threads: skipped, this machine has one core");
+        outln!("all threads: skipped, this machine has one core")?;
     }
 
-    println!();
+    outln!()?;
     memory(args.memory_width)?;
     Ok(ExitCode::SUCCESS)
 }
@@ -171,14 +171,19 @@ fn verdict(met: bool) -> &'static str {
     if met { "met" } else { "NOT met" }
 }
 
-fn print_row(name: &str, size: Option<(usize, usize)>, rays: f64, time: Duration) {
+fn print_row(
+    name: &str,
+    size: Option<(usize, usize)>,
+    rays: f64,
+    time: Duration,
+) -> anyhow::Result<()> {
     let size = size.map_or(String::new(), |(w, h)| format!("{w}x{h}"));
-    println!(
+    outln!(
         "  {name:<14} {size:>8} {:>6.2}M rays {:>8.4} s {:>7.2}M rays/s",
         rays / 1e6,
         time.as_secs_f64(),
         rays / time.as_secs_f64() / 1e6
-    );
+    )
 }
 
 /// Total rays and the sums of the best CPU and wall times.
@@ -337,21 +342,21 @@ fn memory(width: u32) -> anyhow::Result<()> {
     let peak = measure(width)?;
     let budget = BUDGET_BYTES_PER_PIXEL * pixels + BUDGET_FIXED_BYTES;
     let mb = |b: u64| b as f64 / 1e6;
-    println!(
+    outln!(
         "memory: peak RSS of `rtoracle render week04-quad --width {width} --spp 1` ({:.1}M pixels):",
         pixels as f64 / 1e6
-    );
-    println!(
+    )?;
+    outln!(
         "  {:.1} MB = {:.1} B/px overall; {:.1} B/px above a 16x16 render's {:.1} MB",
         mb(peak),
         peak as f64 / pixels as f64,
         peak.saturating_sub(small) as f64 / pixels as f64,
         mb(small)
-    );
-    println!(
+    )?;
+    outln!(
         "  budget {BUDGET_BYTES_PER_PIXEL} B/px + 50 MB = {:.1} MB: {}",
         mb(budget),
         verdict(peak <= budget)
-    );
+    )?;
     Ok(())
 }
