@@ -56,12 +56,23 @@ impl OutputError {
     }
 }
 
-/// An I/O error without the path `tempfile` attaches to it (that path is a temporary name, which
-/// must not reach the user).
-fn plain(e: &std::io::Error) -> std::io::Error {
-    match e.raw_os_error() {
-        Some(code) => std::io::Error::from_raw_os_error(code),
-        None => std::io::Error::from(e.kind()),
+/// An I/O error in words, without the path `tempfile` attaches to it (that path is a temporary
+/// name, which must not reach the user).
+fn plain(e: &std::io::Error) -> String {
+    let inner = e
+        .get_ref()
+        .and_then(|inner| inner.source())
+        .and_then(|source| source.downcast_ref::<std::io::Error>());
+    let code = e
+        .raw_os_error()
+        .or_else(|| inner.and_then(|i| i.raw_os_error()));
+    match e.kind() {
+        // Creating a file in an existing folder said "not found": /proc, /sys and the like.
+        std::io::ErrorKind::NotFound => "the folder does not take new files".to_string(),
+        _ => match code {
+            Some(code) => std::io::Error::from_raw_os_error(code).to_string(),
+            None => std::io::Error::from(e.kind()).to_string(),
+        },
     }
 }
 
@@ -157,6 +168,20 @@ pub fn check_output_dir(path: &Path, option: &str) -> Result<(), OutputError> {
             path,
             "is a file; a folder is wanted here",
         ));
+    }
+    if path.is_dir() {
+        // Some commands add files to an existing folder: it must take them too.
+        tempfile::Builder::new()
+            .prefix(".rtoracle-probe-")
+            .tempfile_in(path)
+            .map(drop)
+            .map_err(|e| {
+                OutputError::new(
+                    option,
+                    path,
+                    format!("cannot create files in it: {}", plain(&e)),
+                )
+            })?;
     }
     Ok(())
 }

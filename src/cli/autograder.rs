@@ -20,6 +20,10 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    rtoracle::output::check_output_file(&args.out, "--out")?;
+    if let Some(binary) = &args.binary {
+        check_is_rtoracle(binary)?;
+    }
     let rubric_text = match &args.rubric {
         Some(path) => {
             // Validate it now, so a bad rubric fails here and not on Gradescope.
@@ -40,4 +44,59 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         binary.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Checks that `binary` is an rtoracle: run with `--version` it prints `rtoracle VERSION`, as
+/// this binary does. (The package runs it on Gradescope; anything else would fail there, on
+/// every student's submission.) It runs in a fresh empty folder, with a time limit.
+fn check_is_rtoracle(binary: &std::path::Path) -> anyhow::Result<()> {
+    use std::process::{Command, Stdio};
+    let refuse = |why: String| anyhow::anyhow!("--binary {}: {why}", binary.display());
+    if !binary.is_file() {
+        return Err(refuse("no such file".into()));
+    }
+    let dir = tempfile::tempdir().map_err(|e| refuse(format!("cannot run it: {e}")))?;
+    let _cleanup = rtoracle::interrupt::remove_on_interrupt(dir.path());
+    let mut child = Command::new(std::path::absolute(binary)?)
+        .arg("--version")
+        .current_dir(dir.path())
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .map_err(|e| refuse(format!("cannot run it: {e}")))?;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    loop {
+        match child.try_wait() {
+            Ok(Some(_)) => break,
+            Ok(None) if std::time::Instant::now() < deadline => {
+                std::thread::sleep(std::time::Duration::from_millis(20))
+            }
+            _ => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(refuse(
+                    "is not an rtoracle (it did not answer --version)".into(),
+                ));
+            }
+        }
+    }
+    let output = child.wait_with_output()?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    let first = text.lines().next().unwrap_or("");
+    if !first.starts_with("rtoracle ") {
+        return Err(refuse(format!(
+            "is not an rtoracle (`--version` printed {:?}, not \"rtoracle VERSION\")",
+            rtoracle::escape::truncate(first, 60)
+        )));
+    }
+    let ours = format!("rtoracle {}", env!("CARGO_PKG_VERSION"));
+    if first.trim() != ours {
+        eprintln!(
+            "rtoracle: note: --binary {} is {}, this is {ours}",
+            binary.display(),
+            rtoracle::escape::terminal_line(first.trim())
+        );
+    }
+    Ok(())
 }

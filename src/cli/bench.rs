@@ -29,7 +29,7 @@ enum Area {
     /// and distances, the naive course formula beside it, classification rate, suite generation.
     Oracle {
         /// Random sphere cases (planes get a fifth as many).
-        #[arg(long, default_value_t = 1_000_000)]
+        #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = super::num::count)]
         cases: usize,
     },
     /// Checking candidates: vectors per second through the Python adapter against the in-process

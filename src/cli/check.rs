@@ -25,11 +25,36 @@ pub struct Target {
 impl Target {
     /// The command to run.
     pub fn command(&self) -> anyhow::Result<CandidateCommand> {
+        self.check()?;
         Ok(match (&self.python_course, &self.adapter) {
             (Some(dir), _) => CandidateCommand::python_course(dir)?,
             (_, Some(cmd)) => CandidateCommand::adapter(cmd)?,
             _ => unreachable!("clap requires one"),
         })
+    }
+}
+
+impl Target {
+    /// Checks the submission folder before any work: it is a folder holding `RT_object.py`.
+    pub fn check(&self) -> anyhow::Result<()> {
+        if let Some(dir) = &self.python_course {
+            if !dir.is_dir() {
+                let what = if dir.exists() {
+                    "is a file; the submission folder is wanted"
+                } else {
+                    "no such folder"
+                };
+                anyhow::bail!("--python-course {}: {what}", dir.display());
+            }
+            if !dir.join("RT_object.py").is_file() {
+                anyhow::bail!(
+                    "--python-course {}: the folder has no RT_object.py (the course's layout: \
+                     RT_utility.py, RT_ray.py, RT_object.py)",
+                    dir.display()
+                );
+            }
+        }
+        Ok(())
     }
 }
 
@@ -42,23 +67,24 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     vectors: Option<PathBuf>,
     /// Seed of the built-in suite.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// Time allowed per case, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 2000)]
+    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::num::millis)]
     timeout_ms: u64,
     /// Time allowed for the candidate to start and answer the hello, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::millis)]
     hello_timeout_ms: u64,
     /// Print the whole report as one JSON object on stdout.
     #[arg(long)]
     json: bool,
     /// Failures shown in the text report.
-    #[arg(long, value_name = "N", default_value_t = 10)]
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = super::num::show)]
     show: usize,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    args.target.check()?;
     let cases = match &args.vectors {
         Some(path) => read_vectors(path)?,
         None => default_suite(args.seed),

@@ -21,8 +21,8 @@ pub struct Args {
     #[arg(long, value_name = "FILE.exr")]
     golden: Option<PathBuf>,
     /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes).
-    #[arg(long, value_name = "N")]
-    spp: Option<i64>,
+    #[arg(long, value_name = "N", value_parser = super::num::spp)]
+    spp: Option<u32>,
     /// How the candidate's 8-bit codes encode linear values.
     #[arg(long, value_name = "E", default_value = "course",
           value_parser = ["course", "rtiow", "srgb", "gamma22", "linear"])]
@@ -36,21 +36,6 @@ pub struct Args {
     /// Write a report folder: report.json, heatmap.png, crops of the worst regions, index.html.
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
-}
-
-fn check_parent(path: &Path) -> anyhow::Result<()> {
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if !parent.is_dir() {
-        anyhow::bail!(
-            "{}: the output folder '{}' does not exist",
-            path.display(),
-            parent.display()
-        );
-    }
-    Ok(())
 }
 
 fn summary(c: &Comparison, candidate: &Path) -> String {
@@ -104,13 +89,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .parse()
         .map_err(|e: String| anyhow::anyhow!(e))?;
     if let Some(h) = &args.heatmap {
-        check_parent(h)?;
+        let png = h.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !png {
+            anyhow::bail!(
+                "--heatmap {}: the heatmap is a PNG; give a name ending in .png",
+                h.display()
+            );
+        }
+        rtoracle::output::check_output_file(h, "--heatmap")?;
     }
     if let Some(r) = &args.report {
-        check_parent(r)?;
-        if r.exists() && !r.is_dir() {
-            anyhow::bail!("{}: exists and is not a folder", r.display());
-        }
+        rtoracle::output::check_output_dir(r, "--report")?;
     }
     // The candidate first: a bad candidate is reported before any golden work.
     let candidate = CandidateImage::load(&args.candidate)?;
@@ -133,11 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
             (None, None) => anyhow::bail!("give --scene NAME or --golden FILE.exr"),
         };
-    let spp = match args.spp {
-        Some(n) if n <= 0 => anyhow::bail!("--spp {n}: samples per pixel must be at least 1"),
-        Some(n) => u32::try_from(n).map_err(|_| anyhow::anyhow!("--spp {n}: too large"))?,
-        None => default_spp,
-    };
+    let spp = args.spp.unwrap_or(default_spp);
     let golden = golden(spp)?;
     let options = CompareOptions {
         samples_per_pixel: spp,

@@ -15,7 +15,7 @@ pub struct Args {
     /// camera's `(1e-6, f64::MAX)`).
     case: String,
     /// Seed of the default suite the id refers to.
-    #[arg(long, value_name = "S", default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// A vector file the id refers to instead of the default suite.
     #[arg(long, value_name = "FILE")]

@@ -16,16 +16,16 @@ pub struct Args {
     #[command(flatten)]
     target: super::check::Target,
     /// How many random cases to run.
-    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::count)]
     cases: usize,
     /// Seed of the generator.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// Stop after this many seconds (checked between rounds of 1000 cases).
-    #[arg(long, value_name = "SECS")]
+    #[arg(long, value_name = "SECS", value_parser = super::num::seconds)]
     time: Option<f64>,
     /// Time allowed per case, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 2000)]
+    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::num::millis)]
     timeout_ms: u64,
     /// Print the report as JSON.
     #[arg(long)]
@@ -45,6 +45,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
         Some(s) => anyhow::bail!("--time must be a positive number of seconds, not {s}"),
     };
+    args.target.check()?;
+    if let Some(path) = &args.save {
+        rtoracle::output::check_output_file(path, "--save")?;
+    }
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
         ..RunOptions::default()

@@ -2,7 +2,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::Context;
 use rtoracle::golden::{
     GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_file_name,
 };
@@ -21,25 +20,39 @@ pub struct Args {
     #[arg(long, value_name = "DIR", default_value = "golden")]
     dir: PathBuf,
     /// Samples per pixel.
-    #[arg(long, value_name = "N", default_value_t = GOLDEN_SPP as i64)]
-    spp: i64,
+    #[arg(long, value_name = "N", default_value_t = GOLDEN_SPP, value_parser = super::num::spp)]
+    spp: u32,
     /// Only these built-in scenes (comma-separated; default: all of them).
     #[arg(long, value_name = "A,B", value_delimiter = ',')]
     scenes: Vec<String>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let spp = match args.spp {
-        n if n <= 0 => anyhow::bail!("--spp {n}: samples per pixel must be at least 1"),
-        n => u32::try_from(n).map_err(|_| anyhow::anyhow!("--spp {n}: too large"))?,
-    };
+    let spp = args.spp;
     let scenes: Vec<String> = if args.scenes.is_empty() {
         builtin_names().into_iter().map(String::from).collect()
     } else {
         args.scenes.clone()
     };
     for scene in &scenes {
-        builtin(scene).context("--scenes")?;
+        if builtin(scene).is_err() {
+            anyhow::bail!(
+                "--scenes {scene}: no such built-in scene (the built-in scenes: {})",
+                builtin_names().join(", ")
+            );
+        }
+    }
+    if args.check {
+        if !args.dir.is_dir() {
+            let what = if args.dir.exists() {
+                "is a file, not a folder"
+            } else {
+                "does not exist"
+            };
+            anyhow::bail!("--dir {}: {what}", args.dir.display());
+        }
+    } else {
+        rtoracle::output::check_output_dir(&args.dir, "--dir")?;
     }
     if args.check {
         check(&args.dir, &scenes, spp)
@@ -49,14 +62,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
-    if !dir.is_dir() {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
-    }
+    // The folder is created with the first golden, and removed again on Ctrl-C if this run
+    // created it, so an interrupted run leaves no empty or half-filled new folder.
+    let mut created: Option<rtoracle::interrupt::CleanupGuard> = None;
     for scene in scenes {
         let path = dir.join(golden_file_name(scene));
         let start = Instant::now();
         let bytes = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
+        if created.is_none() && !dir.is_dir() {
+            std::fs::create_dir(dir).map_err(|e| {
+                anyhow::anyhow!("--dir {}: cannot create the folder: {e}", dir.display())
+            })?;
+            created = Some(rtoracle::interrupt::remove_on_interrupt(dir));
+        }
         write_atomically(&path, &bytes)?;
         outln!(
             "wrote {} ({spp} spp, seed {GOLDEN_SEED}, {} bytes) in {:.1} s",
@@ -65,6 +83,7 @@ fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
             start.elapsed().as_secs_f64()
         )?;
     }
+    drop(created);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -79,15 +98,16 @@ fn check(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
         committed.push((path, bytes, image));
     }
     let mut all_equal = true;
-    for (scene, (path, bytes, expected)) in scenes.iter().zip(committed) {
+    for (scene, (path, bytes, on_disk)) in scenes.iter().zip(committed) {
         let fresh = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
         if fresh == bytes {
             outln!("{}: identical bytes", path.display())?;
             continue;
         }
-        let actual = decode_exr(&fresh, &path)?;
-        let diff = compare_goldens(&expected, &actual, &Tolerance::default());
-        let pixels = expected.width * expected.height;
+        // The file is what is checked ("is"); the fresh render is what is expected.
+        let expected = decode_exr(&fresh, &path)?;
+        let diff = compare_goldens(&expected, &on_disk, &Tolerance::default());
+        let pixels = on_disk.width * on_disk.height;
         if diff.is_match() {
             outln!(
                 "{}: equal within tolerance (the bytes differ)",

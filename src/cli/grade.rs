@@ -11,7 +11,7 @@ use rtoracle::oracle::vectors::read_vectors;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// A submission folder in the course's layout (RT_object.py, week04_sphere.png, week04_quad.png).
-    #[arg(required_unless_present_any = ["batch", "print_rubric"], conflicts_with = "batch")]
+    #[arg(conflicts_with = "batch")]
     submission: Option<PathBuf>,
     /// Grade every sub-folder of DIR as a submission, in parallel, and write a gradebook.
     #[arg(long, value_name = "DIR")]
@@ -29,10 +29,10 @@ pub struct Args {
     #[arg(long, value_name = "FILE.jsonl")]
     vectors: Option<PathBuf>,
     /// Wall-clock limit per test vector, in milliseconds.
-    #[arg(long, value_name = "MS", default_value_t = 2000)]
+    #[arg(long, value_name = "MS", default_value_t = 2000, value_parser = super::num::millis)]
     case_timeout_ms: u64,
     /// Worker threads for --batch (default: all cores).
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", value_parser = super::num::threads)]
     threads: Option<usize>,
     /// Print the rubric in use (the built-in one unless --rubric) and exit.
     #[arg(long)]
@@ -52,12 +52,39 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let formats = Format::parse_list(&args.format)?;
-    if args.threads == Some(0) {
-        anyhow::bail!("--threads 0: at least one thread is needed");
+    // Every input and the output folder are checked before any grading.
+    match (&args.submission, &args.batch) {
+        (None, None) => anyhow::bail!(
+            "give a SUBMISSION folder to grade, or --batch DIR to grade every sub-folder of DIR \
+             (see 'rtoracle grade --help')"
+        ),
+        (Some(sub), _) if !sub.is_dir() => {
+            let what = if sub.exists() {
+                "is a file; a submission folder is wanted"
+            } else {
+                "no such submission folder"
+            };
+            anyhow::bail!("{}: {what}", sub.display());
+        }
+        (_, Some(dir)) => {
+            if !dir.is_dir() {
+                let what = if dir.exists() {
+                    "is a file; a folder of submission folders is wanted"
+                } else {
+                    "no such folder"
+                };
+                anyhow::bail!("--batch {}: {what}", dir.display());
+            }
+            if batch::submissions(dir, Some(&args.out))?.is_empty() {
+                anyhow::bail!(
+                    "--batch {}: no submissions found (each submission is a sub-folder)",
+                    dir.display()
+                );
+            }
+        }
+        _ => {}
     }
-    if args.case_timeout_ms == 0 {
-        anyhow::bail!("--case-timeout-ms 0: the limit must be at least 1 ms");
-    }
+    rtoracle::output::check_output_dir(&args.out, "--out")?;
     let vectors = match &args.vectors {
         Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
         None => None,

@@ -11,13 +11,14 @@ mod explain;
 mod fuzz;
 mod golden;
 mod grade;
+mod num;
 mod render;
 mod scenes;
 mod vectors;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// A test oracle and verification harness for ray tracers.
 #[derive(Debug, Parser)]
@@ -49,7 +50,7 @@ enum Command {
     Grade(grade::Args),
     /// Build a Gradescope autograder package.
     Autograder(autograder::Args),
-    /// Measure speed (renderer, oracle, comparison) against baselines in the same run.
+    /// Measure speed (render, oracle, candidate, compare, grade) against baselines in the same run.
     Bench(bench::Args),
 }
 
@@ -57,14 +58,25 @@ enum Command {
 #[allow(dead_code)]
 pub const FAILED: u8 = 1;
 
-/// Parses the arguments and runs the subcommand. Usage errors exit 2 through clap.
+/// Parses the arguments and runs the subcommand. Usage errors are one line on stderr and exit 2.
 pub fn run() -> anyhow::Result<ExitCode> {
-    let cli = match Cli::try_parse() {
+    let command = num::allow_negative_numbers(Cli::command());
+    let parsed = command
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version: the whole text, on stdout.
+            out::print(&e.render().to_string())?;
+            return Ok(ExitCode::SUCCESS);
+        }
         Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
-            let _ = e.print();
-            return Ok(ExitCode::from(code));
+            eprintln!(
+                "rtoracle: {}",
+                one_line_usage_error(&e.render().to_string())
+            );
+            return Ok(ExitCode::from(2));
         }
     };
     match cli.command {
@@ -80,4 +92,48 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Autograder(args) => autograder::run(args),
         Command::Bench(args) => bench::run(args),
     }
+}
+
+/// The subcommand the user typed (for the pointer to its `--help`), if any.
+fn subcommand_typed() -> Option<String> {
+    let names: Vec<String> = Cli::command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let first = args.iter().find(|a| !a.starts_with('-'))?;
+    if !names.contains(first) {
+        return None;
+    }
+    // `bench AREA`: point to the area's help.
+    let rest = args.iter().skip_while(|a| *a != first).skip(1);
+    let sub = Cli::command().find_subcommand(first)?.clone();
+    let second = rest.into_iter().find(|a| !a.starts_with('-'));
+    match second {
+        Some(area) if sub.find_subcommand(area).is_some() => Some(format!("{first} {area}")),
+        _ => Some(first.clone()),
+    }
+}
+
+/// Clap's error as one line: its first line without the `error: ` prefix (with the list that
+/// follows a line ending in `:` joined onto it), then where to look.
+fn one_line_usage_error(rendered: &str) -> String {
+    let mut lines = rendered.lines();
+    let mut line = lines
+        .next()
+        .unwrap_or("bad arguments")
+        .trim_start_matches("error: ")
+        .to_string();
+    if line.ends_with(':') {
+        let items: Vec<&str> = lines
+            .take_while(|l| l.starts_with("  "))
+            .map(str::trim)
+            .collect();
+        line = format!("{} {}", line, items.join(", "));
+    }
+    let help = match subcommand_typed() {
+        Some(sub) => format!("rtoracle {sub} --help"),
+        None => "rtoracle --help".to_string(),
+    };
+    format!("{line} (see '{help}')")
 }

@@ -15,16 +15,16 @@ pub struct Args {
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's, 20 for the course scenes).
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
-    spp: Option<i64>,
+    #[arg(long, value_name = "N", value_parser = super::num::spp)]
+    spp: Option<u32>,
     /// Seed of the per-pixel random streams.
-    #[arg(long, value_name = "S", default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// Image width in pixels (the height follows the scene's aspect ratio).
-    #[arg(long, value_name = "W", allow_negative_numbers = true)]
-    width: Option<i64>,
+    #[arg(long, value_name = "W", value_parser = super::num::width)]
+    width: Option<usize>,
     /// Worker threads (default: all cores). The image is the same for any count.
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", value_parser = super::num::threads)]
     threads: Option<usize>,
 }
 
@@ -49,29 +49,27 @@ pub fn load_scene(name: &str) -> anyhow::Result<(String, SceneDescription)> {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (name, description) = load_scene(&args.scene)?;
-    let spp = match args.spp {
-        Some(n) if n <= 0 => anyhow::bail!("--spp {n}: samples per pixel must be at least 1"),
-        Some(n) => u32::try_from(n).map_err(|_| anyhow::anyhow!("--spp {n}: too large"))?,
-        None => description.image.samples_per_pixel,
+    let spp = args.spp.unwrap_or(description.image.samples_per_pixel);
+    let width = args.width;
+    let option = if args.output.is_some() {
+        "-o"
+    } else {
+        "the default -o"
     };
-    let width = match args.width {
-        Some(w) if w <= 0 => anyhow::bail!("--width {w}: the width must be at least 1 pixel"),
-        Some(w) => Some(usize::try_from(w).map_err(|_| anyhow::anyhow!("--width {w}: too large"))?),
-        None => None,
-    };
-    if args.threads == Some(0) {
-        anyhow::bail!("--threads 0: at least one thread is needed");
-    }
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
-    let format = OutputFormat::of(&output)?;
-    rtoracle::image_io::check_writable(&output)?;
+    rtoracle::output::check_output_file(&output, option)?;
+    let format = OutputFormat::of(&output, option)?;
 
     let camera = description.camera(width);
     if camera.width.saturating_mul(camera.height) > MAX_PIXELS {
+        let what = match width {
+            Some(w) => format!("--width {w}"),
+            None => name.clone(),
+        };
         anyhow::bail!(
-            "{name}: a {}x{} image is too large (at most {MAX_PIXELS} pixels)",
+            "{what}: a {}x{} image is too large (at most {MAX_PIXELS} pixels)",
             camera.width,
             camera.height
         );
@@ -122,7 +120,8 @@ enum OutputFormat {
 }
 
 impl OutputFormat {
-    fn of(path: &std::path::Path) -> anyhow::Result<Self> {
+    fn of(path: &std::path::Path, option: &str) -> anyhow::Result<Self> {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
         match path
             .extension()
             .and_then(|e| e.to_str())
@@ -131,8 +130,13 @@ impl OutputFormat {
         {
             Some("png") => Ok(OutputFormat::Png),
             Some("exr") => Ok(OutputFormat::Exr),
+            _ if name.starts_with('.') && !name[1..].contains('.') => anyhow::bail!(
+                "{option} {}: the name has no extension ('{name}' is a hidden file's whole name); \
+                 give a name such as out.png or out.exr",
+                path.display()
+            ),
             _ => anyhow::bail!(
-                "{}: cannot write this kind of image; use a .png or .exr name",
+                "{option} {}: cannot write this kind of image; use a .png or .exr name",
                 path.display()
             ),
         }

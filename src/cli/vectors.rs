@@ -2,24 +2,25 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::image_io::write_atomically;
 use rtoracle::oracle::generate::generate;
 use rtoracle::oracle::suite::DEFAULT_COUNT;
 use rtoracle::oracle::vectors::{SCHEMA_VERSION, ShapeKind};
+use rtoracle::output::OutputFile;
 
 /// `rtoracle vectors [--seed S] [--count N] [--shapes sphere,quad,triangle] -o FILE.jsonl`
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Seed of the generators: the same seed gives the same bytes.
-    #[arg(long, value_name = "S", default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// Number of vectors (the default suite has 4000).
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_COUNT as i64)]
-    count: i64,
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_COUNT, value_parser = super::num::count)]
+    count: usize,
     /// Comma-separated shapes to generate.
     #[arg(long, value_name = "LIST", default_value = "sphere,quad,triangle")]
     shapes: String,
-    /// The JSON-lines file to write; `FILE.meta.json` is written beside it.
+    /// The JSON-lines file to write; `FILE.jsonl.meta.json` (the name with `.meta.json`
+    /// added) is written beside it.
     #[arg(short, long, value_name = "FILE.jsonl")]
     output: PathBuf,
 }
@@ -41,10 +42,13 @@ pub fn parse_shapes(list: &str) -> anyhow::Result<Vec<ShapeKind>> {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let shapes = parse_shapes(&args.shapes)?;
-    if args.count <= 0 {
-        anyhow::bail!("--count {}: at least one vector is needed", args.count);
-    }
-    let count = usize::try_from(args.count).context("--count: too large")?;
+    let count = args.count;
+    let mut meta_path = args.output.clone().into_os_string();
+    meta_path.push(".meta.json");
+    let meta_path = PathBuf::from(meta_path);
+    // Both files are checked before the work and appear together, whole, or not at all.
+    let mut out = OutputFile::create(&args.output, "-o")?;
+    let mut meta_out = OutputFile::create(&meta_path, "-o")?;
     let cases = generate(args.seed, count, &shapes);
     let mut text = String::with_capacity(cases.len() * 400);
     let mut classes = std::collections::BTreeMap::<String, usize>::new();
@@ -64,14 +68,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "shapes": shapes.iter().map(|k| k.name()).collect::<Vec<_>>(),
         "classes": classes,
     });
-    let mut meta_path = args.output.clone().into_os_string();
-    meta_path.push(".meta.json");
-    let meta_path = PathBuf::from(meta_path);
-    write_atomically(&args.output, text.as_bytes())?;
-    write_atomically(
-        &meta_path,
-        (serde_json::to_string_pretty(&meta)? + "\n").as_bytes(),
-    )?;
+    out.write_all(text.as_bytes())?;
+    meta_out.write_all((serde_json::to_string_pretty(&meta)? + "\n").as_bytes())?;
+    out.commit()?;
+    meta_out.commit()?;
     eprintln!(
         "wrote {} vectors to {} ({})",
         cases.len(),

@@ -262,9 +262,12 @@ pub enum VectorFileError {
     },
 }
 
-/// Parses a whole vector file's text (blank lines are skipped); `path` labels errors.
+/// Parses a whole vector file's text (blank lines are skipped; ids must be unique); `path`
+/// labels errors.
 pub fn parse_vectors(text: &str, path: &str) -> Result<Vec<Case>, VectorFileError> {
     let mut cases = Vec::new();
+    // Ids name the failures in every report: each must be unique.
+    let mut seen = std::collections::HashMap::<String, usize>::new();
     for (i, line) in text.lines().enumerate() {
         if line.trim().is_empty() {
             continue;
@@ -274,6 +277,13 @@ pub fn parse_vectors(text: &str, path: &str) -> Result<Vec<Case>, VectorFileErro
             line: i + 1,
             message: e.to_string(),
         })?;
+        if let Some(first) = seen.insert(case.id.clone(), i + 1) {
+            return Err(VectorFileError::Line {
+                path: path.to_string(),
+                line: i + 1,
+                message: format!("the id {:?} is already used on line {first}", case.id),
+            });
+        }
         cases.push(case);
     }
     if cases.is_empty() {

@@ -176,6 +176,9 @@ fn check_vec(path: &str, field: &str, v: [f64; 3]) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// The largest width or height a scene may have, in pixels.
+pub const MAX_SIDE: usize = 100_000;
+
 fn check_num(path: &str, field: &str, x: f64) -> Result<(), SceneError> {
     if x.is_finite() {
         Ok(())
@@ -242,8 +245,24 @@ impl SceneDescription {
             return Err(invalid(
                 name,
                 format!(
-                    "image.aspect_ratio is {}, it must be positive",
+                    "image.aspect_ratio is {:?}, it must be positive",
                     image.aspect_ratio
+                ),
+            ));
+        }
+        if image.width > MAX_SIDE {
+            return Err(invalid(
+                name,
+                format!("image.width is {}, at most {MAX_SIDE} pixels", image.width),
+            ));
+        }
+        if image.width as f64 / image.aspect_ratio >= (MAX_SIDE + 1) as f64 {
+            return Err(invalid(
+                name,
+                format!(
+                    "image.aspect_ratio is {:?}: a {}-pixel-wide image would be more than \
+                     {MAX_SIDE} pixels high",
+                    image.aspect_ratio, image.width
                 ),
             ));
         }
@@ -264,7 +283,7 @@ impl SceneDescription {
             return Err(invalid(
                 name,
                 format!(
-                    "camera.vfov is {}, it must lie strictly between 0 and 180 degrees",
+                    "camera.vfov is {:?}, it must lie strictly between 0 and 180 degrees",
                     cam.vfov
                 ),
             ));
@@ -273,7 +292,7 @@ impl SceneDescription {
             return Err(invalid(
                 name,
                 format!(
-                    "camera.focus_distance is {}, it must be positive",
+                    "camera.focus_distance is {:?}, it must be positive",
                     cam.focus_distance
                 ),
             ));
@@ -282,7 +301,7 @@ impl SceneDescription {
             return Err(invalid(
                 name,
                 format!(
-                    "camera.defocus_angle is {}, it must lie in [0, 180)",
+                    "camera.defocus_angle is {:?}, it must lie in [0, 180)",
                     cam.defocus_angle
                 ),
             ));

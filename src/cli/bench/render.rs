@@ -31,10 +31,11 @@ const BASELINE_C: &str = include_str!("../../../bench/baseline.c");
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Runs of each timing; the fastest is reported.
-    #[arg(long, value_name = "N", default_value_t = 5)]
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::num::runs)]
     runs: u32,
-    /// Width of the render whose peak memory is measured (the square quad scene, 1 spp).
-    #[arg(long, value_name = "W", default_value_t = 4000)]
+    /// Width of the render whose peak memory is measured (the square quad scene, 1 spp; at most
+    /// 10000, as `render` makes at most 100 million pixels).
+    #[arg(long, value_name = "W", default_value_t = 4000, value_parser = crate::cli::num::memory_width)]
     memory_width: u32,
     /// The C compiler that builds the baseline.
     #[arg(long, value_name = "CC", default_value = "cc")]
