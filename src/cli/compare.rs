@@ -89,6 +89,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .parse()
         .map_err(|e: String| anyhow::anyhow!(e))?;
     if let Some(h) = &args.heatmap {
+        rtoracle::output::check_output_file(h, "--heatmap")?;
         let png = h.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if !png {
             anyhow::bail!(
@@ -96,7 +97,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 h.display()
             );
         }
-        rtoracle::output::check_output_file(h, "--heatmap")?;
     }
     if let Some(r) = &args.report {
         rtoracle::output::check_output_dir(r, "--report")?;

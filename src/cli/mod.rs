@@ -41,12 +41,19 @@ enum Command {
     /// Explain, step by step, the oracle's answer for one vector.
     Explain(explain::Args),
     /// Check an implementation against the intersection vectors.
+    ///
+    /// Exit codes: 0 every vector passed, 1 a vector failed, 2 bad input or a harness error.
     Check(check::Args),
     /// Differential fuzzing of an implementation against the oracle, with shrinking.
     Fuzz(fuzz::Args),
     /// Compare a rendered image with a golden, telling Monte Carlo noise from bugs.
+    ///
+    /// Exit codes: 0 PASS (the differences are noise), 1 FAIL, 2 bad input.
     Compare(compare::Args),
-    /// Grade a submission (or a folder of them) and write the reports.
+    /// Grade a submission (or a folder of them with --batch) and write the reports.
+    ///
+    /// Exit codes: 0 graded (whatever the score; the score is in the reports), 2 bad input or
+    /// a harness error.
     Grade(grade::Args),
     /// Build a Gradescope autograder package.
     Autograder(autograder::Args),

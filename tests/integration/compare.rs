@@ -422,7 +422,7 @@ fn bad_candidates_exit_2_naming_the_file() {
     }
     // Bad options are usage errors, also exit 2.
     let out = compare_cli(p, &["good.png", "--scene", "week04-sphere", "--spp", "0"]);
-    assert_bad_input(&out, "--spp 0");
+    assert_bad_input(&out, "'0' for '--spp");
     let out = compare_cli(p, &["good.png", "--scene", "no-such-scene"]);
     assert_bad_input(&out, "no-such-scene");
     let out = compare_cli(p, &["good.png", "--golden", "missing.exr"]);

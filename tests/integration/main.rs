@@ -1,6 +1,7 @@
 //! One integration-test binary with a module per area (as ripgrep does).
 
 mod check;
+mod cli;
 mod common;
 mod compare;
 mod golden;
