@@ -645,7 +645,8 @@ fn golden_check_names_the_differing_pixel() {
         ],
     );
     assert_eq!(out.status.code(), Some(1));
-    assert!(stdout(&out).contains("rtoracle.spp is '3' but '2' was expected"));
+    // The file (2 spp) is what is checked; the fresh render (3 spp) is what is expected.
+    assert!(stdout(&out).contains("rtoracle.spp is '2' but '3' was expected"));
 }
 
 #[test]
@@ -684,9 +685,9 @@ fn golden_check_rejects_unreadable_files() {
 fn golden_cli_rejects_bad_arguments() {
     let dir = tempfile::tempdir().unwrap();
     let out = run_in(dir.path(), &["golden", "--spp", "0"]);
-    assert_bad_input(&out, "--spp 0");
+    assert_bad_input(&out, "'0' for '--spp");
     let out = run_in(dir.path(), &["golden", "--scenes", "week04-quad,nope"]);
-    assert_bad_input(&out, "unknown scene 'nope'");
+    assert_bad_input(&out, "--scenes nope: no such built-in scene");
     std::fs::write(dir.path().join("file"), "").unwrap();
     let out = run_in(
         dir.path(),

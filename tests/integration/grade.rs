@@ -448,7 +448,7 @@ fn grading_that_cannot_run_exits_2_with_one_line_and_writes_nothing() {
     let out = run_in(dir.path(), &["grade", "sub", "--format", "pdf"]);
     assert_bad_input(&out, "--format \"pdf\"");
     let out = run_in(dir.path(), &["grade", "--batch", "nowhere"]);
-    assert_bad_input(&out, "nowhere: no such submission folder");
+    assert_bad_input(&out, "--batch nowhere: no such folder");
     let out = run_in(dir.path(), &["grade", "sub", "--vectors", "none.jsonl"]);
     assert_bad_input(&out, "none.jsonl: cannot read");
     std::fs::write(dir.path().join("bad.jsonl"), "{\"id\": 1}\n").unwrap();

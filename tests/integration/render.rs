@@ -557,13 +557,25 @@ fn bad_input_is_one_line_and_exit_2() {
     );
 
     // Zero or negative sample counts and widths, on the command line and in the file.
-    assert_render_refused(&[], &["render", "week04-quad", "--spp", "0"], "--spp 0");
-    assert_render_refused(&[], &["render", "week04-quad", "--spp", "-3"], "--spp -3");
-    assert_render_refused(&[], &["render", "week04-quad", "--width", "0"], "--width 0");
+    assert_render_refused(
+        &[],
+        &["render", "week04-quad", "--spp", "0"],
+        "'0' for '--spp",
+    );
+    assert_render_refused(
+        &[],
+        &["render", "week04-quad", "--spp", "-3"],
+        "'-3' for '--spp",
+    );
+    assert_render_refused(
+        &[],
+        &["render", "week04-quad", "--width", "0"],
+        "'0' for '--width",
+    );
     assert_render_refused(
         &[],
         &["render", "week04-quad", "--width", "-7"],
-        "--width -7",
+        "'-7' for '--width",
     );
     let zero_spp = with_line(&good, "samples_per_pixel = 20", "samples_per_pixel = 0");
     assert_render_refused(
@@ -582,24 +594,47 @@ fn bad_input_is_one_line_and_exit_2() {
     assert_render_refused(
         &[],
         &["render", "week04-quad", "-o", "nowhere/out.png"],
-        "the output folder 'nowhere' does not exist",
+        "-o nowhere/out.png: the folder 'nowhere' does not exist",
     );
     assert_render_refused(
         &[],
         &["render", "week04-quad", "-o", "out.jpg"],
-        "out.jpg: cannot write this kind of image",
+        "-o out.jpg: cannot write this kind of image",
     );
     assert_render_refused(
         &[],
         &["render", "week04-quad", "-o", "out"],
-        "out: cannot write this kind of image",
+        "-o out: cannot write this kind of image",
     );
 
-    // An image too large to hold.
+    // An image too large to hold: past the width any image may have, or past the pixels.
     assert_render_refused(
         &[],
         &["render", "week04-quad", "--width", "1000000"],
-        "1000000x1000000 image is too large",
+        "'1000000' for '--width <W>': must be an integer from 1 to 100000",
+    );
+    assert_render_refused(
+        &[],
+        &["render", "week04-quad", "--width", "100000"],
+        "--width 100000: a 100000x100000 image is too large",
+    );
+    // A huge number is shown short, not in 309 digits.
+    let wide = with_line(&good, "defocus_angle = 0.0", "defocus_angle = 1e308");
+    assert_render_refused(
+        &[("scene.toml", &wide)],
+        &render(&[]),
+        "camera.defocus_angle is 1e308, it must lie in [0, 180)",
+    );
+    // A scene whose aspect ratio makes it absurdly high names the aspect ratio, briefly.
+    let flat = with_line(
+        &good,
+        "aspect_ratio = 1.7777777777777777",
+        "aspect_ratio = 1e-300",
+    );
+    assert_render_refused(
+        &[("scene.toml", &flat)],
+        &render(&[]),
+        "image.aspect_ratio is 1e-300: a 400-pixel-wide image would be more than 100000 pixels high",
     );
 
     // scenes --dump of an unknown name.
