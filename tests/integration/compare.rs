@@ -206,6 +206,10 @@ fn course_png(dir: &Path, name: &str) -> CandidateImage {
 
 /// The course's published PNGs (rendered by its Python code, unseeded) pass.
 #[test]
+#[cfg_attr(
+    not(rtoracle_course_fixtures),
+    ignore = "set RTORACLE_COURSE_FIXTURES to the course's published images to run it"
+)]
 fn the_course_pngs_pass() {
     let Some(dir) = course_fixtures("the_course_pngs_pass") else {
         return;
@@ -337,6 +341,10 @@ fn the_command_judges_renders_of_a_builtin_scene() {
 }
 
 #[test]
+#[cfg_attr(
+    not(rtoracle_course_fixtures),
+    ignore = "set RTORACLE_COURSE_FIXTURES to the course's published images to run it"
+)]
 fn the_course_pngs_pass_on_the_command_line() {
     let Some(fixtures) = course_fixtures("the_course_pngs_pass_on_the_command_line") else {
         return;
