@@ -36,21 +36,32 @@ struct FixtureImage {
     encoding: Option<String>,
 }
 
-/// `tests/fixtures/submissions` of this crate.
+include!(concat!(env!("OUT_DIR"), "/fixtures.rs"));
+
+/// The embedded fixture file at `rel` (under `tests/fixtures/`).
+fn embedded(rel: &str) -> Option<&'static [u8]> {
+    FIXTURE_FILES
+        .iter()
+        .find(|(path, _)| *path == rel)
+        .map(|(_, bytes)| *bytes)
+}
+
+/// `tests/fixtures/submissions` of this crate's source (for tests; the benchmark itself uses the
+/// copies embedded at build time).
 pub fn fixtures_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/submissions")
 }
 
 /// The fixture names (the folders holding a `fixture.toml`), sorted.
 pub fn fixture_names() -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(fixtures_dir())
-        .map(|rd| {
-            rd.flatten()
-                .filter(|e| e.path().join("fixture.toml").is_file())
-                .map(|e| e.file_name().to_string_lossy().to_string())
-                .collect()
+    let mut names: Vec<String> = FIXTURE_FILES
+        .iter()
+        .filter_map(|(path, _)| {
+            path.strip_prefix("submissions/")?
+                .strip_suffix("/fixture.toml")
+                .map(String::from)
         })
-        .unwrap_or_default();
+        .collect();
     names.sort();
     names
 }
@@ -71,32 +82,31 @@ pub fn materialize_code(name: &str, dest: &Path) -> Result<Vec<String>, String> 
 }
 
 fn materialize_spec(name: &str, dest: &Path) -> Result<FixtureSpec, String> {
-    let dir = fixtures_dir().join(name);
-    let spec_path = dir.join("fixture.toml");
-    let text =
-        std::fs::read_to_string(&spec_path).map_err(|e| format!("{}: {e}", spec_path.display()))?;
-    let spec: FixtureSpec =
-        toml::from_str(&text).map_err(|e| format!("{}: {e}", spec_path.display()))?;
+    let spec_path = format!("submissions/{name}/fixture.toml");
+    let text = embedded(&spec_path)
+        .and_then(|b| std::str::from_utf8(b).ok())
+        .ok_or_else(|| format!("{spec_path}: no such fixture"))?;
+    let spec: FixtureSpec = toml::from_str(text).map_err(|e| format!("{spec_path}: {e}"))?;
     std::fs::create_dir_all(dest).map_err(|e| format!("{}: {e}", dest.display()))?;
-    let copy_py = |from: &Path| -> Result<(), String> {
-        for e in std::fs::read_dir(from)
-            .map_err(|e| format!("{}: {e}", from.display()))?
-            .flatten()
-        {
-            let n = e.file_name().to_string_lossy().to_string();
-            if n.ends_with(".py") {
-                std::fs::copy(e.path(), dest.join(&n)).map_err(|e| format!("{n}: {e}"))?;
+    // The `.py` files directly in the embedded folder `from` (under `tests/fixtures/`).
+    let copy_py = |from: &str| -> Result<(), String> {
+        for (path, bytes) in FIXTURE_FILES {
+            let Some(n) = path.strip_prefix(from).and_then(|r| r.strip_prefix('/')) else {
+                continue;
+            };
+            if n.ends_with(".py") && !n.contains('/') {
+                std::fs::write(dest.join(n), bytes).map_err(|e| format!("{n}: {e}"))?;
             }
         }
         Ok(())
     };
     // The course's shared modules (RT_utility, RT_ray, RT_material) are the ones the `check`
     // fixtures use; a fixture's `base` and its own files come on top.
-    copy_py(&fixtures_dir().join("../python/common"))?;
+    copy_py("python/common")?;
     if let Some(base) = &spec.base {
-        copy_py(&fixtures_dir().join(base))?;
+        copy_py(&format!("submissions/{base}"))?;
     }
-    copy_py(&dir)?;
+    copy_py(&format!("submissions/{name}"))?;
     Ok(spec)
 }
 
@@ -134,8 +144,9 @@ fn secs(d: Duration) -> f64 {
     d.as_secs_f64()
 }
 
-/// Runs the benchmark and prints its figures; returns `(one submission, batch of 30)` in seconds.
-pub fn run() -> (f64, f64) {
+/// Runs the benchmark and returns its figures as text: one submission and a batch of 30, in
+/// seconds and against the baseline.
+pub fn run() -> String {
     let work = tempfile::tempdir().expect("a temporary folder");
     let names = fixture_names();
     let subs = work.path().join("subs");
@@ -201,24 +212,29 @@ pub fn run() -> (f64, f64) {
         assert_eq!(entries.len(), 30);
         secs(t.elapsed())
     });
-    println!(
+    let mut report = String::new();
+    report.push_str(&format!(
         "grade benchmark (2 threads; fixtures: {})",
         names.join(", ")
-    );
-    println!(
+    ));
+    report.push('\n');
+    report.push_str(&format!(
         "  baseline: start python3 once            {:8.3} s",
         baseline
-    );
-    println!(
+    ));
+    report.push('\n');
+    report.push_str(&format!(
         "  one submission (honest, cold)           {:8.3} s  = {:6.1} x baseline  (target < 10 s)",
         one,
         one / baseline
-    );
-    println!(
+    ));
+    report.push('\n');
+    report.push_str(&format!(
         "  batch of 30 (all fixtures, 2 threads)   {:8.3} s  = {:6.1} x baseline, {:.3} s per submission  (target < 180 s)",
         batch_time,
         batch_time / baseline,
         batch_time / 30.0
-    );
-    (one, batch_time)
+    ));
+    report.push('\n');
+    report
 }
