@@ -52,8 +52,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 fn check_is_rtoracle(binary: &std::path::Path) -> anyhow::Result<()> {
     use std::process::{Command, Stdio};
     let refuse = |why: String| anyhow::anyhow!("--binary {}: {why}", binary.display());
+    if binary.is_dir() {
+        return Err(refuse("is a folder; the rtoracle binary is wanted".into()));
+    }
     if !binary.is_file() {
         return Err(refuse("no such file".into()));
+    }
+    // Not an ELF at all: the package builder says what it must be, without running it.
+    let mut magic = [0u8; 4];
+    let is_elf = std::fs::File::open(binary)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+        .is_ok()
+        && magic == *b"\x7fELF";
+    if !is_elf {
+        return Ok(());
     }
     let dir = tempfile::tempdir().map_err(|e| refuse(format!("cannot run it: {e}")))?;
     let _cleanup = rtoracle::interrupt::remove_on_interrupt(dir.path());

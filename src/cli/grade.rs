@@ -85,6 +85,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         _ => {}
     }
     rtoracle::output::check_output_dir(&args.out, "--out")?;
+    if let Some(sub) = &args.submission {
+        // The reports must not land among the student's files (nor replace them).
+        let out = std::path::absolute(&args.out)?;
+        let sub_abs = sub.canonicalize()?;
+        let out_real = match out.parent().and_then(|p| p.canonicalize().ok()) {
+            Some(parent) => parent.join(out.file_name().unwrap_or_default()),
+            None => out,
+        };
+        if out_real.starts_with(&sub_abs) {
+            anyhow::bail!(
+                "--out {}: is inside the submission folder {}; put the reports elsewhere",
+                args.out.display(),
+                sub.display()
+            );
+        }
+    }
     let vectors = match &args.vectors {
         Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
         None => None,

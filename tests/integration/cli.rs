@@ -376,6 +376,15 @@ fn wrong_names_and_wrong_inputs_are_refused_up_front() {
         (&["golden", "--scenes", "nope"], "no such built-in scene"),
         (&["golden", "--check", "--dir", "a-file"], "is a file"),
         (&["autograder", "--binary", "/bin/ls"], "is not an rtoracle"),
+        (&["autograder", "--binary", "empty"], "is a folder"),
+        (
+            &["grade", "empty", "--out", "empty"],
+            "is inside the submission folder",
+        ),
+        (
+            &["grade", "empty", "--out", "empty/report"],
+            "is inside the submission folder",
+        ),
     ];
     for (args, needle) in cases {
         let out = run_in(root, args);
