@@ -1,20 +1,23 @@
 //! The `rtoracle` command: parses the command line and hands each subcommand to the library.
-//! Exit codes: 0 success or a passing verdict, 1 a failing verdict, 2 bad input or a harness error.
+//! Exit codes: 0 success or a passing verdict, 1 a failing verdict, 2 bad input or a harness error,
+//! 130 / 143 interrupted by SIGINT / SIGTERM (after removing what was half-written). A closed
+//! stdout or stderr never makes it panic (see `cli::out`).
 
+#[macro_use]
 mod cli;
 
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     if let Err(err) = rtoracle::interrupt::install() {
-        eprintln!("rtoracle: cannot install the signal handlers: {err}");
+        errln!("rtoracle: cannot install the signal handlers: {err}");
         return ExitCode::from(2);
     }
     match cli::run() {
         Ok(code) => code,
         Err(err) => {
             // One line: the whole chain of causes, joined by ": ".
-            eprintln!("rtoracle: {err:#}");
+            errln!("rtoracle: {err:#}");
             ExitCode::from(2)
         }
     }

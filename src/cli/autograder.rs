@@ -38,7 +38,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => std::env::current_exe().context("cannot find the running rtoracle binary")?,
     };
     autograder::build_package(&binary, &rubric_text, &args.out)?;
-    eprintln!(
+    errln!(
         "wrote {} (setup.sh, run_autograder, rubric.toml, rtoracle from {}); upload it as the assignment's autograder",
         args.out.display(),
         binary.display()
@@ -104,7 +104,7 @@ fn check_is_rtoracle(binary: &std::path::Path) -> anyhow::Result<()> {
     }
     let ours = format!("rtoracle {}", env!("CARGO_PKG_VERSION"));
     if first.trim() != ours {
-        eprintln!(
+        errln!(
             "rtoracle: note: --binary {} is {}, this is {ours}",
             binary.display(),
             rtoracle::escape::terminal_line(first.trim())

@@ -55,7 +55,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let mut session = Session::start(args.target.command()?, options).context("fuzz")?;
     if let Some(e) = &session.hello().error {
-        eprintln!("rtoracle: the submission cannot be imported: {e}");
+        errln!("rtoracle: the submission cannot be imported: {e}");
     }
     let kinds: Vec<ShapeKind> = ShapeKind::ALL
         .into_iter()

@@ -127,7 +127,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 Err(msg) => outln!("{}: not graded: {msg}", e.name)?,
             }
         }
-        eprintln!(
+        errln!(
             "graded {graded} of {} submissions; gradebook in {}",
             entries.len(),
             args.out.join("gradebook.csv").display()
@@ -153,7 +153,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         report.score,
         report.max_score
     )?;
-    eprintln!(
+    errln!(
         "graded {} in {:.2} s; reports in {}",
         report.submission,
         report.execution_time,

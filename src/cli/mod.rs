@@ -79,7 +79,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
             return Ok(ExitCode::SUCCESS);
         }
         Err(e) => {
-            eprintln!(
+            errln!(
                 "rtoracle: {}",
                 one_line_usage_error(&e.render().to_string())
             );

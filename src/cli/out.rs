@@ -48,3 +48,11 @@ macro_rules! outln {
         $crate::cli::out::print(&(format!($($arg)*) + "\n"))
     };
 }
+
+/// `eprintln!` that cannot panic: a closed stderr (`2>&1 | head -1`) loses the line quietly.
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}

@@ -104,7 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             rtoracle::image_io::write_exr(&output, &film, &attributes)?
         }
     }
-    eprintln!(
+    errln!(
         "rendered {name} ({}x{}, {spp} spp, seed {}) to {}",
         film.width,
         film.height,

@@ -72,7 +72,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     meta_out.write_all((serde_json::to_string_pretty(&meta)? + "\n").as_bytes())?;
     out.commit()?;
     meta_out.commit()?;
-    eprintln!(
+    errln!(
         "wrote {} vectors to {} ({})",
         cases.len(),
         args.output.display(),

@@ -358,7 +358,12 @@ pub fn golden_for_scene(name: &str, candidate_spp: u32) -> Result<Golden, Compar
             }
         }
     }
-    eprintln!("rendering the golden of {name} at {spp} spp (once; it is cached)");
+    // Not `eprintln!`, which panics on a closed stderr.
+    use std::io::Write as _;
+    let _ = writeln!(
+        std::io::stderr(),
+        "rendering the golden of {name} at {spp} spp (once; it is cached)"
+    );
     let golden = Golden::render(&description, name, spp, true)?;
     if let Some(path) = &cached {
         // A cache that cannot be written costs time, not correctness.

@@ -505,6 +505,43 @@ fn a_closed_stdout_is_a_quiet_exit_for_every_subcommand() {
     }
 }
 
+#[test]
+fn a_closed_stderr_is_no_panic_either() {
+    let tmp = tempfile::tempdir().unwrap();
+    let runs: &[(&[&str], i32)] = &[
+        (
+            &[
+                "render",
+                "week04-quad",
+                "--width",
+                "8",
+                "--spp",
+                "1",
+                "-o",
+                "r.png",
+            ],
+            0,
+        ),
+        (&["vectors", "--count", "10", "-o", "v.jsonl"], 0),
+        (&["render", "no-such-scene"], 2),
+        (&["render", "--spp", "-1", "week04-quad"], 2),
+    ];
+    for (args, code) in runs {
+        let mut child = rtoracle()
+            .current_dir(tmp.path())
+            .args(*args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stderr.take());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(*code), "{args:?}");
+    }
+    assert!(tmp.path().join("r.png").is_file() && tmp.path().join("v.jsonl").is_file());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Interruptions
 
