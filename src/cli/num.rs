@@ -18,7 +18,7 @@ pub fn int_in<const LO: u64, const HI: u64>(s: &str) -> Result<u64, String> {
         }
     };
     if t.starts_with('-') && t.len() > 1 && t[1..].bytes().all(|b| b.is_ascii_digit()) {
-        return Err(format!("{} (it is negative)", what()));
+        return Err(format!("{}, not a negative number", what()));
     }
     if t.is_empty() || !t.bytes().all(|b| b.is_ascii_digit()) {
         return Err(what());
