@@ -62,7 +62,9 @@ pub fn judge(expect: &Expect, answer: &Answer) -> Result<(), String> {
                 let off = (0..3)
                     .map(|i| (h.normal[i] - n[i]).abs())
                     .fold(0.0, f64::max);
-                if h.normal.iter().any(|x| !x.is_finite()) || off > 1e-6 {
+                if h.normal.iter().any(|x| !x.is_finite())
+                    || off > expect.normal_tol.unwrap_or(1e-6)
+                {
                     return Err(format!("normal {:?} but expected {n:?}", h.normal));
                 }
             }
