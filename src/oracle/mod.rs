@@ -19,4 +19,4 @@ pub mod vectors;
 
 pub use classify::{analyse, analyse_with, classify, classify_tagged, classify_with};
 pub use profile::{Judging, Precision, Profile};
-pub use suite::default_suite;
+pub use suite::{default_suite, default_suite_with};
