@@ -3,7 +3,8 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use rtoracle::image_io::write_atomically;
-use rtoracle::oracle::generate::generate;
+use rtoracle::oracle::Profile;
+use rtoracle::oracle::generate::generate_with;
 use rtoracle::oracle::suite::DEFAULT_COUNT;
 use rtoracle::oracle::vectors::{SCHEMA_VERSION, ShapeKind};
 
@@ -19,6 +20,8 @@ pub struct Args {
     /// Comma-separated shapes to generate.
     #[arg(long, value_name = "LIST", default_value = "sphere,quad,triangle")]
     shapes: String,
+    #[command(flatten)]
+    judging: super::check::JudgingArgs,
     /// The JSON-lines file to write; `FILE.meta.json` is written beside it.
     #[arg(short, long, value_name = "FILE.jsonl")]
     output: PathBuf,
@@ -45,7 +48,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--count {}: at least one vector is needed", args.count);
     }
     let count = usize::try_from(args.count).context("--count: too large")?;
-    let cases = generate(args.seed, count, &shapes);
+    let judging = args.judging.judging(Profile::Course);
+    let cases = generate_with(args.seed, count, &shapes, judging);
     let mut text = String::with_capacity(cases.len() * 400);
     let mut classes = std::collections::BTreeMap::<String, usize>::new();
     for c in &cases {
@@ -63,6 +67,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "count": cases.len(),
         "shapes": shapes.iter().map(|k| k.name()).collect::<Vec<_>>(),
         "classes": classes,
+        "profile": judging.profile,
+        "precision": judging.precision,
+        "judged_by": judging.to_string(),
     });
     let mut meta_path = args.output.clone().into_os_string();
     meta_path.push(".meta.json");
@@ -73,7 +80,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         (serde_json::to_string_pretty(&meta)? + "\n").as_bytes(),
     )?;
     eprintln!(
-        "wrote {} vectors to {} ({})",
+        "wrote {} vectors judged by {judging} to {} ({})",
         cases.len(),
         args.output.display(),
         classes

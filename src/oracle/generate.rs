@@ -741,12 +741,7 @@ pub fn generate(seed: u64, count: usize, shapes: &[ShapeKind]) -> Vec<Case> {
 
 /// [`generate`] classified under `judging`: the same inputs and ids for every judging; the
 /// classes, tags and tolerances are the judging's.
-pub fn generate_with(
-    seed: u64,
-    count: usize,
-    shapes: &[ShapeKind],
-    judging: Judging,
-) -> Vec<Case> {
+pub fn generate_with(seed: u64, count: usize, shapes: &[ShapeKind], judging: Judging) -> Vec<Case> {
     let mut cases = Vec::with_capacity(count);
     for (kind, category, n) in allocate(count, shapes) {
         let mut r = Stream::new(seed, &format!("{kind}-{category}"));

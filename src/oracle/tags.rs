@@ -13,6 +13,7 @@
 //! | `tangent` | `\|disc\| <= 2^-20 a r^2` (`dist` within about `2^-21 r` of `r`) |
 //! | `near-tangent` | `\|disc\| <= 2^-8 a r^2` (`dist` within about `2^-9 r` of `r`) |
 //! | `far` | `\|C - O\| >= 1000 \|r\|` |
+//! | `tiny` | sphere: `\|r\| <= 2^-10 \|C - O\|`; plane: the longer edge `<= 2^-10 \|Q - O\|` |
 //! | `inside` | `\|C - O\| < \|r\|` |
 //! | `behind` | sphere: `d.(C - O) <= 0` and `\|C - O\| > \|r\|` (both roots negative); plane: `t < 0` |
 //! | `negative-radius` | `r < 0` |
@@ -41,7 +42,8 @@ use super::vectors::{RaySpec, ShapeSpec};
 use crate::geometry::PARALLEL_EPSILON;
 
 /// The tags [`holds`] has a definition for.
-pub const DEFINED: [&str; 19] = [
+pub const DEFINED: [&str; 20] = [
+    "tiny",
     "tangent",
     "near-tangent",
     "far",
@@ -162,6 +164,7 @@ pub fn holds(tag: &str, shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) ->
                 "near-tangent" => within(&disc, &pow2(-8), &ar2),
                 "far" => ff.cmp_value(&dy(1e6).mul(&r2)) != Ordering::Less,
                 "inside" => ff.cmp_value(&r2) == Ordering::Less,
+                "tiny" => r2.mul(&pow2(20)).cmp_value(&ff) != Ordering::Greater,
                 "behind" => h.signum() != Ordering::Less && ff.cmp_value(&r2) == Ordering::Greater,
                 "interval-boundary" => {
                     let ex = exact::sphere_exact(center, radius, ray);
@@ -247,6 +250,15 @@ fn plane_holds(
             }
         }
         "behind" => !ex.nd.is_zero() && ex.tn.mul(&ex.nd).signum() == Ordering::Less,
+        "tiny" => {
+            let w = V3::<Dyadic>::of(ray.origin).minus(&qn);
+            let big = if uu.cmp_value(&vv) == Ordering::Less {
+                vv.clone()
+            } else {
+                uu.clone()
+            };
+            big.mul(&pow2(20)).cmp_value(&w.dot(&w)) != Ordering::Greater
+        }
         "skewed" => uv.mul(&uv).cmp_value(&dy(0.75).mul(&uu).mul(&vv)) != Ordering::Less,
         "skinny" => {
             let (lo, hi) = if uu.cmp_value(&vv) == Ordering::Less {

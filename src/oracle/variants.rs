@@ -480,7 +480,7 @@ fn robust_sphere_f32(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
     let k = half_b / a;
     let perp = [f[0] - d[0] * k, f[1] - d[1] * k, f[2] - d[2] * k];
     let disc = a * (r2 - dot(perp, perp));
-    if !(disc >= 0.0) {
+    if disc.is_nan() || disc < 0.0 {
         return Ok(None);
     }
     let q = -(half_b + disc.sqrt().copysign(half_b));
@@ -671,7 +671,10 @@ mod tests {
             assert!(f.is_empty(), "{} fails {:?}", v.name, &f[..f.len().min(5)]);
         }
         // The robust profile is not "accept everything": it still scores most of the suite.
-        let definite = suite.iter().filter(|c| c.expect.class.is_definite()).count();
+        let definite = suite
+            .iter()
+            .filter(|c| c.expect.class.is_definite())
+            .count();
         assert!(definite * 10 >= suite.len() * 6, "{definite} definite");
     }
 
@@ -682,7 +685,12 @@ mod tests {
         let mut robust_sphere_failures = vec![];
         for v in rtiow() {
             let f = failures(&v, &course);
-            assert!(f.is_empty(), "{} fails course: {:?}", v.name, &f[..f.len().min(5)]);
+            assert!(
+                f.is_empty(),
+                "{} fails course: {:?}",
+                v.name,
+                &f[..f.len().min(5)]
+            );
             if v.shape == ShapeKind::Sphere {
                 robust_sphere_failures = failures(&v, &robust);
             }
@@ -708,20 +716,36 @@ mod tests {
             };
             for v in honest {
                 let f = failures(&v, &suite);
-                assert!(f.is_empty(), "{} fails {profile}/f32: {:?}", v.name, &f[..f.len().min(5)]);
+                assert!(
+                    f.is_empty(),
+                    "{} fails {profile}/f32: {:?}",
+                    v.name,
+                    &f[..f.len().min(5)]
+                );
             }
             let bug = &rtiow_f32_buggy()[0];
-            assert!(!failures(bug, &suite).is_empty(), "{profile}/f32 accepts {}", bug.name);
+            assert!(
+                !failures(bug, &suite).is_empty(),
+                "{profile}/f32 accepts {}",
+                bug.name
+            );
             // Still a real test: most sphere and quad vectors stay definite in f32.
             let definite = suite
                 .iter()
                 .filter(|c| c.expect.class.is_definite() && c.shape.kind() == ShapeKind::Sphere)
                 .count();
-            assert!(definite >= 500, "{definite} definite sphere vectors in {profile}/f32");
+            assert!(
+                definite >= 500,
+                "{definite} definite sphere vectors in {profile}/f32"
+            );
         }
         let f64_suite = judged(Judging::COURSE);
         for v in rtiow_f32() {
-            assert!(!failures(&v, &f64_suite).is_empty(), "{} passes course/f64", v.name);
+            assert!(
+                !failures(&v, &f64_suite).is_empty(),
+                "{} passes course/f64",
+                v.name
+            );
         }
     }
 
