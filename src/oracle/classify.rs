@@ -366,7 +366,7 @@ fn sphere<B: Band>(
     };
     let (tmin, tmax) = (end::<B>(interval[0]), end::<B>(interval[1]));
     // Exact comparisons (from the decision and the exact roots).
-    let ex = exact::sphere_exact(center, radius, ray);
+    let ex = exact::sphere_exact_roots(center, radius, ray, false);
     let disc_pos = ex.disc.signum() == std::cmp::Ordering::Greater;
     let disc_neg = ex.disc.signum() == std::cmp::Ordering::Less;
     let mut checks = vec![Check::new(

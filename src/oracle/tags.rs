@@ -36,6 +36,7 @@
 
 use std::cmp::Ordering;
 
+use super::band::{Iv, robust_sphere_bands_in};
 use super::exact::{self, Dyadic, Num, V3};
 use super::profile::Judging;
 use super::vectors::{RaySpec, ShapeSpec};
@@ -76,44 +77,87 @@ fn poisoned(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> bool {
         .any(|x| !x.is_finite() || (*x == 0.0 && x.is_sign_negative()))
 }
 
-fn dy(x: f64) -> Dyadic {
-    Dyadic::of(x)
+fn pow2(k: i32) -> f64 {
+    libm::ldexp(1.0, k)
 }
 
-fn pow2(k: i32) -> Dyadic {
-    dy(libm::ldexp(1.0, k))
+/// `a <= b`, or `None` when `N` cannot tell.
+fn le<N: Num>(a: &N, b: &N) -> Option<bool> {
+    Some(b.minus(a).sign()? != Ordering::Less)
 }
 
-fn abs(x: &Dyadic) -> Dyadic {
-    if x.signum() == Ordering::Less {
-        x.neg()
+/// `a < b`.
+fn lt<N: Num>(a: &N, b: &N) -> Option<bool> {
+    Some(b.minus(a).sign()? == Ordering::Greater)
+}
+
+/// `|x|`, or `None` when the sign of `x` is unknown.
+fn abs<N: Num>(x: &N) -> Option<N> {
+    Some(if x.sign()? == Ordering::Less {
+        N::of(0.0).minus(x)
     } else {
         x.clone()
-    }
+    })
 }
 
 /// `|x| <= k |y|`.
-fn within(x: &Dyadic, k: &Dyadic, y: &Dyadic) -> bool {
-    abs(x).cmp_value(&k.mul(&abs(y))) != Ordering::Greater
+fn within<N: Num>(x: &N, k: f64, y: &N) -> Option<bool> {
+    le(&abs(x)?, &N::of(k).times(&abs(y)?))
+}
+
+/// The larger of two non-negative values.
+fn max<N: Num>(a: N, b: N) -> Option<N> {
+    Some(if le(&a, &b)? { b } else { a })
+}
+
+/// `|t - end| <= 2^-20 max(|t|, |end|)` for finite `end`, for `t = tn / nd` (`nd != 0`):
+/// `|tn - end nd| <= 2^-20 max(|tn|, |end nd|)`.
+fn near_end_ratio<N: Num>(tn: &N, nd: &N, end: f64) -> Option<bool> {
+    if !end.is_finite() {
+        return Some(false);
+    }
+    let e = N::of(end).times(nd);
+    let m = max(abs(tn)?, abs(&e)?)?;
+    within(&tn.minus(&e), pow2(-20), &m)
 }
 
 /// `|t - end| <= 2^-20 max(|t|, |end|)` for finite `end`.
 fn near_end(t: &Dyadic, end: f64) -> bool {
-    if !end.is_finite() {
-        return false;
+    near_end_ratio(t, &Dyadic::of(1.0), end).expect("exact")
+}
+
+/// `|t - end| <= 2^-20 max(|t|, |end|)` decided in interval arithmetic for `t` in the band
+/// `t`, or `None` when the band cannot tell.
+fn near_end_iv(t: Iv, end: f64) -> Option<bool> {
+    near_end_ratio(&t, &Iv::point(1.0), end)
+}
+
+/// The sphere's `interval-boundary` by the robust root bands when they decide it.
+fn sphere_boundary_fast(
+    center: [f64; 3],
+    radius: f64,
+    ray: &RaySpec,
+    iv: [f64; 2],
+) -> Option<bool> {
+    let b = robust_sphere_bands_in::<Iv>(center, radius, ray.origin, ray.direction);
+    if b.disc.hi < 0.0 {
+        return Some(false);
     }
-    let e = dy(end);
-    let (at, ae) = (abs(t), abs(&e));
-    let m = if at.cmp_value(&ae) == Ordering::Greater {
-        at
-    } else {
-        ae
-    };
-    within(&t.sub(&e), &pow2(-20), &m)
+    if b.disc.lo < 0.0 {
+        return None;
+    }
+    let mut any = false;
+    for t in [b.t_near, b.t_far] {
+        for e in iv {
+            any |= near_end_iv(t, e)?;
+        }
+    }
+    Some(any)
 }
 
 /// Whether `tag`'s definition holds for the case; `None` for a tag without one (`random`,
-/// `overflow`, the ill-conditioned tags, anything unknown).
+/// `overflow`, the ill-conditioned tags, anything unknown). Decided in interval arithmetic
+/// when that can, else with exact dyadic arithmetic.
 pub fn holds(tag: &str, shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Option<bool> {
     if tag == "nonfinite" {
         return Some(poisoned(shape, ray, interval));
@@ -124,12 +168,9 @@ pub fn holds(tag: &str, shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) ->
     if !exact::inputs_finite(shape, ray, interval) {
         return Some(false);
     }
-    let d = V3::<Dyadic>::of(ray.direction);
-    let dd = d.dot(&d);
     match tag {
         "scale" => {
-            let big = libm::ldexp(1.0, 20);
-            let small = libm::ldexp(1.0, -20);
+            let (big, small) = (pow2(20), pow2(-20));
             return Some(
                 shape
                     .numbers()
@@ -139,51 +180,80 @@ pub fn holds(tag: &str, shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) ->
                     .any(|x| *x != 0.0 && (x.abs() >= big || x.abs() <= small)),
             );
         }
-        "unnormalised" => {
-            return Some(
-                dd.cmp_value(&dy(0.25)) != Ordering::Greater
-                    || dd.cmp_value(&dy(4.0)) != Ordering::Less,
-            );
+        "negative-radius" => {
+            return Some(matches!(shape, ShapeSpec::Sphere { radius, .. } if *radius < 0.0));
+        }
+        "interval-boundary" => {
+            if let ShapeSpec::Sphere { center, radius } = *shape {
+                if let Some(b) = sphere_boundary_fast(center, radius, ray, interval) {
+                    return Some(b);
+                }
+                let ex = exact::sphere_exact(center, radius, ray);
+                return Some(match ex.roots {
+                    Some((near, far)) => [near, far]
+                        .iter()
+                        .any(|t| near_end(t, interval[0]) || near_end(t, interval[1])),
+                    None => false,
+                });
+            }
         }
         _ => {}
     }
-    let o = V3::<Dyadic>::of(ray.origin);
+    Some(
+        holds_in::<Iv>(tag, shape, ray, interval)
+            .or_else(|| holds_in::<Dyadic>(tag, shape, ray, interval))
+            .expect("exact arithmetic decides"),
+    )
+}
+
+/// [`holds`] for a defined tag with finite inputs in arithmetic `N` (`None`: cannot tell).
+fn holds_in<N: Num>(
+    tag: &str,
+    shape: &ShapeSpec,
+    ray: &RaySpec,
+    interval: [f64; 2],
+) -> Option<bool> {
+    let d = V3::<N>::of(ray.direction);
+    let dd = d.dot(&d);
+    if tag == "unnormalised" {
+        return Some(le(&dd, &N::of(0.25))? || le(&N::of(4.0), &dd)?);
+    }
+    let o = V3::<N>::of(ray.origin);
     match *shape {
         ShapeSpec::Sphere { center, radius } => {
-            let r = dy(radius);
-            let r2 = r.mul(&r);
+            let r = N::of(radius);
+            let r2 = r.times(&r);
             let f = o.minus(&V3::of(center));
             let ff = f.dot(&f);
-            let h = f.dot(&d); // = -d.(C - O)
-            let disc = h.mul(&h).sub(&dd.mul(&ff.sub(&r2)));
-            let ar2 = dd.mul(&r2);
-            Some(match tag {
-                "degenerate" => radius == 0.0 || ray.direction == [0.0; 3],
-                "negative-radius" => radius < 0.0,
-                "tangent" => within(&disc, &pow2(-20), &ar2),
-                "near-tangent" => within(&disc, &pow2(-8), &ar2),
-                "far" => ff.cmp_value(&dy(1e6).mul(&r2)) != Ordering::Less,
-                "inside" => ff.cmp_value(&r2) == Ordering::Less,
-                "tiny" => r2.mul(&pow2(20)).cmp_value(&ff) != Ordering::Greater,
-                "behind" => h.signum() != Ordering::Less && ff.cmp_value(&r2) == Ordering::Greater,
-                "interval-boundary" => {
-                    let ex = exact::sphere_exact(center, radius, ray);
-                    match ex.roots {
-                        Some((near, far)) => [near, far]
-                            .iter()
-                            .any(|t| near_end(t, interval[0]) || near_end(t, interval[1])),
-                        None => false,
-                    }
+            match tag {
+                "degenerate" => Some(radius == 0.0 || ray.direction == [0.0; 3]),
+                "far" => le(&N::of(1e6).times(&r2), &ff),
+                "inside" => lt(&ff, &r2),
+                "tiny" => le(&r2.times(&N::of(pow2(20))), &ff),
+                "behind" => {
+                    // d.(C - O) <= 0 <=> f.d >= 0, and the origin outside.
+                    let h = f.dot(&d);
+                    Some(h.sign()? != Ordering::Less && lt(&r2, &ff)?)
                 }
-                _ => false,
-            })
+                "tangent" | "near-tangent" => {
+                    let h = f.dot(&d);
+                    let disc = h.times(&h).minus(&dd.times(&ff.minus(&r2)));
+                    let k = if tag == "tangent" {
+                        pow2(-20)
+                    } else {
+                        pow2(-8)
+                    };
+                    within(&disc, k, &dd.times(&r2))
+                }
+                _ => Some(false),
+            }
         }
-        ShapeSpec::Quad { q, u, v } => Some(plane_holds(tag, q, u, v, false, ray, interval)),
-        ShapeSpec::Triangle { a, b, c } => Some(plane_holds(tag, a, b, c, true, ray, interval)),
+        ShapeSpec::Quad { q, u, v } => plane_holds::<N>(tag, q, u, v, false, ray, interval),
+        ShapeSpec::Triangle { a, b, c } => plane_holds::<N>(tag, a, b, c, true, ray, interval),
     }
 }
 
-fn plane_holds(
+fn plane_holds<N: Num>(
     tag: &str,
     q: [f64; 3],
     u: [f64; 3],
@@ -191,84 +261,93 @@ fn plane_holds(
     triangle: bool,
     ray: &RaySpec,
     interval: [f64; 2],
-) -> bool {
-    let qn = V3::<Dyadic>::of(q);
+) -> Option<bool> {
+    let qn = V3::<N>::of(q);
     let (un, vn) = if triangle {
         (V3::of(u).minus(&qn), V3::of(v).minus(&qn))
     } else {
         (V3::of(u), V3::of(v))
     };
-    let ex = exact::plane_exact(q, u, v, triangle, ray);
-    let n = V3(ex.n.clone());
-    let nn = n.dot(&n);
-    let d = V3::<Dyadic>::of(ray.direction);
-    let dd = d.dot(&d);
-    let nd2 = ex.nd.mul(&ex.nd);
-    let (uu, vv, uv) = (un.dot(&un), vn.dot(&vn), un.dot(&vn));
-    let n_zero = ex.n.iter().all(|x| x.is_zero());
-    let edges = || -> Vec<bool> {
-        if ex.nd.is_zero() {
-            return vec![false; 4];
-        }
-        let k = pow2(-20);
-        let a_near_0 = within(&ex.an, &k, &ex.nd);
-        let b_near_0 = within(&ex.bn, &k, &ex.nd);
-        if triangle {
-            let rest = ex.nd.sub(&ex.an).sub(&ex.bn);
-            vec![a_near_0, b_near_0, within(&rest, &k, &ex.nd)]
-        } else {
-            vec![
-                a_near_0,
-                within(&ex.nd.sub(&ex.an), &k, &ex.nd),
-                b_near_0,
-                within(&ex.nd.sub(&ex.bn), &k, &ex.nd),
-            ]
-        }
-    };
+    let n = un.cross(&vn);
+    let mut n_zero = true;
+    for c in &n.0 {
+        n_zero &= c.sign()? == Ordering::Equal;
+    }
+    let d = V3::<N>::of(ray.direction);
+    let w = V3::<N>::of(ray.origin).minus(&qn);
+    let nd = n.dot(&d);
+    let nd_zero = nd.sign()? == Ordering::Equal;
+    let uu = un.dot(&un);
+    let vv = vn.dot(&vn);
     match tag {
-        "degenerate" => n_zero || ray.direction == [0.0; 3] || (ex.nd.is_zero() && ex.tn.is_zero()),
-        "parallel" => !n_zero && ex.nd.is_zero(),
-        "grazing" => !n_zero && nd2.cmp_value(&pow2(-20).mul(&nn).mul(&dd)) != Ordering::Greater,
+        "degenerate" => {
+            return Some(
+                n_zero
+                    || ray.direction == [0.0; 3]
+                    || (nd_zero && n.dot(&w).sign()? == Ordering::Equal),
+            );
+        }
+        "parallel" => return Some(!n_zero && nd_zero),
+        "skewed" => {
+            let uv = un.dot(&vn);
+            return le(&N::of(0.75).times(&uu).times(&vv), &uv.times(&uv));
+        }
+        "skinny" => {
+            return Some(le(&N::of(256.0).times(&uu), &vv)? || le(&N::of(256.0).times(&vv), &uu)?);
+        }
+        "tiny" => {
+            let big = max(uu, vv)?;
+            return le(&big.times(&N::of(pow2(20))), &w.dot(&w));
+        }
+        _ => {}
+    }
+    if n_zero {
+        return Some(false);
+    }
+    let nn = n.dot(&n);
+    let nd2 = nd.times(&nd);
+    match tag {
+        "grazing" => return le(&nd2, &N::of(pow2(-20)).times(&nn).times(&d.dot(&d))),
         "parallel-threshold" => {
             // (n.d)^2 <= (2e-8)^2 n.n
-            let eps = dy(2.0 * PARALLEL_EPSILON);
-            !n_zero && nd2.cmp_value(&eps.mul(&eps).mul(&nn)) != Ordering::Greater
+            let eps = N::of(2.0 * PARALLEL_EPSILON);
+            return le(&nd2, &eps.times(&eps).times(&nn));
         }
-        "edge" => edges().iter().any(|&e| e),
-        "corner" => {
-            let e = edges();
-            if triangle {
-                e.iter().filter(|&&x| x).count() >= 2
-            } else {
-                (e[0] || e[1]) && (e[2] || e[3])
-            }
-        }
+        _ => {}
+    }
+    if nd_zero {
+        return Some(false);
+    }
+    let tn = N::of(0.0).minus(&n.dot(&w));
+    match tag {
         "interval-boundary" => {
-            !ex.nd.is_zero() && {
-                let t = ex.tn.div_approx(&ex.nd, 130);
-                near_end(&t, interval[0]) || near_end(&t, interval[1])
-            }
+            return Some(
+                near_end_ratio(&tn, &nd, interval[0])? || near_end_ratio(&tn, &nd, interval[1])?,
+            );
         }
-        "behind" => !ex.nd.is_zero() && ex.tn.mul(&ex.nd).signum() == Ordering::Less,
-        "tiny" => {
-            let w = V3::<Dyadic>::of(ray.origin).minus(&qn);
-            let big = if uu.cmp_value(&vv) == Ordering::Less {
-                vv.clone()
-            } else {
-                uu.clone()
-            };
-            big.mul(&pow2(20)).cmp_value(&w.dot(&w)) != Ordering::Greater
-        }
-        "skewed" => uv.mul(&uv).cmp_value(&dy(0.75).mul(&uu).mul(&vv)) != Ordering::Less,
-        "skinny" => {
-            let (lo, hi) = if uu.cmp_value(&vv) == Ordering::Less {
-                (uu, vv)
-            } else {
-                (vv, uu)
-            };
-            hi.cmp_value(&dy(256.0).mul(&lo)) != Ordering::Less
-        }
-        _ => false,
+        "behind" => return Some(tn.times(&nd).sign()? == Ordering::Less),
+        _ => {}
+    }
+    // alpha nd = w.(v x d), beta nd = u.(w x d).
+    let an = w.dot(&vn.cross(&d));
+    let bn = un.dot(&w.cross(&d));
+    let k = pow2(-20);
+    let mut e = vec![within(&an, k, &nd)?, within(&bn, k, &nd)?];
+    if triangle {
+        e.push(within(&nd.minus(&an).minus(&bn), k, &nd)?);
+    } else {
+        e.push(within(&nd.minus(&an), k, &nd)?);
+        e.push(within(&nd.minus(&bn), k, &nd)?);
+    }
+    match tag {
+        "edge" => Some(e.iter().any(|&x| x)),
+        "corner" => Some(if triangle {
+            e.iter().filter(|&&x| x).count() >= 2
+        } else {
+            // e = [alpha ~ 0, beta ~ 0, alpha ~ 1, beta ~ 1]
+            (e[0] || e[2]) && (e[1] || e[3])
+        }),
+        _ => Some(false),
     }
 }
 
