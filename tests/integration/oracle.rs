@@ -438,3 +438,73 @@ mod truthful_tags {
         assert!(!text.contains("below 1e-6 |d|"), "{text}");
     }
 }
+
+#[test]
+fn vectors_and_explain_take_a_profile_and_a_precision() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        dir.path(),
+        &[
+            "vectors",
+            "--count",
+            "300",
+            "--profile",
+            "robust",
+            "--precision",
+            "f32",
+            "-o",
+            "v.jsonl",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("v.jsonl.meta.json")).unwrap())
+            .unwrap();
+    assert_eq!(meta["judged_by"], "robust/f32");
+    assert_eq!(meta["profile"], "robust");
+    assert_eq!(meta["precision"], "f32");
+    // Every f32 hit carries the f32 normal tolerance, and the lines are what the oracle says
+    // of their inputs under that judging.
+    let judging = rtoracle::oracle::Judging::new(
+        rtoracle::oracle::Profile::Robust,
+        rtoracle::oracle::Precision::F32,
+    );
+    let cases = read_vectors(&dir.path().join("v.jsonl")).unwrap();
+    for c in &cases {
+        if c.expect.class == Class::Hit {
+            assert_eq!(c.expect.normal_tol, Some(1e-3), "{}", c.id);
+        }
+        let again = rtoracle::oracle::classify_with(&c.shape, &c.ray, c.interval, judging);
+        assert_eq!(again.class, c.expect.class, "{}", c.id);
+    }
+    let out = run_in(
+        dir.path(),
+        &["vectors", "--profile", "naive", "-o", "w.jsonl"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("naive"));
+    assert!(!dir.path().join("w.jsonl").exists());
+    // A far sphere that only the naive formula cannot settle: ambiguous under course, a
+    // definite hit under robust.
+    let course = run_in(dir.path(), &["explain", "sphere-far-0007"]);
+    let robust = run_in(
+        dir.path(),
+        &["explain", "sphere-far-0007", "--profile", "robust"],
+    );
+    let (course, robust) = (
+        String::from_utf8_lossy(&course.stdout),
+        String::from_utf8_lossy(&robust.stdout),
+    );
+    assert!(
+        course.contains("Class: ambiguous") && course.contains("naive-ill-conditioned"),
+        "{course}"
+    );
+    assert!(
+        robust.contains("Class: hit") && robust.contains("(robust/f64)"),
+        "{robust}"
+    );
+}
