@@ -2,7 +2,7 @@
 //!
 //! Each number (shape, origin, direction, interval ends) is replaced, one at a time, by simpler
 //! values: `0`, `+-1`, an integer, then dyadic fractions with fewer bits. A replacement is kept
-//! when [`oracle_expect`] still calls the case definite and the candidate still fails with the
+//! when [`oracle_expect_with`] still calls the case definite and the candidate still fails with the
 //! same kind of failure. Candidates for one number are tried as one batch, so a shrink costs
 //! a few dozen round trips.
 
