@@ -695,6 +695,11 @@ mod tests {
                 robust_sphere_failures = failures(&v, &robust);
             }
         }
+        eprintln!(
+            "RTIOW's sphere fails {} robust vectors of the default suite, e.g. {:?}",
+            robust_sphere_failures.len(),
+            &robust_sphere_failures[..robust_sphere_failures.len().min(2)]
+        );
         assert!(
             robust_sphere_failures
                 .iter()
