@@ -165,7 +165,7 @@ pub fn judge_answer(case: &Case, answer: &super::protocol::Answer) -> Verdict {
                 let off = (0..3)
                     .map(|k| (n[k] - ne[k]).abs())
                     .fold(0.0f64, |a, b| if b.is_nan() { f64::NAN } else { a.max(b) });
-                let close = off <= NORMAL_TOL;
+                let close = off <= expect.normal_tol.unwrap_or(NORMAL_TOL);
                 if !close {
                     return fail(
                         FailureKind::Mismatch,

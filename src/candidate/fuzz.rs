@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::check::{FailureKind, Verdict, judge};
-use super::generate::random_cases;
+use super::generate::random_cases_with;
 use super::process::{HarnessError, Outcome};
 use super::report::python_repro;
+use crate::oracle::Judging;
 use crate::oracle::vectors::{Case, ShapeKind};
 
 /// A candidate as the fuzzer sees it: a batch of cases in, one outcome per case out.
@@ -30,6 +31,8 @@ pub struct FuzzOptions {
     pub kinds: Vec<ShapeKind>,
     /// Largest number of cases tried while shrinking one failure.
     pub shrink_budget: usize,
+    /// The profile and precision the cases are classified by.
+    pub judging: Judging,
 }
 
 impl Default for FuzzOptions {
@@ -41,6 +44,7 @@ impl Default for FuzzOptions {
             round: 1000,
             kinds: ShapeKind::ALL.to_vec(),
             shrink_budget: 2000,
+            judging: Judging::COURSE,
         }
     }
 }
@@ -111,7 +115,7 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
             break;
         }
         let n = options.round.min(options.cases - report.cases_run);
-        let cases = random_cases(options.seed, stream, n, &options.kinds);
+        let cases = random_cases_with(options.seed, stream, n, &options.kinds, options.judging);
         stream += 1;
         if cases.is_empty() {
             break;
@@ -150,7 +154,13 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
                     Err(_) => vec![None; batch.len()],
                 }
             };
-            super::shrink::shrink(&case, kind, &mut fails, options.shrink_budget)
+            super::shrink::shrink_with(
+                &case,
+                kind,
+                &mut fails,
+                options.shrink_budget,
+                options.judging,
+            )
         };
         let message = match run(std::slice::from_ref(&minimal))?
             .first()

@@ -9,13 +9,110 @@
 use rand_core::Rng;
 use rand_pcg::Pcg64;
 
+use crate::oracle::Judging;
+use crate::oracle::generate::{self as og, Stream};
 use crate::oracle::vectors::{Case, Expect, RaySpec, ShapeKind, ShapeSpec};
 
 /// The exact oracle's expected answer for a case when it is definite, `None` when it is not
-/// (degenerate, non-finite, or within the error band of a decision boundary).
+/// (degenerate, non-finite, or within the error band of a decision boundary), under the course
+/// profile in `f64`.
 pub fn oracle_expect(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Option<Expect> {
-    let expect = crate::oracle::classify::classify(shape, ray, interval);
+    oracle_expect_with(shape, ray, interval, Judging::COURSE)
+}
+
+/// [`oracle_expect`] under `judging`.
+pub fn oracle_expect_with(
+    shape: &ShapeSpec,
+    ray: &RaySpec,
+    interval: [f64; 2],
+    judging: Judging,
+) -> Option<Expect> {
+    let expect = crate::oracle::classify::classify_with(shape, ray, interval, judging);
     expect.class.is_definite().then_some(expect)
+}
+
+/// The precision regimes of the vector suite each shape's fuzzing draws from (the oracle's
+/// generator categories), besides `tiny`.
+fn regimes(kind: ShapeKind) -> &'static [&'static str] {
+    match kind {
+        ShapeKind::Sphere => &[
+            "far",
+            "scale",
+            "unnormalised",
+            "tangent",
+            "near-tangent",
+            "interval-boundary",
+            "inside",
+            "behind",
+            "negative-radius",
+            "tiny",
+        ],
+        ShapeKind::Quad => &[
+            "scale",
+            "unnormalised",
+            "grazing",
+            "edge",
+            "corner",
+            "skewed",
+            "skinny",
+            "parallel",
+            "interval-boundary",
+            "tiny",
+        ],
+        ShapeKind::Triangle => &[
+            "scale",
+            "unnormalised",
+            "grazing",
+            "edge",
+            "corner",
+            "interval-boundary",
+            "tiny",
+        ],
+    }
+}
+
+/// A primitive `2^-40 .. 2^-10` the size of its distance from the origin, aimed at (a sphere:
+/// offset up to 1.3 radii; a plane: coordinates in `[-0.4, 1.4]`).
+fn tiny(r: &mut Stream, kind: ShapeKind) -> og::Raw {
+    let s = r.log_scale(-20.0, 20.0);
+    let size = s * r.log_scale(-40.0, -10.0);
+    let origin = og::scale(r.unit(), s * r.uniform(0.0, 4.0));
+    let target = og::add(origin, og::scale(r.unit(), s));
+    let shape = match kind {
+        ShapeKind::Sphere => ShapeSpec::Sphere {
+            center: target,
+            radius: size,
+        },
+        ShapeKind::Quad => ShapeSpec::Quad {
+            q: target,
+            u: og::scale(r.unit(), size),
+            v: og::scale(r.unit(), size),
+        },
+        ShapeKind::Triangle => ShapeSpec::Triangle {
+            a: target,
+            b: og::add(target, og::scale(r.unit(), size)),
+            c: og::add(target, og::scale(r.unit(), size)),
+        },
+    };
+    let aim = match shape {
+        ShapeSpec::Sphere { center, radius } => {
+            og::add(center, og::scale(r.unit(), radius * r.uniform(0.0, 1.3)))
+        }
+        ShapeSpec::Quad { q, u, v } | ShapeSpec::Triangle { a: q, b: u, c: v } => {
+            let (u, v) = if kind == ShapeKind::Triangle {
+                (og::sub(u, q), og::sub(v, q))
+            } else {
+                (u, v)
+            };
+            let (a, b) = (r.uniform(-0.4, 1.4), r.uniform(-0.4, 1.4));
+            og::add(q, og::add(og::scale(u, a), og::scale(v, b)))
+        }
+    };
+    let dir = og::sub(aim, origin);
+    let len = r.log_scale(-10.0, 10.0) / og::dot(dir, dir).sqrt();
+    let mut raw = og::raw_parts(shape, origin, og::scale(dir, len), og::CAMERA);
+    raw.tags = vec!["tiny"];
+    raw
 }
 
 /// A seeded stream of random inputs.
@@ -201,7 +298,61 @@ impl CaseGen {
 }
 
 /// `n` definite random cases of the given kinds (round-robin), deterministic for `seed` and
-/// `stream`; ids are `fuzz-<kind>-<stream>-<n>`.
+/// `stream`, classified under `judging`; ids are `fuzz-<kind>-<stream>-<n>`. Half the attempts
+/// are the small dyadic cases of [`random_cases`] (logic bugs), half draw from every precision
+/// regime the vector suite covers: far spheres (distance over radius up to `1e8`), scenes scaled
+/// by `2^-60 .. 2^60` and translated, tiny primitives (`2^-40 .. 2^-10` of their distance),
+/// tangent and near-tangent ulp ladders, grazing rays, edges and corners, unnormalised
+/// directions (length `1e-3 .. 1e3`) and interval boundaries. Only definite cases are kept.
+pub fn random_cases_with(
+    seed: u64,
+    stream: u64,
+    n: usize,
+    kinds: &[ShapeKind],
+    judging: Judging,
+) -> Vec<Case> {
+    let mut g = CaseGen::new(seed, stream);
+    let mut r = Stream::new(seed, &format!("fuzz-regimes-{stream}"));
+    let mut cases = Vec::with_capacity(n);
+    let mut attempts = 0usize;
+    while cases.len() < n && attempts < 20 * n + 100 {
+        let kind = kinds[attempts % kinds.len()];
+        let i = attempts / kinds.len();
+        attempts += 1;
+        let (shape, ray, interval, gen_tags) = if i % 2 == 0 {
+            g.inputs(kind)
+        } else {
+            let list = regimes(kind);
+            let cat = list[r.int(0, list.len() as i64 - 1) as usize];
+            let raw = if cat == "tiny" {
+                tiny(&mut r, kind)
+            } else {
+                og::raw_case(kind, cat, &mut r, i / 2)
+            };
+            let tags = raw.tags.iter().map(|t| t.to_string()).collect();
+            (raw.shape, raw.ray, raw.interval, tags)
+        };
+        let tag_refs: Vec<&str> = gen_tags.iter().map(String::as_str).collect();
+        let expect = crate::oracle::classify::classify_tagged_with(
+            &shape, &ray, interval, &tag_refs, judging,
+        );
+        if expect.class.is_definite() {
+            cases.push(Case {
+                id: format!("fuzz-{}-{stream}-{:05}", kind.name(), cases.len()),
+                shape,
+                ray,
+                interval,
+                expect,
+            });
+        }
+    }
+    cases
+}
+
+/// `n` definite random cases of the given kinds (round-robin), deterministic for `seed` and
+/// `stream`; ids are `fuzz-<kind>-<stream>-<n>`. Small integers and dyadic fractions only,
+/// classified under the course profile (the fixtures' tests use these; fuzzing uses
+/// [`random_cases_with`]).
 pub fn random_cases(seed: u64, stream: u64, n: usize, kinds: &[ShapeKind]) -> Vec<Case> {
     let mut g = CaseGen::new(seed, stream);
     let mut cases = Vec::with_capacity(n);
@@ -253,6 +404,48 @@ mod tests {
                 .filter(|c| c.expect.tags.iter().any(|t| t == "parallel"))
                 .all(|c| c.expect.class == Class::Miss)
         );
+    }
+
+    fn fuzz_failures(v: &crate::oracle::variants::Variant, cases: &[Case]) -> Vec<String> {
+        cases
+            .iter()
+            .filter(|c| c.shape.kind() == v.shape)
+            .filter_map(|c| {
+                crate::oracle::variants::judge(&c.expect, &(v.run)(&c.shape, &c.ray, c.interval))
+                    .err()
+                    .map(|e| format!("{}: {e}", c.id))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fuzzing_under_robust_finds_rtiow_out_and_the_reference_passes_it() {
+        use crate::oracle::variants::{honest, rtiow};
+        // Seeded: the same 2000 sphere cases every run.
+        let robust = random_cases_with(3, 0, 2000, &[ShapeKind::Sphere], Judging::ROBUST);
+        assert_eq!(robust.len(), 2000);
+        let sphere = rtiow().remove(0);
+        let f = fuzz_failures(&sphere, &robust);
+        assert!(
+            !f.is_empty(),
+            "2000 robust cases never catch RTIOW's sphere"
+        );
+        // Fair: under the course profile the same code passes.
+        let course = random_cases_with(3, 0, 2000, &[ShapeKind::Sphere], Judging::COURSE);
+        assert_eq!(fuzz_failures(&sphere, &course), Vec::<String>::new());
+        // The reference passes every robust fuzzed case of every shape.
+        let all = random_cases_with(4, 1, 3000, &ShapeKind::ALL, Judging::ROBUST);
+        for v in honest().iter().filter(|v| v.name.ends_with("-reference")) {
+            let f = fuzz_failures(v, &all);
+            assert!(f.is_empty(), "{}: {:?}", v.name, &f[..f.len().min(3)]);
+        }
+        // The regimes are reached: far, scaled and tiny cases are among the definite ones.
+        for tag in ["far", "scale", "tiny", "unnormalised", "edge", "grazing"] {
+            assert!(
+                all.iter().any(|c| c.expect.tags.iter().any(|t| t == tag)),
+                "no fuzzed case tagged {tag}"
+            );
+        }
     }
 
     #[test]

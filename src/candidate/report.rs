@@ -98,6 +98,10 @@ pub struct Failure {
 pub struct CheckReport {
     /// The candidate's name (from its hello).
     pub candidate: String,
+    /// What the expectations were judged by (`"robust/f64"`, ...; see
+    /// [`crate::oracle::Judging`]), or where they came from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub judged_by: Option<String>,
     /// Counts over all shapes.
     #[serde(flatten)]
     pub counts: Counts,
@@ -175,6 +179,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
     }
     CheckReport {
         candidate: info.candidate,
+        judged_by: None,
         counts,
         by_shape,
         failures,
@@ -202,6 +207,9 @@ impl CheckReport {
     pub fn to_text(&self, max_failures: usize) -> String {
         let mut s = String::new();
         let _ = writeln!(s, "candidate: {}", self.candidate);
+        if let Some(j) = &self.judged_by {
+            let _ = writeln!(s, "judged by: {j}");
+        }
         if let Some(e) = &self.import_error {
             let _ = writeln!(s, "the submission could not be imported: {e}");
             if !e.traceback.is_empty() {

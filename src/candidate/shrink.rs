@@ -2,12 +2,13 @@
 //!
 //! Each number (shape, origin, direction, interval ends) is replaced, one at a time, by simpler
 //! values: `0`, `+-1`, an integer, then dyadic fractions with fewer bits. A replacement is kept
-//! when [`oracle_expect`] still calls the case definite and the candidate still fails with the
+//! when [`oracle_expect_with`] still calls the case definite and the candidate still fails with the
 //! same kind of failure. Candidates for one number are tried as one batch, so a shrink costs
 //! a few dozen round trips.
 
 use super::check::FailureKind;
-use super::generate::oracle_expect;
+use super::generate::oracle_expect_with;
+use crate::oracle::Judging;
 use crate::oracle::vectors::{Case, RaySpec, ShapeSpec};
 
 /// How simple a number is: fewer fractional bits first, then smaller magnitude. The camera's
@@ -56,7 +57,7 @@ fn numbers(case: &Case) -> Vec<f64> {
 }
 
 /// The case with its numbers replaced, re-classified; `None` when no longer definite.
-fn with_numbers(case: &Case, v: &[f64]) -> Option<Case> {
+fn with_numbers(case: &Case, v: &[f64], judging: Judging) -> Option<Case> {
     let a3 = |i: usize| [v[i], v[i + 1], v[i + 2]];
     let (shape, k) = match case.shape {
         ShapeSpec::Sphere { .. } => (
@@ -88,7 +89,7 @@ fn with_numbers(case: &Case, v: &[f64]) -> Option<Case> {
         direction: a3(k + 3),
     };
     let interval = [v[k + 6], v[k + 7]];
-    let expect = oracle_expect(&shape, &ray, interval)?;
+    let expect = oracle_expect_with(&shape, &ray, interval, judging)?;
     Some(Case {
         id: format!("{}-shrunk", case.id.trim_end_matches("-shrunk")),
         shape,
@@ -106,6 +107,17 @@ pub fn shrink(
     fails: &mut dyn FnMut(&[Case]) -> Vec<Option<FailureKind>>,
     budget: usize,
 ) -> Case {
+    shrink_with(case, kind, fails, budget, Judging::COURSE)
+}
+
+/// [`shrink`], keeping only cases that are definite under `judging`.
+pub fn shrink_with(
+    case: &Case,
+    kind: FailureKind,
+    fails: &mut dyn FnMut(&[Case]) -> Vec<Option<FailureKind>>,
+    budget: usize,
+    judging: Judging,
+) -> Case {
     let mut best = case.clone();
     let mut tried = 0usize;
     // First the camera's interval, then each number in turn, until nothing changes.
@@ -121,13 +133,13 @@ pub fn shrink(
                 w[n - 2] = 1e-6;
                 w[n - 1] = f64::MAX;
                 if w != v {
-                    options.extend(with_numbers(&best, &w));
+                    options.extend(with_numbers(&best, &w, judging));
                 }
             }
             for y in simpler(v[field]) {
                 let mut w = v.clone();
                 w[field] = y;
-                options.extend(with_numbers(&best, &w));
+                options.extend(with_numbers(&best, &w, judging));
             }
             if options.is_empty() {
                 continue;

@@ -14,6 +14,7 @@ pub(crate) fn basic_cases() -> Vec<Case> {
         point: None,
         normal,
         front_face: t.map(|_| true),
+        normal_tol: None,
     };
     let down = RaySpec {
         origin: [0.0, 0.0, 5.0],

@@ -6,7 +6,10 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::candidate::{CandidateCommand, RunOptions, check_command};
-use rtoracle::oracle::{default_suite, vectors::read_vectors};
+use rtoracle::oracle::vectors::{Case, read_vectors};
+use rtoracle::oracle::{
+    Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
+};
 
 /// Which candidate to run (shared by `check` and `fuzz`).
 #[derive(Debug, clap::Args)]
@@ -22,7 +25,65 @@ pub struct Target {
     pub adapter: Option<String>,
 }
 
+/// `--profile` and `--precision` (shared by `check`, `fuzz`, `vectors` and `explain`).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct JudgingArgs {
+    /// Whose formulas draw the line between definite and ambiguous: `course` (the course's
+    /// naive formulas; the default for --python-course and for vectors and explain) or `robust`
+    /// (the reference's robust formulas; the default for --adapter).
+    #[arg(long, value_name = "course|robust")]
+    pub profile: Option<Profile>,
+    /// The precision the candidate computes in: `f64` (the default) or `f32` (inputs rounded to
+    /// f32, bands and tolerances of f32 arithmetic).
+    #[arg(long, value_name = "f64|f32")]
+    pub precision: Option<Precision>,
+}
+
+impl JudgingArgs {
+    /// The judging, with `default` for an absent `--profile`.
+    pub fn judging(&self, default: Profile) -> Judging {
+        Judging::new(
+            self.profile.unwrap_or(default),
+            self.precision.unwrap_or_default(),
+        )
+    }
+
+    /// Whether either flag was given.
+    pub fn given(&self) -> bool {
+        self.profile.is_some() || self.precision.is_some()
+    }
+}
+
+/// Reclassifies `cases` under `judging`, keeping the file's provenance tags (its
+/// ill-conditioned tags belong to the judging that wrote it and are dropped).
+pub fn reclassify(cases: Vec<Case>, judging: Judging) -> Vec<Case> {
+    cases
+        .into_iter()
+        .map(|mut c| {
+            let tags: Vec<&str> = c
+                .expect
+                .tags
+                .iter()
+                .map(String::as_str)
+                .filter(|t| !t.ends_with("ill-conditioned"))
+                .collect();
+            c.expect = classify_tagged_with(&c.shape, &c.ray, c.interval, &tags, judging);
+            c
+        })
+        .collect()
+}
+
 impl Target {
+    /// The profile a candidate is judged by when `--profile` is not given: `course` for the
+    /// course adapter, `robust` for an `--adapter` (another renderer).
+    pub fn default_profile(&self) -> Profile {
+        if self.python_course.is_some() {
+            Profile::Course
+        } else {
+            Profile::Robust
+        }
+    }
+
     /// The command to run.
     pub fn command(&self) -> anyhow::Result<CandidateCommand> {
         self.check()?;
@@ -63,7 +124,10 @@ impl Target {
 pub struct Args {
     #[command(flatten)]
     target: Target,
-    /// A vector file (JSON lines); the built-in suite when absent.
+    #[command(flatten)]
+    judging: JudgingArgs,
+    /// A vector file (JSON lines); the built-in suite when absent. Its expectations are used as
+    /// written unless --profile or --precision is given, which reclassifies every case.
     #[arg(long, value_name = "FILE")]
     vectors: Option<PathBuf>,
     /// Seed of the built-in suite.
@@ -85,9 +149,17 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.target.check()?;
-    let cases = match &args.vectors {
-        Some(path) => read_vectors(path)?,
-        None => default_suite(args.seed),
+    let judging = args.judging.judging(args.target.default_profile());
+    let (cases, judged_by) = match &args.vectors {
+        Some(path) if args.judging.given() => (
+            reclassify(read_vectors(path)?, judging),
+            format!("{judging} (the file's cases reclassified)"),
+        ),
+        Some(path) => (
+            read_vectors(path)?,
+            format!("the expectations in {}", path.display()),
+        ),
+        None => (default_suite_with(args.seed, judging), judging.to_string()),
     };
     if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
         anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
@@ -98,7 +170,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..RunOptions::default()
     };
     let command = args.target.command()?;
-    let report = check_command(command, &cases, options).context("check")?;
+    let mut report = check_command(command, &cases, options).context("check")?;
+    report.judged_by = Some(judged_by);
     let text = if args.json {
         report.to_json()
     } else {

@@ -2,10 +2,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::oracle::explain::explain;
+use rtoracle::oracle::Profile;
+use rtoracle::oracle::explain::explain_with;
 use rtoracle::oracle::generate::CAMERA;
 use rtoracle::oracle::vectors::{Case, RaySpec, ShapeSpec, read_vectors};
-use rtoracle::oracle::{classify, default_suite};
+use rtoracle::oracle::{classify_with, default_suite_with};
 
 /// `rtoracle explain (ID | 'JSON') [--seed S] [--vectors FILE]`
 #[derive(Debug, clap::Args)]
@@ -20,6 +21,8 @@ pub struct Args {
     /// A vector file the id refers to instead of the default suite.
     #[arg(long, value_name = "FILE")]
     vectors: Option<PathBuf>,
+    #[command(flatten)]
+    judging: super::check::JudgingArgs,
 }
 
 #[derive(serde::Deserialize)]
@@ -36,6 +39,7 @@ fn camera() -> [f64; 2] {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let judging = args.judging.judging(Profile::Course);
     let text = args.case.trim();
     let case = if text.starts_with('{') {
         match Case::from_json_line(text) {
@@ -45,7 +49,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     .map_err(|e| anyhow::anyhow!("the case JSON is not valid: {e}"))?;
                 Case {
                     id: "(given)".into(),
-                    expect: classify(&bare.shape, &bare.ray, bare.interval),
+                    expect: classify_with(&bare.shape, &bare.ray, bare.interval, judging),
                     shape: bare.shape,
                     ray: bare.ray,
                     interval: bare.interval,
@@ -56,7 +60,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let (cases, source) = match &args.vectors {
             Some(path) => (read_vectors(path)?, path.display().to_string()),
             None => (
-                default_suite(args.seed),
+                default_suite_with(args.seed, judging),
                 format!("the default suite (seed {})", args.seed),
             ),
         };
@@ -65,6 +69,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .find(|c| c.id == text)
             .with_context(|| format!("no vector with id {text:?} in {source}"))?
     };
-    out!("{}", explain(&case))?;
+    out!("{}", explain_with(&case, judging))?;
     Ok(ExitCode::SUCCESS)
 }

@@ -15,6 +15,8 @@ use rtoracle::oracle::vectors::ShapeKind;
 pub struct Args {
     #[command(flatten)]
     target: super::check::Target,
+    #[command(flatten)]
+    judging: super::check::JudgingArgs,
     /// How many random cases to run.
     #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::count)]
     cases: usize,
@@ -69,6 +71,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         cases: args.cases,
         seed: args.seed,
         time,
+        judging: args.judging.judging(args.target.default_profile()),
         ..FuzzOptions::default()
     };
     // Progress on stderr when it is a terminal: cases run (shrinking included).

@@ -2,7 +2,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::oracle::generate::generate;
+use rtoracle::oracle::Profile;
+use rtoracle::oracle::generate::generate_with;
 use rtoracle::oracle::suite::DEFAULT_COUNT;
 use rtoracle::oracle::vectors::{SCHEMA_VERSION, ShapeKind};
 use rtoracle::output::OutputFile;
@@ -19,6 +20,8 @@ pub struct Args {
     /// Comma-separated shapes to generate.
     #[arg(long, value_name = "LIST", default_value = "sphere,quad,triangle")]
     shapes: String,
+    #[command(flatten)]
+    judging: super::check::JudgingArgs,
     /// The JSON-lines file to write; `FILE.jsonl.meta.json` (the name with `.meta.json`
     /// added) is written beside it.
     #[arg(short, long, value_name = "FILE.jsonl")]
@@ -49,7 +52,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // Both files are checked before the work and appear together, whole, or not at all.
     let mut out = OutputFile::create(&args.output, "-o")?;
     let mut meta_out = OutputFile::create(&meta_path, "-o")?;
-    let cases = generate(args.seed, count, &shapes);
+    let judging = args.judging.judging(Profile::Course);
+    let cases = generate_with(args.seed, count, &shapes, judging);
     let mut text = String::with_capacity(cases.len() * 400);
     let mut classes = std::collections::BTreeMap::<String, usize>::new();
     for c in &cases {
@@ -67,13 +71,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "count": cases.len(),
         "shapes": shapes.iter().map(|k| k.name()).collect::<Vec<_>>(),
         "classes": classes,
+        "profile": judging.profile,
+        "precision": judging.precision,
+        "judged_by": judging.to_string(),
     });
     out.write_all(text.as_bytes())?;
     meta_out.write_all((serde_json::to_string_pretty(&meta)? + "\n").as_bytes())?;
     out.commit()?;
     meta_out.commit()?;
     errln!(
-        "wrote {} vectors to {} ({})",
+        "wrote {} vectors judged by {judging} to {} ({})",
         cases.len(),
         args.output.display(),
         classes

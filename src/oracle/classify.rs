@@ -5,9 +5,18 @@
 //! way to that answer is then checked against the band of its naive formula (see
 //! [`super::band`]), widened by [`K`]: the case is definite only when every comparison that
 //! decides it lies outside its band, so every honest `f64` variant reaches the same answer.
+//!
+//! Which formulas give the bands, and in which precision, is the [`Judging`]: [`analyse`] and
+//! [`classify`] use [`Judging::COURSE`] (today's policy); the `_with` functions take any.
+//! Tags are kept only when their definitions ([`super::tags`]) hold.
 
-use super::band::{IV3, Iv, K, plane_bands, sphere_bands};
+use super::band::{
+    B3, Band, Iv, Iv32, K, PlaneBands, SphereBands, b3, bsub, plane_bands_in,
+    robust_sphere_bands_in, sphere_bands_in, sphere_normal_radius,
+};
 use super::exact::{self, Decision, ExactHit, PlaneSigns, Root};
+use super::profile::{Judging, Precision, Profile};
+use super::tags;
 use super::vectors::{Class, Expect, RaySpec, ShapeSpec};
 use crate::geometry::PARALLEL_EPSILON;
 
@@ -59,12 +68,24 @@ pub struct Analysis {
     pub t_tol: Option<f64>,
     /// Words on why the case is not definite, if it is not.
     pub why: Option<String>,
+    /// What the case was judged by.
+    pub judging: Judging,
 }
 
 /// Classifies a case: its class, tags, and for a hit the exact `t`, `t_tol`, point, normal and
 /// `front_face`.
 pub fn classify(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Expect {
     analyse(shape, ray, interval).expect(&[])
+}
+
+/// [`classify`] under `judging`.
+pub fn classify_with(
+    shape: &ShapeSpec,
+    ray: &RaySpec,
+    interval: [f64; 2],
+    judging: Judging,
+) -> Expect {
+    analyse_with(shape, ray, interval, judging).expect(&[])
 }
 
 /// Classifies a case and merges the generator's `tags` into the answer.
@@ -74,7 +95,30 @@ pub fn classify_tagged(
     interval: [f64; 2],
     tags: &[&str],
 ) -> Expect {
-    analyse(shape, ray, interval).expect(tags)
+    classify_tagged_with(shape, ray, interval, tags, Judging::COURSE)
+}
+
+/// [`classify_tagged`] under `judging`; a generator's tag is kept only when its definition
+/// ([`super::tags`]) holds.
+pub fn classify_tagged_with(
+    shape: &ShapeSpec,
+    ray: &RaySpec,
+    interval: [f64; 2],
+    extra: &[&str],
+    judging: Judging,
+) -> Expect {
+    let mut a = analyse_with(shape, ray, interval, judging);
+    let mut all = a.tags.clone();
+    all.extend(extra.iter().map(|t| t.to_string()));
+    a.tags = tags::truthful(
+        all,
+        a.class == Class::Ambiguous,
+        judging,
+        shape,
+        ray,
+        interval,
+    );
+    a.expect(&[])
 }
 
 impl Analysis {
@@ -97,6 +141,8 @@ impl Analysis {
             point: hit.map(|h| h.point),
             normal: hit.map(|h| h.normal),
             front_face: hit.map(|h| h.front_face),
+            normal_tol: (hit.is_some() && self.judging.precision != Precision::F64)
+                .then(|| self.judging.normal_tol()),
         }
     }
 }
@@ -111,16 +157,54 @@ fn any(tag: &str, decision: Option<Decision>, by_filter: bool, why: &str) -> Ana
         tags: vec![tag.to_string()],
         t_tol: None,
         why: Some(why.to_string()),
+        judging: Judging::COURSE,
     }
 }
 
-fn t_tol(band: Iv, t: f64) -> Option<f64> {
-    let tol = (band.rad() * K).max(1e-9 * t.abs());
+fn t_tol(band: Iv, t: f64, judging: Judging) -> Option<f64> {
+    let tol = (band.rad() * K).max(judging.t_floor() * t.abs());
     tol.is_finite().then_some(tol)
 }
 
-/// The full analysis of a case.
+/// The full analysis of a case under [`Judging::COURSE`].
 pub fn analyse(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Analysis {
+    analyse_with(shape, ray, interval, Judging::COURSE)
+}
+
+/// The full analysis of a case under `judging`, its tags kept only where they hold.
+pub fn analyse_with(
+    shape: &ShapeSpec,
+    ray: &RaySpec,
+    interval: [f64; 2],
+    judging: Judging,
+) -> Analysis {
+    let mut a = match judging.precision {
+        Precision::F64 => analyse_in::<Iv>(shape, ray, interval, judging),
+        Precision::F32 => analyse_in::<Iv32>(shape, ray, interval, judging),
+    };
+    a.judging = judging;
+    a.tags = tags::truthful(
+        std::mem::take(&mut a.tags),
+        a.class == Class::Ambiguous,
+        judging,
+        shape,
+        ray,
+        interval,
+    );
+    a
+}
+
+/// An interval end as code in precision `B` compares with it.
+fn end<B: Band>(x: f64) -> Iv {
+    B::input(x).iv()
+}
+
+fn analyse_in<B: Band>(
+    shape: &ShapeSpec,
+    ray: &RaySpec,
+    interval: [f64; 2],
+    judging: Judging,
+) -> Analysis {
     if !exact::inputs_finite(shape, ray, interval) {
         return any(
             "nonfinite",
@@ -148,47 +232,66 @@ pub fn analyse(shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Analysis
         return a;
     }
     let hit = exact::exact_hit(shape, ray, decision);
+    let ctx = Ctx {
+        decision,
+        by_filter,
+        hit,
+        judging,
+    };
     match *shape {
-        ShapeSpec::Sphere { center, radius } => {
-            sphere(center, radius, ray, interval, decision, by_filter, hit)
-        }
+        ShapeSpec::Sphere { center, radius } => sphere::<B>(center, radius, ray, interval, ctx),
         ShapeSpec::Quad { q, u, v } => {
             let s = exact::plane_signs(shape, ray, interval).expect("a plane shape");
-            let bands = plane_bands(
-                IV3::of(q),
-                IV3::of(u),
-                IV3::of(v),
-                ray.origin,
-                ray.direction,
-            );
-            plane(false, bands, s, ray, interval, decision, by_filter, hit)
+            let bands = plane_bands_in::<B>(b3(q), b3(u), b3(v), ray.origin, ray.direction);
+            plane::<B>(false, bands, s, ray, interval, ctx)
         }
         ShapeSpec::Triangle { a, b, c } => {
             let s = exact::plane_signs(shape, ray, interval).expect("a plane shape");
-            let qa = IV3::of(a);
-            let bands = plane_bands(
+            let qa: B3<B> = b3(a);
+            let bands = plane_bands_in::<B>(
                 qa,
-                IV3::of(b).sub(qa),
-                IV3::of(c).sub(qa),
+                bsub(b3(b), qa),
+                bsub(b3(c), qa),
                 ray.origin,
                 ray.direction,
             );
-            plane(true, bands, s, ray, interval, decision, by_filter, hit)
+            plane::<B>(true, bands, s, ray, interval, ctx)
         }
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn finish(
+/// What every classification step carries along.
+#[derive(Clone, Copy)]
+struct Ctx {
     decision: Decision,
     by_filter: bool,
     hit: Option<ExactHit>,
+    judging: Judging,
+}
+
+/// The words for a profile's formulas in its precision.
+fn formulas(j: Judging) -> String {
+    let who = match j.profile {
+        Profile::Course => "the course's naive formula",
+        Profile::Robust => "the robust formula",
+    };
+    format!("{who} in {}", j.precision)
+}
+
+fn finish(
+    ctx: Ctx,
     checks: Vec<Check>,
     definite: bool,
     mut tags: Vec<String>,
     t_band: Option<Iv>,
     why: Option<String>,
 ) -> Analysis {
+    let Ctx {
+        decision,
+        by_filter,
+        hit,
+        judging,
+    } = ctx;
     let is_hit = hit.is_some();
     let overflow = checks
         .iter()
@@ -220,9 +323,10 @@ fn finish(
                 .map(|c| {
                     let w = c.band.widen(K);
                     format!(
-                        "{} (exactly {}, but the naive formula's band widened by K = {K} is [{:e}, {:e}], which holds 0)",
+                        "{} (exactly {}, but the band of {} widened by K = {K} is [{:e}, {:e}], which holds 0)",
                         c.quantity,
                         if c.passes { "passes" } else { "fails" },
+                        formulas(judging),
                         w.lo,
                         w.hi
                     )
@@ -232,7 +336,7 @@ fn finish(
         })
     };
     let t_tol = match (hit, t_band) {
-        (Some(h), Some(b)) => t_tol(b, h.t),
+        (Some(h), Some(b)) => t_tol(b, h.t, judging),
         _ => None,
     };
     Analysis {
@@ -244,26 +348,32 @@ fn finish(
         tags,
         t_tol,
         why,
+        judging,
     }
 }
 
-fn sphere(
+fn sphere<B: Band>(
     center: [f64; 3],
     radius: f64,
     ray: &RaySpec,
     interval: [f64; 2],
-    decision: Decision,
-    by_filter: bool,
-    hit: Option<ExactHit>,
+    ctx: Ctx,
 ) -> Analysis {
-    let b = sphere_bands(center, radius, ray.origin, ray.direction);
-    let (tmin, tmax) = (Iv::point(interval[0]), Iv::point(interval[1]));
+    let decision = ctx.decision;
+    let b: SphereBands = match ctx.judging.profile {
+        Profile::Course => sphere_bands_in::<B>(center, radius, ray.origin, ray.direction),
+        Profile::Robust => robust_sphere_bands_in::<B>(center, radius, ray.origin, ray.direction),
+    };
+    let (tmin, tmax) = (end::<B>(interval[0]), end::<B>(interval[1]));
     // Exact comparisons (from the decision and the exact roots).
-    let ex = exact::sphere_exact(center, radius, ray);
+    let ex = exact::sphere_exact_roots(center, radius, ray, false);
     let disc_pos = ex.disc.signum() == std::cmp::Ordering::Greater;
     let disc_neg = ex.disc.signum() == std::cmp::Ordering::Less;
     let mut checks = vec![Check::new(
-        "disc = half_b^2 - a c > 0",
+        match ctx.judging.profile {
+            Profile::Course => "disc = half_b^2 - a c > 0",
+            Profile::Robust => "disc = a (r^2 - |f - (f.d/a) d|^2) > 0",
+        },
         "tangent",
         b.disc,
         disc_pos,
@@ -274,7 +384,7 @@ fn sphere(
     }
     if disc_neg {
         let definite = checks[0].definite;
-        return finish(decision, by_filter, hit, checks, definite, tags, None, None);
+        return finish(ctx, checks, definite, tags, None, None);
     }
     // Exact root comparisons with the open interval.
     let cmp = |root: Root| root_signs(&ex, root, interval);
@@ -295,17 +405,16 @@ fn sphere(
     }
     if disc_pos && near_after && near_before {
         let definite = checks.iter().all(|c| c.definite);
-        let (definite, why) = normal_check(definite, center, radius, ray, b.t_near, &mut tags);
-        return finish(
-            decision,
-            by_filter,
-            hit,
-            checks,
+        let (definite, why) = normal_check::<B>(
             definite,
-            tags,
-            Some(b.t_near),
-            why,
+            center,
+            radius,
+            ray,
+            b.t_near,
+            ctx.judging,
+            &mut tags,
         );
+        return finish(ctx, checks, definite, tags, Some(b.t_near), why);
     }
     let near_fails_definitely = checks[1..].iter().any(|c| !c.passes && c.definite);
     let (far_after, far_before) = cmp(Root::Far);
@@ -337,7 +446,15 @@ fn sphere(
     // tangent ray that hits is not definite.
     let definite = definite && (checks[0].definite || decision == Decision::Miss);
     let (definite, why) = if decision == Decision::SphereHit(Root::Far) {
-        normal_check(definite, center, radius, ray, b.t_far, &mut tags)
+        normal_check::<B>(
+            definite,
+            center,
+            radius,
+            ray,
+            b.t_far,
+            ctx.judging,
+            &mut tags,
+        )
     } else {
         (definite, None)
     };
@@ -345,43 +462,36 @@ fn sphere(
         // Exact tangent outside the interval: fine, but say so.
         tags.push("tangent".into());
     }
-    finish(
-        decision,
-        by_filter,
-        hit,
-        checks,
-        definite,
-        tags,
-        Some(b.t_far),
-        why,
-    )
+    finish(ctx, checks, definite, tags, Some(b.t_far), why)
 }
 
-/// A definite sphere hit also needs the naive normal `(O + t d - C) / r` within the 1e-6 the
-/// normal is compared to: far from the sphere, or far from the origin of coordinates, the naive
-/// `t` and point are too coarse for that, and the case is ambiguous (`ill-conditioned`).
-fn normal_check(
+/// A definite sphere hit also needs the profile's normal `(O + t d - C) / r` within the
+/// judging's normal tolerance: far from the sphere, or far from the origin of coordinates, the
+/// computed `t` and point are too coarse for that, and the case is ambiguous (tagged with the
+/// judging's ill-conditioned tag).
+fn normal_check<B: Band>(
     definite: bool,
     center: [f64; 3],
     radius: f64,
     ray: &RaySpec,
     t: Iv,
+    judging: Judging,
     tags: &mut Vec<String>,
 ) -> (bool, Option<String>) {
     if !definite {
         return (false, None);
     }
-    let p = IV3::of(ray.origin).add(IV3::of(ray.direction).scale(t));
-    let n = p.sub(IV3::of(center)).div(Iv::point(radius));
-    let worst = n.0.iter().map(|c| c.widen(K).rad()).fold(0.0, f64::max);
-    if worst <= 1e-6 {
+    let worst = sphere_normal_radius::<B>(center, radius, ray.origin, ray.direction, t);
+    let tol = judging.normal_tol();
+    if worst <= tol {
         (true, None)
     } else {
-        tags.push("ill-conditioned".into());
+        tags.push(judging.ill_conditioned_tag().into());
         (
             false,
             Some(format!(
-                "the decision is certain, but the naive normal (O + t d - C) / r is only known to +-{worst:e} (band widened by K = {K}), more than the 1e-6 it is compared to"
+                "the decision is certain, but the normal (O + t d - C) / r of {} is only known to +-{worst:e} (band widened by K = {K}), more than the {tol:e} it is compared to",
+                formulas(judging)
             )),
         )
     }
@@ -411,17 +521,15 @@ fn root_signs(ex: &exact::SphereExact, root: Root, interval: [f64; 2]) -> (bool,
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn plane(
+fn plane<B: Band>(
     triangle: bool,
-    b: super::band::PlaneBands,
+    b: PlaneBands,
     s: PlaneSigns,
     ray: &RaySpec,
     interval: [f64; 2],
-    decision: Decision,
-    by_filter: bool,
-    hit: Option<ExactHit>,
+    ctx: Ctx,
 ) -> Analysis {
+    let (decision, by_filter) = (ctx.decision, ctx.by_filter);
     if s.parallel {
         // Exactly parallel and off the plane (in the plane is degenerate, handled before). It is
         // a definite miss when the course's f64 denominator `unit(n) . d` is surely below the
@@ -430,7 +538,7 @@ fn plane(
         let check = Check::new(
             "1e-8 - |unit(n) . d| > 0 (parallel)",
             "grazing",
-            Iv::point(PARALLEL_EPSILON) - b.denom.abs(),
+            end::<B>(PARALLEL_EPSILON) - b.denom.abs(),
             true,
         );
         let definite = check.definite;
@@ -451,11 +559,12 @@ fn plane(
             },
             t_tol: None,
             why: (!definite).then(|| {
-                "the ray is exactly parallel to the plane, but the course's rounded unit normal is not exactly perpendicular to d, so honest f64 code may compute a t".to_string()
+                format!("the ray is exactly parallel to the plane, but the rounded unit normal of {} is not exactly perpendicular to d, so honest code may compute a t", formulas(ctx.judging))
             }),
+            judging: ctx.judging,
         };
     }
-    let (tmin, tmax) = (Iv::point(interval[0]), Iv::point(interval[1]));
+    let (tmin, tmax) = (end::<B>(interval[0]), end::<B>(interval[1]));
     let one = Iv::point(1.0);
     let mut checks = vec![
         Check::new(
@@ -515,20 +624,36 @@ fn plane(
     }
     let geometric_hit = checks.iter().all(|c| c.passes);
     let fails_definitely = checks.iter().any(|c| !c.passes && c.definite);
-    let len_d = IV3::of(ray.direction).dot(IV3::of(ray.direction)).sqrt();
+    let dir: B3<Iv> = b3(ray.direction);
+    let len_d = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
     let denom = b.denom.abs();
-    let steep = denom.lo >= 1e-6 * len_d.hi && denom.lo >= PARALLEL_EPSILON * (1.0 + 1e-6);
+    let near_threshold = denom.lo < PARALLEL_EPSILON * (1.0 + 1e-6);
+    let shallow = denom.lo < 1e-6 * len_d.hi;
     let mut tags = vec![];
     let mut why = None;
     let definite = if geometric_hit {
         let all = checks.iter().all(|c| c.definite);
-        if !steep || s.below_threshold {
+        if s.below_threshold || near_threshold {
+            // The course's absolute threshold on |unit(n) . d| decides, or may.
+            tags.push("parallel-threshold".to_string());
+            why = Some(if s.below_threshold {
+                format!(
+                    "the ray meets the primitive, but exactly |unit(n) . d| < 1e-8 (its band is [{:e}, {:e}]): the course's absolute parallel threshold rejects it, so the exact answer is a miss; code that tests only denom == 0 hits, so it is not scored",
+                    denom.lo, denom.hi
+                )
+            } else {
+                format!(
+                    "the ray meets the primitive, but |unit(n) . d| is in [{:e}, {:e}], within rounding of the course's absolute parallel threshold 1e-8, so honest code may reject it",
+                    denom.lo, denom.hi
+                )
+            });
+            false
+        } else if shallow {
             tags.push("grazing".to_string());
             why = Some(format!(
-                "the ray is nearly parallel to the plane: |unit(n) . d| is in [{:e}, {:e}], below 1e-6 |d| = {:e} or near the course's threshold 1e-8, so honest code may call it parallel",
-                denom.lo,
-                denom.hi,
-                1e-6 * len_d.hi
+                "the ray is nearly parallel to the plane: |unit(n) . d| / |d| is in [{:e}, {:e}], below 1e-6, where code that normalises d or scales the threshold differs",
+                denom.lo / len_d.hi,
+                denom.hi / len_d.lo
             ));
             false
         } else {
@@ -542,17 +667,8 @@ fn plane(
     if !definite && edge_amb >= 2 {
         tags.push("corner".into());
     }
-    let _ = triangle;
-    finish(
-        decision,
-        by_filter,
-        hit,
-        checks,
-        definite,
-        tags,
-        Some(b.t),
-        why,
-    )
+    let _ = (triangle, decision, by_filter);
+    finish(ctx, checks, definite, tags, Some(b.t), why)
 }
 
 #[cfg(test)]

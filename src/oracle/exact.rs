@@ -580,6 +580,16 @@ fn dv(v: [f64; 3]) -> V3<Dyadic> {
 
 /// The exact sphere quantities (finite inputs).
 pub fn sphere_exact(center: [f64; 3], radius: f64, ray: &RaySpec) -> SphereExact {
+    sphere_exact_roots(center, radius, ray, true)
+}
+
+/// The exact sphere quantities, the roots only when `roots` (they need a 130-bit square root).
+pub fn sphere_exact_roots(
+    center: [f64; 3],
+    radius: f64,
+    ray: &RaySpec,
+    roots: bool,
+) -> SphereExact {
     let d = dv(ray.direction);
     let oc = dv(center).minus(&dv(ray.origin));
     let a = d.dot(&d);
@@ -587,7 +597,7 @@ pub fn sphere_exact(center: [f64; 3], radius: f64, ray: &RaySpec) -> SphereExact
     let r = Dyadic::of(radius);
     let c = oc.dot(&oc).sub(&r.mul(&r));
     let disc = h.mul(&h).sub(&a.mul(&c));
-    let roots = (disc.signum() != Ordering::Less && !a.is_zero()).then(|| {
+    let roots = (roots && disc.signum() != Ordering::Less && !a.is_zero()).then(|| {
         let s = disc.sqrt_approx(130);
         const B: u64 = 130;
         // No cancellation: (h - s)/a = c/(h + s) when h > 0, and (h + s)/a = c/(h - s) when h < 0.

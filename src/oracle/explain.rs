@@ -5,8 +5,9 @@ use std::cmp::Ordering;
 use std::fmt::Write;
 
 use super::band::K;
-use super::classify::{Analysis, analyse};
+use super::classify::{Analysis, analyse_with};
 use super::exact::{self, Decision, Dyadic, Root};
+use super::profile::{Judging, Profile};
 use super::vectors::{Case, Class, RaySpec, ShapeSpec};
 
 /// A dyadic as a number a reader can take in: the `f64` itself when it is exact, else `~x`.
@@ -30,10 +31,16 @@ fn v(x: [f64; 3]) -> String {
     format!("({:?}, {:?}, {:?})", x[0], x[1], x[2])
 }
 
-/// The explanation of `case` (its `expect` is recomputed, not trusted).
+/// The explanation of `case` under the course profile in `f64` (its `expect` is recomputed, not
+/// trusted).
 pub fn explain(case: &Case) -> String {
+    explain_with(case, Judging::COURSE)
+}
+
+/// The explanation of `case` under `judging`.
+pub fn explain_with(case: &Case, judging: Judging) -> String {
     let mut s = String::new();
-    let a = analyse(&case.shape, &case.ray, case.interval);
+    let a = analyse_with(&case.shape, &case.ray, case.interval, judging);
     let (r, iv) = (&case.ray, case.interval);
     let _ = writeln!(s, "case {}", case.id);
     match case.shape {
@@ -198,6 +205,32 @@ fn plane(
         return;
     }
     let _ = writeln!(s, "  n.d = {}: {}", show(&ex.nd), sign_word(ex.nd.signum()));
+    if !ex.nd.is_zero() {
+        // Exact quantities shown rounded: |unit(n).d| = |n.d| / |n|, and its ratio to |d|.
+        let nn = ex.n[0]
+            .mul(&ex.n[0])
+            .add(&ex.n[1].mul(&ex.n[1]))
+            .add(&ex.n[2].mul(&ex.n[2]));
+        let eps = Dyadic::from_f64(crate::geometry::PARALLEL_EPSILON).expect("finite");
+        let dd: f64 = ray.direction.iter().map(|x| x * x).sum();
+        let nd = ex.nd.to_f64().abs();
+        let len_n = nn.to_f64().sqrt();
+        let denom = nd / len_n;
+        let ratio = denom / dd.sqrt();
+        let _ = writeln!(
+            s,
+            "  |unit(n).d| = ~{denom:e}: {} the course's absolute parallel threshold 1e-8",
+            if ex.nd.mul(&ex.nd).cmp_value(&nn.mul(&eps.mul(&eps))) == Ordering::Less {
+                "below"
+            } else {
+                "not below"
+            }
+        );
+        let _ = writeln!(
+            s,
+            "  |unit(n).d| / |d| = ~{ratio:e} (the cosine between the ray and the normal; a hit with this below 1e-6 is not scored, grazing means <= 2^-10)"
+        );
+    }
     if ex.nd.is_zero() {
         if ex.tn.is_zero() {
             let _ = writeln!(
@@ -267,7 +300,7 @@ fn plane(
         if sg.below_threshold {
             let _ = writeln!(
                 s,
-                "  |unit(n).d| < 1e-8: the course calls the ray parallel (a miss)."
+                "  exactly |unit(n).d| < 1e-8: the course calls the ray parallel (a miss), whatever |d| is."
             );
         }
     }
@@ -295,10 +328,15 @@ fn answer(s: &mut String, a: &Analysis) {
         (None, _) => "miss".to_string(),
     };
     let _ = writeln!(s, "Exact answer: {exact_answer}.");
+    let who = match a.judging.profile {
+        Profile::Course => "the course's naive formula",
+        Profile::Robust => "the reference's robust formula",
+    };
     let _ = writeln!(
         s,
-        "Tolerance policy: each comparison the course's code makes is checked against the band of its\n\
-         naive f64 formula (evaluated in outward-rounded interval arithmetic, widened by K = {K})."
+        "Tolerance policy ({}): each deciding comparison is checked against the band of\n\
+         {who} in {} (outward-rounded interval arithmetic, widened by K = {K}).",
+        a.judging, a.judging.precision
     );
     for c in &a.checks {
         let w = c.band.widen(K);
@@ -314,9 +352,9 @@ fn answer(s: &mut String, a: &Analysis) {
     }
     let class = match a.class {
         Class::Hit => {
-            "hit (definite: every honest f64 implementation must hit, with t within t_tol)"
+            "hit (definite: every honest implementation this judging covers must hit, with t within t_tol)"
         }
-        Class::Miss => "miss (definite: every honest f64 implementation must miss)",
+        Class::Miss => "miss (definite: every honest implementation this judging covers must miss)",
         Class::Ambiguous => {
             "ambiguous (floating point cannot settle it; no answer is marked wrong by default)"
         }
@@ -329,7 +367,11 @@ fn answer(s: &mut String, a: &Analysis) {
         let _ = writeln!(s, "Tags: {}.", a.tags.join(", "));
     }
     if let Some(tol) = a.t_tol.filter(|_| a.class == Class::Hit) {
-        let _ = writeln!(s, "t_tol: {tol:e}.");
+        let _ = writeln!(
+            s,
+            "t_tol: {tol:e}; normal tolerance {:e} per component.",
+            a.judging.normal_tol()
+        );
     }
     if let Some(why) = &a.why {
         let _ = writeln!(s, "Why: {why}.");

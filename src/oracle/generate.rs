@@ -8,7 +8,8 @@
 use rand_core::Rng;
 use rand_pcg::Pcg64;
 
-use super::classify::classify_tagged;
+use super::classify::classify_tagged_with;
+use super::profile::Judging;
 use super::vectors::{Case, RaySpec, ShapeKind, ShapeSpec};
 
 /// The course camera's interval `(1e-6, f64::MAX)`.
@@ -732,14 +733,21 @@ fn allocate(count: usize, shapes: &[ShapeKind]) -> Vec<(ShapeKind, &'static str,
     out
 }
 
-/// `count` classified cases of the given shapes for `seed`, ids like `quad-corner-0007`.
+/// `count` classified cases of the given shapes for `seed`, ids like `quad-corner-0007`, under
+/// the course profile in `f64`.
 pub fn generate(seed: u64, count: usize, shapes: &[ShapeKind]) -> Vec<Case> {
+    generate_with(seed, count, shapes, Judging::COURSE)
+}
+
+/// [`generate`] classified under `judging`: the same inputs and ids for every judging; the
+/// classes, tags and tolerances are the judging's.
+pub fn generate_with(seed: u64, count: usize, shapes: &[ShapeKind], judging: Judging) -> Vec<Case> {
     let mut cases = Vec::with_capacity(count);
     for (kind, category, n) in allocate(count, shapes) {
         let mut r = Stream::new(seed, &format!("{kind}-{category}"));
         for i in 0..n {
             let c = raw_case(kind, category, &mut r, i);
-            let expect = classify_tagged(&c.shape, &c.ray, c.interval, &c.tags);
+            let expect = classify_tagged_with(&c.shape, &c.ray, c.interval, &c.tags, judging);
             cases.push(Case {
                 id: format!("{kind}-{category}-{i:04}"),
                 shape: c.shape,

@@ -11,9 +11,12 @@ pub mod exact;
 pub mod explain;
 pub mod fuzzing;
 pub mod generate;
+pub mod profile;
 pub mod suite;
+pub mod tags;
 pub mod variants;
 pub mod vectors;
 
-pub use classify::{analyse, classify, classify_tagged};
-pub use suite::default_suite;
+pub use classify::{analyse, analyse_with, classify, classify_tagged, classify_with};
+pub use profile::{Judging, Precision, Profile};
+pub use suite::{default_suite, default_suite_with};

@@ -1,6 +1,7 @@
 //! The built-in vector suite: [`DEFAULT_COUNT`] generated cases for a seed.
 
-use super::generate::generate;
+use super::generate::generate_with;
+use super::profile::Judging;
 use super::vectors::{Case, ShapeKind};
 
 /// The number of cases of the default suite.
@@ -9,7 +10,13 @@ pub const DEFAULT_COUNT: usize = 4000;
 /// The default suite for `seed`: every case `rtoracle check` runs when no vector file is given.
 /// The same seed always gives the same cases, bit for bit, with stable ids.
 pub fn default_suite(seed: u64) -> Vec<Case> {
-    generate(seed, DEFAULT_COUNT, &ShapeKind::ALL)
+    default_suite_with(seed, Judging::COURSE)
+}
+
+/// The default suite for `seed` classified under `judging` (the same inputs and ids as
+/// [`default_suite`]).
+pub fn default_suite_with(seed: u64, judging: Judging) -> Vec<Case> {
+    generate_with(seed, DEFAULT_COUNT, &ShapeKind::ALL, judging)
 }
 
 /// Every tag `ORACLE.md` names; the default suite holds each.

@@ -62,7 +62,9 @@ pub fn judge(expect: &Expect, answer: &Answer) -> Result<(), String> {
                 let off = (0..3)
                     .map(|i| (h.normal[i] - n[i]).abs())
                     .fold(0.0, f64::max);
-                if h.normal.iter().any(|x| !x.is_finite()) || off > 1e-6 {
+                if h.normal.iter().any(|x| !x.is_finite())
+                    || off > expect.normal_tol.unwrap_or(1e-6)
+                {
                     return Err(format!("normal {:?} but expected {n:?}", h.normal));
                 }
             }
@@ -325,6 +327,212 @@ fn reference(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
         }))
 }
 
+/// Ray Tracing in One Weekend's own C++ (`sphere.h`, `quad.h`, `hittable.h`), transcribed in the
+/// float type `$t`: every input rounded to `$t` first, all arithmetic in `$t`, C++ semantics
+/// (a division by zero gives an infinity or NaN, never an error).
+macro_rules! rtiow {
+    ($sphere:ident, $quad:ident, $t:ty, $far_first:expr) => {
+        fn $sphere(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+            let ShapeSpec::Sphere { center, radius } = *shape else {
+                return Ok(None);
+            };
+            let v = |x: [f64; 3]| x.map(|c| c as $t);
+            let dot = |a: [$t; 3], b: [$t; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            let (c, r) = (v(center), radius as $t);
+            let (o, d) = (v(ray.origin), v(ray.direction));
+            let (tmin, tmax) = (iv[0] as $t, iv[1] as $t);
+            let surrounds = |x: $t| tmin < x && x < tmax;
+            let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+            let a = dot(d, d);
+            let half_b = dot(oc, d);
+            let cc = dot(oc, oc) - r * r;
+            let discriminant = half_b * half_b - a * cc;
+            if discriminant < 0.0 {
+                return Ok(None);
+            }
+            let sqrtd = discriminant.sqrt();
+            let (first, second) = ((-half_b - sqrtd) / a, (-half_b + sqrtd) / a);
+            let (first, second) = if $far_first {
+                (second, first)
+            } else {
+                (first, second)
+            };
+            let mut root = first;
+            if !surrounds(root) {
+                root = second;
+                if !surrounds(root) {
+                    return Ok(None);
+                }
+            }
+            let p = [0, 1, 2].map(|i| o[i] + root * d[i]);
+            let outward = [0, 1, 2].map(|i| (p[i] - c[i]) / r);
+            let front_face = dot(d, outward) < 0.0;
+            let normal = outward.map(|x| if front_face { x as f64 } else { -x as f64 });
+            Ok(Some(VHit {
+                t: root as f64,
+                normal,
+                front_face,
+            }))
+        }
+
+        fn $quad(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+            let ShapeSpec::Quad { q, u, v: e } = *shape else {
+                return Ok(None);
+            };
+            let v = |x: [f64; 3]| x.map(|c| c as $t);
+            let dot = |a: [$t; 3], b: [$t; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            let cross = |a: [$t; 3], b: [$t; 3]| {
+                [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ]
+            };
+            let (q, u, vv) = (v(q), v(u), v(e));
+            let (o, d) = (v(ray.origin), v(ray.direction));
+            let (tmin, tmax) = (iv[0] as $t, iv[1] as $t);
+            let n = cross(u, vv);
+            let len = dot(n, n).sqrt();
+            let normal = n.map(|x| x / len);
+            let big_d = dot(normal, q);
+            let nn = dot(n, n);
+            let w = n.map(|x| x / nn);
+            let denom = dot(normal, d);
+            if denom.abs() < 1e-8 {
+                return Ok(None);
+            }
+            let t = (big_d - dot(normal, o)) / denom;
+            if !(tmin <= t && t <= tmax) {
+                return Ok(None);
+            }
+            let p = [0, 1, 2].map(|i| o[i] + t * d[i] - q[i]);
+            let alpha = dot(w, cross(p, vv));
+            let beta = dot(w, cross(u, p));
+            if !((0.0..=1.0).contains(&alpha) && (0.0..=1.0).contains(&beta)) {
+                return Ok(None);
+            }
+            let front_face = dot(d, normal) < 0.0;
+            Ok(Some(VHit {
+                t: t as f64,
+                normal: normal.map(|x| if front_face { x as f64 } else { -x as f64 }),
+                front_face,
+            }))
+        }
+    };
+}
+
+rtiow!(rtiow_sphere, rtiow_quad, f64, false);
+rtiow!(rtiow_sphere_f32, rtiow_quad_f32, f32, false);
+rtiow!(rtiow_sphere_f32_far_first, rtiow_quad_f32_unused, f32, true);
+
+/// Ray Tracing in One Weekend's C++ sphere and quad in `f64` (`half_b^2 - a c`, the near root
+/// then the far root with `ray_t.surrounds`, the quad's `fabs(denom) < 1e-8` on the unnormalised
+/// direction, `set_face_normal`). Honest under the course profile; the robust profile finds its
+/// cancellation on far and scaled spheres.
+pub fn rtiow() -> Vec<Variant> {
+    vec![
+        Variant {
+            name: "sphere-rtiow",
+            shape: ShapeKind::Sphere,
+            honest: true,
+            run: rtiow_sphere,
+        },
+        Variant {
+            name: "quad-rtiow",
+            shape: ShapeKind::Quad,
+            honest: true,
+            run: rtiow_quad,
+        },
+    ]
+}
+
+/// The same code in `f32` (inputs rounded to `f32`): honest under `--precision f32`.
+pub fn rtiow_f32() -> Vec<Variant> {
+    vec![
+        Variant {
+            name: "sphere-rtiow-f32",
+            shape: ShapeKind::Sphere,
+            honest: true,
+            run: rtiow_sphere_f32,
+        },
+        Variant {
+            name: "quad-rtiow-f32",
+            shape: ShapeKind::Quad,
+            honest: true,
+            run: rtiow_quad_f32,
+        },
+    ]
+}
+
+/// The reference's robust sphere formulas (`a (r^2 - |f - (f.d/a) d|^2)`, Ray Tracing Gems
+/// roots) transcribed in `f32`, inputs rounded to `f32`: honest under `robust/f32`.
+fn robust_sphere_f32(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let ShapeSpec::Sphere { center, radius } = *shape else {
+        return Ok(None);
+    };
+    let v = |x: [f64; 3]| x.map(|c| c as f32);
+    let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (c, r, o, d) = (v(center), radius as f32, v(ray.origin), v(ray.direction));
+    let (tmin, tmax) = (iv[0] as f32, iv[1] as f32);
+    let f = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+    let (a, half_b, r2) = (dot(d, d), dot(f, d), r * r);
+    let cc = dot(f, f) - r2;
+    let k = half_b / a;
+    let perp = [f[0] - d[0] * k, f[1] - d[1] * k, f[2] - d[2] * k];
+    let disc = a * (r2 - dot(perp, perp));
+    if disc.is_nan() || disc < 0.0 {
+        return Ok(None);
+    }
+    let q = -(half_b + disc.sqrt().copysign(half_b));
+    let (t0, t1) = if q == 0.0 {
+        (-half_b / a, -half_b / a)
+    } else {
+        (cc / q, q / a)
+    };
+    let (near, far) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+    let root = [near, far].into_iter().find(|&t| tmin < t && t < tmax);
+    let Some(root) = root else {
+        return Ok(None);
+    };
+    let outward = [0, 1, 2].map(|i| (o[i] + root * d[i] - c[i]) / r);
+    let front_face = dot(d, outward) < 0.0;
+    Ok(Some(VHit {
+        t: root as f64,
+        normal: outward.map(|x| if front_face { x as f64 } else { -x as f64 }),
+        front_face,
+    }))
+}
+
+/// The reference's robust sphere in `f32` (with RTIOW's `f32` quad, which is the reference's
+/// quad formula): honest under `robust/f32`.
+pub fn robust_f32() -> Vec<Variant> {
+    vec![
+        Variant {
+            name: "sphere-robust-f32",
+            shape: ShapeKind::Sphere,
+            honest: true,
+            run: robust_sphere_f32,
+        },
+        Variant {
+            name: "quad-rtiow-f32",
+            shape: ShapeKind::Quad,
+            honest: true,
+            run: rtiow_quad_f32,
+        },
+    ]
+}
+
+/// The `f32` sphere with a bug (the far root tried first): `--precision f32` must still fail it.
+pub fn rtiow_f32_buggy() -> Vec<Variant> {
+    let _ = rtiow_quad_f32_unused;
+    vec![Variant {
+        name: "sphere-rtiow-f32-far-root-first",
+        shape: ShapeKind::Sphere,
+        honest: false,
+        run: rtiow_sphere_f32_far_first,
+    }]
+}
+
 macro_rules! sphere_variant {
     ($name:literal, $honest:expr, { $($k:ident),* }) => {
         Variant {
@@ -419,6 +627,7 @@ pub fn buggy() -> Vec<Variant> {
 mod tests {
     use super::*;
     use crate::oracle::default_suite;
+    use crate::oracle::profile::{Judging, Precision, Profile};
 
     fn failures(v: &Variant, suite: &[crate::oracle::vectors::Case]) -> Vec<String> {
         suite
@@ -448,6 +657,101 @@ mod tests {
             }
         }
         assert!(bad.is_empty(), "{bad:#?}");
+    }
+
+    fn judged(j: Judging) -> Vec<crate::oracle::vectors::Case> {
+        crate::oracle::default_suite_with(0, j)
+    }
+
+    #[test]
+    fn the_reference_passes_the_robust_profile_on_the_default_suite() {
+        let suite = judged(Judging::ROBUST);
+        for v in honest().iter().filter(|v| v.name.ends_with("-reference")) {
+            let f = failures(v, &suite);
+            assert!(f.is_empty(), "{} fails {:?}", v.name, &f[..f.len().min(5)]);
+        }
+        // The robust profile is not "accept everything": it still scores most of the suite.
+        let definite = suite
+            .iter()
+            .filter(|c| c.expect.class.is_definite())
+            .count();
+        assert!(definite * 10 >= suite.len() * 6, "{definite} definite");
+    }
+
+    #[test]
+    fn rtiow_passes_the_course_profile_and_fails_the_robust_one_on_far_or_scaled_spheres() {
+        let course = judged(Judging::COURSE);
+        let robust = judged(Judging::ROBUST);
+        let mut robust_sphere_failures = vec![];
+        for v in rtiow() {
+            let f = failures(&v, &course);
+            assert!(
+                f.is_empty(),
+                "{} fails course: {:?}",
+                v.name,
+                &f[..f.len().min(5)]
+            );
+            if v.shape == ShapeKind::Sphere {
+                robust_sphere_failures = failures(&v, &robust);
+            }
+        }
+        eprintln!(
+            "RTIOW's sphere fails {} robust vectors of the default suite, e.g. {:?}",
+            robust_sphere_failures.len(),
+            &robust_sphere_failures[..robust_sphere_failures.len().min(2)]
+        );
+        assert!(
+            robust_sphere_failures
+                .iter()
+                .any(|f| f.starts_with("sphere-far-") || f.starts_with("sphere-scale-")),
+            "{robust_sphere_failures:?}"
+        );
+    }
+
+    #[test]
+    fn f32_code_passes_the_f32_profiles_but_not_f64_and_a_buggy_f32_fails() {
+        for profile in [Profile::Course, Profile::Robust] {
+            let suite = judged(Judging::new(profile, Precision::F32));
+            // Naive f32 code under course/f32; the robust formulas in f32 under robust/f32
+            // (which, like robust/f64, finds the naive formula's cancellation).
+            let honest = if profile == Profile::Course {
+                rtiow_f32()
+            } else {
+                robust_f32()
+            };
+            for v in honest {
+                let f = failures(&v, &suite);
+                assert!(
+                    f.is_empty(),
+                    "{} fails {profile}/f32: {:?}",
+                    v.name,
+                    &f[..f.len().min(5)]
+                );
+            }
+            let bug = &rtiow_f32_buggy()[0];
+            assert!(
+                !failures(bug, &suite).is_empty(),
+                "{profile}/f32 accepts {}",
+                bug.name
+            );
+            // Still a real test: most sphere and quad vectors stay definite in f32.
+            let definite = suite
+                .iter()
+                .filter(|c| c.expect.class.is_definite() && c.shape.kind() == ShapeKind::Sphere)
+                .count();
+            assert!(
+                definite >= 500,
+                "{definite} definite sphere vectors in {profile}/f32"
+            );
+        }
+        let f64_suite = judged(Judging::COURSE);
+        for v in rtiow_f32() {
+            assert!(
+                !failures(&v, &f64_suite).is_empty(),
+                "{} passes course/f64",
+                v.name
+            );
+        }
     }
 
     #[test]

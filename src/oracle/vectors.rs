@@ -195,6 +195,10 @@ pub struct Expect {
     /// Whether the ray arrives from the outside.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub front_face: Option<bool>,
+    /// How far each component of a candidate's normal may be from `normal`, when not the
+    /// default `1e-6` (written for `f32` judging: `1e-3`).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "opt_num")]
+    pub normal_tol: Option<f64>,
 }
 
 /// One test vector.
@@ -432,6 +436,7 @@ mod tests {
                 point: None,
                 normal: None,
                 front_face: None,
+                normal_tol: None,
             },
         };
         let line = case.to_json_line();
