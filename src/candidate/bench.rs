@@ -19,20 +19,31 @@ pub fn fixture_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/python")
 }
 
-/// A submission folder for the fixture `variant` (the common modules plus the variant's
-/// `RT_object.py`) in a new temporary folder.
+/// A submission folder for the fixture `variant` (the common modules, then the variant's own
+/// `.py` files: its `RT_object.py` and any common module it replaces, as a later week's
+/// `RT_ray.py`) in a new temporary folder.
 pub fn assemble_fixture(variant: &str) -> std::io::Result<tempfile::TempDir> {
     let root = fixture_root();
     let dir = tempfile::Builder::new()
         .prefix(&format!("rtoracle-fixture-{variant}-"))
         .tempdir()?;
-    for name in ["RT_utility.py", "RT_ray.py", "RT_material.py"] {
-        std::fs::copy(root.join("common").join(name), dir.path().join(name))?;
+    for from in [root.join("common"), root.join("variants").join(variant)] {
+        let mut names: Vec<_> = std::fs::read_dir(&from)?
+            .flatten()
+            .map(|e| e.file_name())
+            .filter(|n| n.to_string_lossy().ends_with(".py"))
+            .collect();
+        names.sort();
+        for name in names {
+            std::fs::copy(from.join(&name), dir.path().join(&name))?;
+        }
     }
-    std::fs::copy(
-        root.join("variants").join(variant).join("RT_object.py"),
-        dir.path().join("RT_object.py"),
-    )?;
+    if !dir.path().join("RT_object.py").is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("fixture {variant} has no RT_object.py"),
+        ));
+    }
     Ok(dir)
 }
 

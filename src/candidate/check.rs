@@ -5,11 +5,17 @@
 //! of the normal within [`NORMAL_TOL`] of the expected unit normal facing the ray, and
 //! `front_face` exact. An error answer, a dead process or a timeout is an `error` / `timeout`;
 //! stray output is a `protocol` error. `ambiguous` and `any` cases are reported, never scored.
+//!
+//! Triangles: the course defines none, so no winding is wrong. [`decide_winding`] reads the
+//! submission's own winding off its answers (the majority of its definite triangle hits whose
+//! `front_face` agrees with `(b - a) x (c - a)`, the reference's, against those that agree with
+//! `(c - a) x (b - a)`; a tie keeps the reference's), and [`judge_wound`] judges `front_face`
+//! against it. The normal facing the ray and `t` do not depend on the winding.
 
 use serde::{Deserialize, Serialize};
 
 use super::process::Outcome;
-use crate::oracle::vectors::{Case, Class};
+use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// How far each component of a candidate's normal may be from the expected one.
 pub const NORMAL_TOL: f64 = 1e-6;
@@ -71,6 +77,84 @@ fn with_junk(mut message: String, junk: &[String]) -> String {
         message.push_str(&format!("; it printed {:?}", junk.join("\n")));
     }
     message
+}
+
+/// Which way a submission's triangles face: the side `front_face` calls the front.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Winding {
+    /// The outward normal is `unit((b - a) x (c - a))`, as the reference's.
+    BaCa,
+    /// The outward normal is `unit((c - a) x (b - a))`.
+    CaBa,
+}
+
+impl Winding {
+    /// The cross product, as the report says it: `"(b - a) x (c - a)"`.
+    pub fn formula(self) -> &'static str {
+        match self {
+            Winding::BaCa => "(b - a) x (c - a)",
+            Winding::CaBa => "(c - a) x (b - a)",
+        }
+    }
+
+    /// `case` with its expectation as the winding makes it: `front_face` negated for a
+    /// triangle when the winding is not the reference's; any other case unchanged.
+    pub fn expectation(self, case: &Case) -> std::borrow::Cow<'_, Case> {
+        match (self, case.shape.kind()) {
+            (Winding::CaBa, ShapeKind::Triangle) => {
+                let mut c = case.clone();
+                c.expect.front_face = c.expect.front_face.map(|f| !f);
+                std::borrow::Cow::Owned(c)
+            }
+            _ => std::borrow::Cow::Borrowed(case),
+        }
+    }
+}
+
+/// The winding of the submission's triangles, decided from its answers on definite triangle
+/// hits that it answers with a hit and a `front_face`: [`Winding::CaBa`] when more of them
+/// disagree with the reference's `front_face` than agree, else [`Winding::BaCa`]. `None` when
+/// there is no such answer (no triangles run, or none hit).
+pub fn decide_winding(cases: &[Case], outcomes: &[Outcome]) -> Option<Winding> {
+    let (mut agree, mut disagree) = (0usize, 0usize);
+    for (case, outcome) in cases.iter().zip(outcomes) {
+        if case.shape.kind() != ShapeKind::Triangle || case.expect.class != Class::Hit {
+            continue;
+        }
+        let Outcome::Answered { answer, .. } = outcome else {
+            continue;
+        };
+        if answer.error.is_some() || answer.hit != Some(true) {
+            continue;
+        }
+        match (case.expect.front_face, answer.front_face) {
+            (Some(e), Some(f)) if e == f => agree += 1,
+            (Some(_), Some(_)) => disagree += 1,
+            _ => {}
+        }
+    }
+    match (agree, disagree) {
+        (0, 0) => None,
+        (a, d) if d > a => Some(Winding::CaBa),
+        _ => Some(Winding::BaCa),
+    }
+}
+
+/// [`judge`] with triangles' `front_face` judged against `winding` (`None`: the reference's).
+pub fn judge_wound(case: &Case, outcome: &Outcome, winding: Option<Winding>) -> Verdict {
+    match winding {
+        Some(w) => judge(&w.expectation(case), outcome),
+        None => judge(case, outcome),
+    }
+}
+
+/// [`judge_exact`] with triangles' `front_face` judged against `winding`.
+pub fn judge_exact_wound(case: &Case, outcome: &Outcome, winding: Option<Winding>) -> Verdict {
+    match winding {
+        Some(w) => judge_exact(&w.expectation(case), outcome),
+        None => judge_exact(case, outcome),
+    }
 }
 
 /// Judges `outcome` for `case`.
