@@ -90,6 +90,7 @@ pub fn describe(mistake_id: &str) -> String {
         "quad-no-interval-check" => "not checking t against the interval",
         "quad-u-v-swapped-in-beta" => "a sign error in beta (p x u instead of u x p)",
         "quad-beta-uses-v" => "using v instead of u in beta (v x p)",
+        "quad-unnormalised-normal" => "not normalising the quad's normal u x v",
         "quad-d-from-u" => "computing D from u instead of Q (D = n . u)",
         "quad-interior-upper-bounds-only" => {
             "checking only alpha <= 1 and beta <= 1 (not >= 0) for the interior"

@@ -77,8 +77,9 @@ def missing_module_message(exc):
 
 def error_json(exc):
     # Leave out the adapter's own frame: the traceback starts in the submission.
-    tb = exc.__traceback__
-    tb = "".join(traceback.format_exception(type(exc), exc, tb.tb_next if tb else None))
+    raw = exc.__traceback__
+    raw = raw.tb_next if raw else None
+    tb = "".join(traceback.format_exception(type(exc), exc, raw))
     if len(tb) > TB_LIMIT:
         tb = "..." + tb[-TB_LIMIT:]
     message = None
@@ -87,6 +88,13 @@ def error_json(exc):
             message = missing_module_message(exc)
         except Exception:
             message = None
+        if message is not None:
+            # The traceback ends with what the grader means, not Python's "No module named".
+            frames = traceback.format_tb(raw)
+            tb = "Traceback (most recent call last):\n" + "".join(frames)
+            tb += "ModuleNotFoundError: " + message + "\n"
+            if len(tb) > TB_LIMIT:
+                tb = "..." + tb[-TB_LIMIT:]
     if message is None:
         try:
             message = str(exc)

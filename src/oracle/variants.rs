@@ -467,6 +467,7 @@ struct QuadExtra {
     beta_uses_v: bool,
     d_from_u: bool,
     upper_bounds_only: bool,
+    unnormalised_normal: bool,
 }
 
 /// The course's quad (as `quad-course`) with one of the extra mistakes.
@@ -475,7 +476,11 @@ fn quad_extra(o: QuadExtra, shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> A
         return Ok(None);
     };
     let uxv = cross(u, v);
-    let normal = unit(uxv)?;
+    let normal = if o.unnormalised_normal {
+        uxv
+    } else {
+        unit(uxv)?
+    };
     let big_d = if o.d_from_u {
         dot(normal, u)
     } else {
@@ -578,6 +583,18 @@ pub fn buggy_extra() -> Vec<Variant> {
             },
         },
         Variant {
+            name: "quad-unnormalised-normal",
+            shape: ShapeKind::Quad,
+            honest: false,
+            run: |s, r, i| {
+                let o = QuadExtra {
+                    unnormalised_normal: true,
+                    ..Default::default()
+                };
+                quad_extra(o, s, r, i)
+            },
+        },
+        Variant {
             name: "triangle-absolute-epsilon",
             shape: ShapeKind::Triangle,
             honest: false,
@@ -594,19 +611,28 @@ mod extra_tests {
     #[test]
     fn every_extra_buggy_variant_fails_a_definite_vector_and_differs_from_the_others() {
         let suite = default_suite(0);
+        // The failing vectors and the wrong answers given on them.
         let fails = |v: &Variant| -> Vec<String> {
             suite
                 .iter()
                 .filter(|c| c.shape.kind() == v.shape && c.expect.class.is_definite())
-                .filter(|c| judge(&c.expect, &(v.run)(&c.shape, &c.ray, c.interval)).is_err())
-                .map(|c| c.id.clone())
+                .filter_map(|c| {
+                    let answer = (v.run)(&c.shape, &c.ray, c.interval);
+                    judge(&c.expect, &answer)
+                        .is_err()
+                        .then(|| format!("{} {answer:?}", c.id))
+                })
                 .collect()
         };
         let old: Vec<Vec<String>> = buggy().iter().map(fails).collect();
         for v in buggy_extra() {
             let f = fails(&v);
             assert!(!f.is_empty(), "{} passes every definite vector", v.name);
-            assert!(!old.contains(&f), "{} fails as an existing variant", v.name);
+            assert!(
+                !old.contains(&f),
+                "{} answers as an existing variant",
+                v.name
+            );
         }
     }
 }

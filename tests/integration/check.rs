@@ -100,7 +100,8 @@ fn mixed() -> &'static [Case] {
 
 /// Each buggy fixture and the catalogue's mistake that is its bug (by how the fixture is
 /// written: make_variants.py).
-const DIAGNOSED: [(&str, &str); 19] = [
+const DIAGNOSED: [(&str, &str); 20] = [
+    ("bug_quad_unnormalised_normal", "quad-unnormalised-normal"),
     ("bug_far_root_first", "sphere-far-root-first"),
     ("bug_sphere_no_interval_check", "sphere-no-interval-check"),
     ("bug_unnormalised_normal", "sphere-unnormalised-normal"),
@@ -285,6 +286,16 @@ fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
     assert_eq!(
         e.message,
         "your code imports rtoracle_no_such_module, which the grader does not provide"
+    );
+    // The traceback (what grade's feedback shows) ends with the same words, after the line of
+    // the student's file that imports it.
+    assert!(
+        e.traceback
+            .trim_end()
+            .ends_with(&format!("ModuleNotFoundError: {}", e.message))
+            && e.traceback.contains("import rtoracle_no_such_module"),
+        "{}",
+        e.traceback
     );
     let r = check(
         "bug_imports_a_course_module_not_uploaded",

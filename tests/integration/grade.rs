@@ -308,13 +308,25 @@ fn report_json_holds_checks_repros_metrics_pictures_and_hashes() {
     }
     let sphere = &r["checks"][0];
     assert_eq!(sphere["id"], "sphere.intersect");
+    // The fixture tries the far root first (its source says so): the diagnosis names it, as
+    // data and beside the smallest failing case.
+    assert_eq!(
+        r["code"]["diagnosis"][0]["mistake_id"],
+        "sphere-far-root-first"
+    );
+    assert_eq!(r["code"]["diagnosis"][0]["shape"], "sphere");
+    assert!(sphere["message"].as_str().unwrap().contains(
+        "Diagnosis: your sphere failures are exactly those of taking the far root first"
+    ));
     let f = &sphere["failures"][0];
     assert_eq!(f["kind"], "mismatch");
     let repro = f["repro"].as_str().unwrap();
     // The reproduction runs in the submission folder and shows the wrong answer.
     let sub = b.subs.join("sphere-bug");
     std::fs::write(sub.join("repro.py"), repro).unwrap();
-    let out = std::process::Command::new("python3")
+    // With the Python the grader used (the submission's RT_utility imports numpy and PIL).
+    let python = rtoracle::candidate::bench::course_python().expect("the batch graded with it");
+    let out = std::process::Command::new(python)
         .arg("repro.py")
         .current_dir(&sub)
         .output()
