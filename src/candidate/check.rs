@@ -332,6 +332,86 @@ mod tests {
         ));
     }
 
+    /// A definite triangle hit facing +z (the reference's `(b - a) x (c - a)`) seen from above.
+    fn triangle_hit(id: &str) -> Case {
+        use crate::oracle::vectors::{Expect, RaySpec, ShapeSpec};
+        Case {
+            id: id.into(),
+            shape: ShapeSpec::Triangle {
+                a: [0.0, 0.0, 0.0],
+                b: [1.0, 0.0, 0.0],
+                c: [0.0, 1.0, 0.0],
+            },
+            ray: RaySpec {
+                origin: [0.25, 0.25, 1.0],
+                direction: [0.0, 0.0, -1.0],
+            },
+            interval: [1e-6, f64::MAX],
+            expect: Expect {
+                class: Class::Hit,
+                tags: vec![],
+                t: Some(1.0),
+                t_tol: None,
+                point: Some([0.25, 0.25, 0.0]),
+                normal: Some([0.0, 0.0, 1.0]),
+                front_face: Some(true),
+            },
+        }
+    }
+
+    fn said(front_face: bool) -> Outcome {
+        Outcome::Answered {
+            answer: Answer::hit(1.0, [0.25, 0.25, 0.0], [0.0, 0.0, 1.0], front_face),
+            junk: vec![],
+        }
+    }
+
+    #[test]
+    fn the_winding_is_the_majority_of_the_answers_and_front_face_is_judged_by_it() {
+        let cases: Vec<Case> = (0..3).map(|i| triangle_hit(&format!("t{i}"))).collect();
+        // Two of three answers face (c - a) x (b - a): that is the winding, and the third,
+        // inconsistent with it, is the only failure.
+        let outcomes = [said(false), said(false), said(true)];
+        let w = decide_winding(&cases, &outcomes);
+        assert_eq!(w, Some(Winding::CaBa));
+        assert_eq!(judge_wound(&cases[0], &outcomes[0], w), Verdict::Pass);
+        assert!(matches!(
+            judge_wound(&cases[2], &outcomes[2], w),
+            Verdict::Fail {
+                kind: FailureKind::Mismatch,
+                ..
+            }
+        ));
+        // A tie keeps the reference's winding; no triangle hit decides nothing.
+        assert_eq!(
+            decide_winding(&cases[..2], &[said(true), said(false)]),
+            Some(Winding::BaCa)
+        );
+        assert_eq!(
+            decide_winding(&cases, &vec![Outcome::Timeout { junk: vec![] }; 3]),
+            None
+        );
+        // The winding never changes a sphere's judgement, nor a triangle's normal or t.
+        let sphere = sphere_hit();
+        let right = Outcome::Answered {
+            answer: Answer::hit(4.0, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], true),
+            junk: vec![],
+        };
+        assert_eq!(
+            judge_wound(&sphere, &right, Some(Winding::CaBa)),
+            Verdict::Pass
+        );
+        let flipped = Outcome::Answered {
+            answer: Answer::hit(1.0, [0.25, 0.25, 0.0], [0.0, 0.0, -1.0], false),
+            junk: vec![],
+        };
+        assert!(matches!(
+            judge_wound(&cases[0], &flipped, Some(Winding::CaBa)),
+            Verdict::Fail { .. }
+        ));
+        assert_eq!(Winding::CaBa.formula(), "(c - a) x (b - a)");
+    }
+
     #[test]
     fn junk_times_and_deaths_have_their_kinds_and_unscored_cases_are_not_scored() {
         let case = sphere_hit();
