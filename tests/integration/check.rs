@@ -214,6 +214,22 @@ fn students_triangles_are_run_in_each_constructor_form_and_judged_by_their_own_w
         RunOptions::default(),
     );
     assert!(r.passed() && r.failures.is_empty());
+    // fuzz judges by the same winding: random triangles (and spheres and quads) all pass.
+    let dir = assemble_fixture("honest_triangle_mt_mat_required_cxb").unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let out = run_py(
+        tmp.path(),
+        &[
+            "fuzz",
+            "--python-course",
+            dir.path().to_str().unwrap(),
+            "--cases",
+            "3000",
+        ],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("0 failed"), "{text}");
     // A stub with three vertices and no intersect is unsupported: nothing run, nothing failed.
     let r = check_on(
         "honest_triangle_stub_without_intersect",
