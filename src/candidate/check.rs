@@ -5,11 +5,17 @@
 //! of the normal within [`NORMAL_TOL`] of the expected unit normal facing the ray, and
 //! `front_face` exact. An error answer, a dead process or a timeout is an `error` / `timeout`;
 //! stray output is a `protocol` error. `ambiguous` and `any` cases are reported, never scored.
+//!
+//! Triangles: the course defines none, so no winding is wrong. [`decide_winding`] reads the
+//! submission's own winding off its answers (the majority of its definite triangle hits whose
+//! `front_face` agrees with `(b - a) x (c - a)`, the reference's, against those that agree with
+//! `(c - a) x (b - a)`; a tie keeps the reference's), and [`judge_wound`] judges `front_face`
+//! against it. The normal facing the ray and `t` do not depend on the winding.
 
 use serde::{Deserialize, Serialize};
 
 use super::process::Outcome;
-use crate::oracle::vectors::{Case, Class};
+use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// How far each component of a candidate's normal may be from the expected one.
 pub const NORMAL_TOL: f64 = 1e-6;
@@ -71,6 +77,84 @@ fn with_junk(mut message: String, junk: &[String]) -> String {
         message.push_str(&format!("; it printed {:?}", junk.join("\n")));
     }
     message
+}
+
+/// Which way a submission's triangles face: the side `front_face` calls the front.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Winding {
+    /// The outward normal is `unit((b - a) x (c - a))`, as the reference's.
+    BaCa,
+    /// The outward normal is `unit((c - a) x (b - a))`.
+    CaBa,
+}
+
+impl Winding {
+    /// The cross product, as the report says it: `"(b - a) x (c - a)"`.
+    pub fn formula(self) -> &'static str {
+        match self {
+            Winding::BaCa => "(b - a) x (c - a)",
+            Winding::CaBa => "(c - a) x (b - a)",
+        }
+    }
+
+    /// `case` with its expectation as the winding makes it: `front_face` negated for a
+    /// triangle when the winding is not the reference's; any other case unchanged.
+    pub fn expectation(self, case: &Case) -> std::borrow::Cow<'_, Case> {
+        match (self, case.shape.kind()) {
+            (Winding::CaBa, ShapeKind::Triangle) => {
+                let mut c = case.clone();
+                c.expect.front_face = c.expect.front_face.map(|f| !f);
+                std::borrow::Cow::Owned(c)
+            }
+            _ => std::borrow::Cow::Borrowed(case),
+        }
+    }
+}
+
+/// The winding of the submission's triangles, decided from its answers on definite triangle
+/// hits that it answers with a hit and a `front_face`: [`Winding::CaBa`] when more of them
+/// disagree with the reference's `front_face` than agree, else [`Winding::BaCa`]. `None` when
+/// there is no such answer (no triangles run, or none hit).
+pub fn decide_winding(cases: &[Case], outcomes: &[Outcome]) -> Option<Winding> {
+    let (mut agree, mut disagree) = (0usize, 0usize);
+    for (case, outcome) in cases.iter().zip(outcomes) {
+        if case.shape.kind() != ShapeKind::Triangle || case.expect.class != Class::Hit {
+            continue;
+        }
+        let Outcome::Answered { answer, .. } = outcome else {
+            continue;
+        };
+        if answer.error.is_some() || answer.hit != Some(true) {
+            continue;
+        }
+        match (case.expect.front_face, answer.front_face) {
+            (Some(e), Some(f)) if e == f => agree += 1,
+            (Some(_), Some(_)) => disagree += 1,
+            _ => {}
+        }
+    }
+    match (agree, disagree) {
+        (0, 0) => None,
+        (a, d) if d > a => Some(Winding::CaBa),
+        _ => Some(Winding::BaCa),
+    }
+}
+
+/// [`judge`] with triangles' `front_face` judged against `winding` (`None`: the reference's).
+pub fn judge_wound(case: &Case, outcome: &Outcome, winding: Option<Winding>) -> Verdict {
+    match winding {
+        Some(w) => judge(&w.expectation(case), outcome),
+        None => judge(case, outcome),
+    }
+}
+
+/// [`judge_exact`] with triangles' `front_face` judged against `winding`.
+pub fn judge_exact_wound(case: &Case, outcome: &Outcome, winding: Option<Winding>) -> Verdict {
+    match winding {
+        Some(w) => judge_exact(&w.expectation(case), outcome),
+        None => judge_exact(case, outcome),
+    }
 }
 
 /// Judges `outcome` for `case`.
@@ -246,6 +330,87 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    /// A definite triangle hit facing +z (the reference's `(b - a) x (c - a)`) seen from above.
+    fn triangle_hit(id: &str) -> Case {
+        use crate::oracle::vectors::{Expect, RaySpec, ShapeSpec};
+        Case {
+            id: id.into(),
+            shape: ShapeSpec::Triangle {
+                a: [0.0, 0.0, 0.0],
+                b: [1.0, 0.0, 0.0],
+                c: [0.0, 1.0, 0.0],
+            },
+            ray: RaySpec {
+                origin: [0.25, 0.25, 1.0],
+                direction: [0.0, 0.0, -1.0],
+            },
+            interval: [1e-6, f64::MAX],
+            expect: Expect {
+                class: Class::Hit,
+                tags: vec![],
+                t: Some(1.0),
+                t_tol: None,
+                point: Some([0.25, 0.25, 0.0]),
+                normal: Some([0.0, 0.0, 1.0]),
+                normal_tol: None,
+                front_face: Some(true),
+            },
+        }
+    }
+
+    fn said(front_face: bool) -> Outcome {
+        Outcome::Answered {
+            answer: Answer::hit(1.0, [0.25, 0.25, 0.0], [0.0, 0.0, 1.0], front_face),
+            junk: vec![],
+        }
+    }
+
+    #[test]
+    fn the_winding_is_the_majority_of_the_answers_and_front_face_is_judged_by_it() {
+        let cases: Vec<Case> = (0..3).map(|i| triangle_hit(&format!("t{i}"))).collect();
+        // Two of three answers face (c - a) x (b - a): that is the winding, and the third,
+        // inconsistent with it, is the only failure.
+        let outcomes = [said(false), said(false), said(true)];
+        let w = decide_winding(&cases, &outcomes);
+        assert_eq!(w, Some(Winding::CaBa));
+        assert_eq!(judge_wound(&cases[0], &outcomes[0], w), Verdict::Pass);
+        assert!(matches!(
+            judge_wound(&cases[2], &outcomes[2], w),
+            Verdict::Fail {
+                kind: FailureKind::Mismatch,
+                ..
+            }
+        ));
+        // A tie keeps the reference's winding; no triangle hit decides nothing.
+        assert_eq!(
+            decide_winding(&cases[..2], &[said(true), said(false)]),
+            Some(Winding::BaCa)
+        );
+        assert_eq!(
+            decide_winding(&cases, &vec![Outcome::Timeout { junk: vec![] }; 3]),
+            None
+        );
+        // The winding never changes a sphere's judgement, nor a triangle's normal or t.
+        let sphere = sphere_hit();
+        let right = Outcome::Answered {
+            answer: Answer::hit(4.0, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], true),
+            junk: vec![],
+        };
+        assert_eq!(
+            judge_wound(&sphere, &right, Some(Winding::CaBa)),
+            Verdict::Pass
+        );
+        let flipped = Outcome::Answered {
+            answer: Answer::hit(1.0, [0.25, 0.25, 0.0], [0.0, 0.0, -1.0], false),
+            junk: vec![],
+        };
+        assert!(matches!(
+            judge_wound(&cases[0], &flipped, Some(Winding::CaBa)),
+            Verdict::Fail { .. }
+        ));
+        assert_eq!(Winding::CaBa.formula(), "(c - a) x (b - a)");
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::check::{FailureKind, Verdict, judge};
+use super::check::{FailureKind, Verdict, decide_winding, judge_wound};
 use super::generate::random_cases_with;
 use super::process::{HarnessError, Outcome};
 use super::report::python_repro;
@@ -110,6 +110,8 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
     let mut found: Vec<(Case, FailureKind)> = Vec::new();
     let mut seen: BTreeSet<(ShapeKind, FailureKind)> = BTreeSet::new();
     let mut stream = 0u64;
+    // Students' triangles are judged by their own winding, decided on the first round that hits.
+    let mut winding = None;
     while report.cases_run < options.cases {
         if options.time.is_some_and(|t| start.elapsed() >= t) {
             break;
@@ -122,8 +124,9 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
         }
         let outcomes = run(&cases)?;
         report.cases_run += cases.len();
+        winding = winding.or_else(|| decide_winding(&cases, &outcomes));
         for (case, outcome) in cases.iter().zip(&outcomes) {
-            if let Verdict::Fail { kind, .. } = judge(case, outcome) {
+            if let Verdict::Fail { kind, .. } = judge_wound(case, outcome, winding) {
                 if kind == FailureKind::NotRun {
                     continue;
                 }
@@ -146,7 +149,7 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
                     Ok(outcomes) => batch
                         .iter()
                         .zip(&outcomes)
-                        .map(|(c, o)| match judge(c, o) {
+                        .map(|(c, o)| match judge_wound(c, o, winding) {
                             Verdict::Fail { kind, .. } => Some(kind),
                             _ => None,
                         })
@@ -164,7 +167,7 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
         };
         let message = match run(std::slice::from_ref(&minimal))?
             .first()
-            .map(|o| judge(&minimal, o))
+            .map(|o| judge_wound(&minimal, o, winding))
         {
             Some(Verdict::Fail { message, .. }) => message,
             _ => "failed when first run".into(),

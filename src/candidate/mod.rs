@@ -7,6 +7,7 @@
 //!   course adapter on a submission folder) in the [sandbox](crate::sandbox) with pipelined
 //!   requests, per-case timeouts, restarts after crashes and the process group killed on drop.
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and its text.
+//! - [`diagnose`]: the known mistake (a buggy variant of the oracle) that explains the failures.
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
 //! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
 //!   [`generate::oracle_expect`], shrinking, the fuzz driver.
@@ -14,6 +15,7 @@
 
 pub mod bench;
 pub mod check;
+pub mod diagnose;
 pub mod fuzz;
 pub mod generate;
 pub mod process;

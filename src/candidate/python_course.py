@@ -1,14 +1,23 @@
 """rtoracle's adapter for the course's Python API (protocol 1, JSON lines, stdlib only).
 
 Usage: python3 -I -B python_course.py SUBMISSION_DIR [--name NAME] [--prints-to-stderr]
+                                        [--requires numpy,PIL]
 
 Imports RT_utility, RT_ray and RT_object from SUBMISSION_DIR (rtoracle runs it in its sandbox
 folder, where the submission's .py files are copied, with SUBMISSION_DIR "."), builds the course's objects with
 their constructors and answers one request line with one answer line, in order. Answers are
 written in batches (see _Channel), or one by one when a request says "sync": true (the harness
 asks for that after a crash or timeout, since a crash loses the answers not yet written).
+
+It drives every week's API unmodified: a `Ray` with extra defaulted parameters (`fTime=0.0`), a
+`Triangle` whose constructor takes a material (`Triangle(v0, v1, v2, mat)`, given `None`) or
+none, answers holding numpy floats or arrays (read with float() and bool()). A module the
+submission imports that is neither its own nor in `--requires` (default numpy and PIL) is
+reported as the student's ("your code imports scipy, which the grader does not provide"); a
+missing required module is said to be the grader's.
 """
 
+import inspect
 import json
 import os
 import sys
@@ -33,19 +42,106 @@ def num(x):
 
 
 def vec(v):
-    e = v.e
+    # A Vec3 (components in .e, a list or a numpy array), or a bare sequence or array.
+    e = getattr(v, "e", v)
     return "[" + num(e[0]) + "," + num(e[1]) + "," + num(e[2]) + "]"
+
+
+def truth(x):
+    """front_face as a JSON boolean: Python and numpy booleans (np.bool_), 0 and 1."""
+    if x is True or x is False:
+        return "true" if x else "false"
+    return "true" if bool(x) else "false"
+
+
+REQUIRES = ["numpy", "PIL"]
+SUBMISSION = "."
+
+
+def missing_module_message(exc):
+    """What a ModuleNotFoundError means for grading, or None to keep Python's message."""
+    name = getattr(exc, "name", None)
+    if not isinstance(name, str) or not name:
+        return None
+    top = name.split(".")[0]
+    if top in REQUIRES:
+        return (
+            "the grader's Python lacks %s, which the assignment requires: this is the "
+            "grader's problem, not the submission's (tell the instructor)" % top
+        )
+    own = os.path.join(SUBMISSION, top + ".py")
+    if top.startswith("RT_") and not os.path.exists(own):
+        return "your code imports %s, which is not in your submission (upload %s.py)" % (top, top)
+    return "your code imports %s, which the grader does not provide" % top
 
 
 def error_json(exc):
     # Leave out the adapter's own frame: the traceback starts in the submission.
-    tb = exc.__traceback__
-    tb = "".join(traceback.format_exception(type(exc), exc, tb.tb_next if tb else None))
+    raw = exc.__traceback__
+    raw = raw.tb_next if raw else None
+    tb = "".join(traceback.format_exception(type(exc), exc, raw))
     if len(tb) > TB_LIMIT:
         tb = "..." + tb[-TB_LIMIT:]
+    message = None
+    if isinstance(exc, ModuleNotFoundError):
+        try:
+            message = missing_module_message(exc)
+        except Exception:
+            message = None
+        if message is not None:
+            # The traceback ends with what the grader means, not Python's "No module named".
+            frames = traceback.format_tb(raw)
+            tb = "Traceback (most recent call last):\n" + "".join(frames)
+            tb += "ModuleNotFoundError: " + message + "\n"
+            if len(tb) > TB_LIMIT:
+                tb = "..." + tb[-TB_LIMIT:]
+    if message is None:
+        try:
+            message = str(exc)
+        except Exception:
+            message = "(the exception's message cannot be printed)"
     return json.dumps(
-        {"type": type(exc).__name__, "message": str(exc)[:TB_LIMIT], "traceback": tb}
+        {"type": type(exc).__name__, "message": message[:TB_LIMIT], "traceback": tb}
     )
+
+
+def triangle_maker(Triangle, Vec3):
+    """A function (a, b, c) -> a Triangle, or None when the class cannot make one.
+
+    The constructor's signature says how: three vertices, plus None for each further required
+    parameter (a material). The week-4 stub (no vertices) and a class whose objects have no
+    callable intersect are unsupported.
+    """
+    if Triangle is None:
+        return None
+    extra = 0
+    try:
+        params = list(inspect.signature(Triangle).parameters.values())
+    except (TypeError, ValueError):
+        params = None
+    if params is not None:
+        positional = [
+            p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+        ]
+        varargs = any(p.kind == p.VAR_POSITIONAL for p in params)
+        required = [p for p in positional if p.default is p.empty]
+        if len(positional) < 3 and not varargs:
+            return None
+        extra = max(0, len(required) - 3)
+        if any(p.kind == p.KEYWORD_ONLY and p.default is p.empty for p in params):
+            return None
+    nones = (None,) * extra
+
+    def make(a, b, c):
+        return Triangle(a, b, c, *nones)
+
+    try:
+        t = make(Vec3(0.0, 0.0, 0.0), Vec3(1.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0))
+        if not callable(getattr(t, "intersect", None)):
+            return None
+    except BaseException:
+        return None
+    return make
 
 
 class _Channel:
@@ -124,6 +220,10 @@ def main():
     name = "python-course " + submission
     if "--name" in args[:-1]:
         name = args[args.index("--name") + 1]
+    global SUBMISSION
+    SUBMISSION = submission
+    if "--requires" in args[:-1]:
+        REQUIRES[:] = [m for m in args[args.index("--requires") + 1].split(",") if m]
     sys.path.insert(0, os.path.abspath(submission))
     if "--prints-to-stderr" in args:
         # Grading: what the submission prints (even from C or a child process) goes to stderr,
@@ -169,12 +269,10 @@ def main():
     Sphere = getattr(RT_object, "Sphere", None)
     Quad = getattr(RT_object, "Quad", None)
     Triangle = getattr(RT_object, "Triangle", None)
-    # The week-4 Triangle is an empty stub: support it only when it takes three vertices.
-    try:
-        Triangle(Vec3(0.0, 0.0, 0.0), Vec3(1.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0)).intersect
+    # The week-4 Triangle is an empty stub: support it only when it can make one.
+    make_triangle = triangle_maker(Triangle, Vec3)
+    if make_triangle is not None:
         hello["shapes"].append("triangle")
-    except BaseException:
-        pass
     out.write(json.dumps(hello) + "\n")
     threading.Thread(target=chan.watchdog, daemon=True).start()
     monotonic = time.monotonic
@@ -205,7 +303,7 @@ def main():
             elif kind == "quad":
                 obj = Quad(v3(s["q"]), v3(s["u"]), v3(s["v"]), None)
             else:
-                obj = Triangle(v3(s["a"]), v3(s["b"]), v3(s["c"]))
+                obj = make_triangle(v3(s["a"]), v3(s["b"]), v3(s["c"]))
             hit = obj.intersect(
                 Ray(v3(r["origin"]), v3(r["direction"])),
                 Interval(float(iv[0]), float(iv[1])),
@@ -218,7 +316,7 @@ def main():
                     + ',"hit":true,"t":' + num(hit.getT())
                     + ',"point":' + vec(hit.getP())
                     + ',"normal":' + vec(hit.getNormal())
-                    + ',"front_face":' + ("true" if hit.front_face else "false")
+                    + ',"front_face":' + truth(hit.front_face)
                     + "}\n"
                 )
         except BaseException as exc:  # anything the submission raises, SystemExit included

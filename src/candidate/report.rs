@@ -12,7 +12,8 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use super::check::{FailureKind, Verdict, judge, judge_exact};
+use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_exact_wound, judge_wound};
+use super::diagnose::Diagnosis;
 use super::process::Outcome;
 use super::protocol::{Answer, CandidateError};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
@@ -122,6 +123,13 @@ pub struct CheckReport {
     /// not the drop user, if so), network isolation. `None` for in-process candidates.
     #[serde(default)]
     pub sandbox: Option<SandboxFacts>,
+    /// The winding of the candidate's triangles, decided from its answers
+    /// ([`decide_winding`]); `None` when no triangle was hit.
+    #[serde(default)]
+    pub triangle_winding: Option<Winding>,
+    /// The known mistakes that explain the failures, per shape group ([`super::diagnose`]).
+    #[serde(default)]
+    pub diagnosis: Vec<Diagnosis>,
 }
 
 /// Extra facts about a run for [`build_report`].
@@ -150,12 +158,13 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         .map(|&k| (k, Counts::default()))
         .collect();
     let mut failures = Vec::new();
+    let winding = decide_winding(cases, outcomes);
     for (case, outcome) in cases.iter().zip(outcomes) {
-        let verdict = judge(case, outcome);
+        let verdict = judge_wound(case, outcome, winding);
         let group = by_shape.get_mut(&case.shape.kind()).expect("every kind");
         counts.add(&verdict);
         group.add(&verdict);
-        if judge_exact(case, outcome) == Verdict::Pass {
+        if judge_exact_wound(case, outcome, winding) == Verdict::Pass {
             counts.ambiguous_passed += 1;
             group.ambiguous_passed += 1;
         }
@@ -188,6 +197,8 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         stderr_tail: info.stderr_tail,
         restarts: info.restarts,
         sandbox: info.sandbox,
+        triangle_winding: winding,
+        diagnosis: super::diagnose::diagnose(cases, outcomes, winding),
     }
 }
 
@@ -249,6 +260,12 @@ impl CheckReport {
                 String::new()
             }
         );
+        if let Some(w) = self.triangle_winding {
+            let _ = writeln!(s, "triangles: your triangles face {}", w.formula());
+        }
+        for d in &self.diagnosis {
+            let _ = writeln!(s, "diagnosis: {}", d.sentence());
+        }
         if self.restarts > 0 {
             let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
         }

@@ -37,6 +37,9 @@ pub struct Args {
     /// Print the rubric in use (the built-in one unless --rubric) and exit.
     #[arg(long)]
     print_rubric: bool,
+    /// The Python 3 to run students' code with (it needs numpy and Pillow).
+    #[arg(long, value_name = "PATH")]
+    python: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -84,6 +87,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         _ => {}
     }
+    if let Some(p) = args.python.as_ref().filter(|p| !p.is_file()) {
+        anyhow::bail!("--python {}: no such file", p.display());
+    }
     rtoracle::output::check_output_dir(&args.out, "--out")?;
     if let Some(sub) = &args.submission {
         // The reports must not land among the student's files (nor replace them).
@@ -109,8 +115,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         seed: rubric.seed,
         vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
+        python: args.python.clone(),
         ..Default::default()
     };
+    // Said once the grading is done, so bad input stays one line on stderr.
+    let public_seed = (code.vectors.is_none() && rubric.seed == 0).then_some(
+        "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
+    );
     let images = rtoracle::compare::CompareImageChecker::default();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
@@ -132,6 +143,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             entries.len(),
             args.out.join("gradebook.csv").display()
         );
+        if let Some(w) = public_seed {
+            eprintln!("{w}");
+        }
         return Ok(ExitCode::SUCCESS);
     }
 
@@ -159,5 +173,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         report.execution_time,
         args.out.display()
     );
+    if let Some(w) = public_seed {
+        eprintln!("{w}");
+    }
     Ok(ExitCode::SUCCESS)
 }

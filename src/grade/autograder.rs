@@ -1,6 +1,19 @@
 //! The Gradescope autograder package: a zip with `setup.sh`, `run_autograder`, the `rtoracle`
 //! binary itself and the rubric, so a course grades on Gradescope's machines without any network
-//! access beyond Debian's archive (for `python3`, when the base image lacks it).
+//! access beyond the distribution's archive (or PyPI where there is no apt).
+//!
+//! What it promises:
+//! - `setup.sh` leaves a Python 3 that imports numpy and Pillow, which every real submission
+//!   needs (the course's `RT_utility.py` imports both at module level): the distribution's
+//!   `python3 python3-numpy python3-pil` where `apt-get` exists, `python3 -m pip install numpy
+//!   pillow` otherwise, unless one already can. It checks the import and fails loudly when it
+//!   does not work, so no student is ever graded 0 because the grader lacks a package. It
+//!   records the interpreter, which `run_autograder` passes to `grade --python`.
+//! - A secret suite: [`secret_seed`] draws the seed from the OS (`/dev/urandom`, no dependency)
+//!   when the rubric's seed is 0 (the public one) and no `--seed` is given; [`with_seed`] writes
+//!   it into the packaged rubric, which `setup.sh` installs readable only by root (mode 600).
+//!   Every seed draws the same families of cases, so fairness does not depend on it; the seed
+//!   is in each `report.json` (`reproducibility.code_checker`), so any grade can be re-run.
 //!
 //! Gradescope's images are Ubuntu on x86_64 with glibc, so the binary packed must be built for
 //! `x86_64-unknown-linux-gnu` (or `-musl`) against a glibc no newer than the image's; the package
@@ -15,19 +28,44 @@ use zip::{CompressionMethod, DateTime, ZipWriter};
 /// `setup.sh`: run once by Gradescope when it builds the autograder image.
 pub const SETUP_SH: &str = r#"#!/usr/bin/env bash
 # rtoracle autograder: installs the grader. Gradescope runs this once, as root, when it builds
-# the image; the package already holds the rtoracle binary, so the only download is python3
-# from the distribution's archive when the image lacks it.
+# the image. The package already holds the rtoracle binary; students' code needs a Python 3 with
+# numpy and Pillow (the course's RT_utility.py imports both), installed here from the
+# distribution (python3 python3-numpy python3-pil) where apt-get exists, else with pip.
 # PREFIX (default /usr/local) only exists so the package can be tried outside Gradescope.
 set -euo pipefail
 cd "$(dirname "$0")"
 prefix="${PREFIX:-/usr/local}"
 mkdir -p "$prefix/bin" "$prefix/share"
 install -m 0755 rtoracle "$prefix/bin/rtoracle"
-install -m 0644 rubric.toml "$prefix/share/rtoracle-rubric.toml"
-if ! command -v python3 >/dev/null 2>&1; then
-    apt-get update
-    DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends python3
+# The rubric holds the secret seed of the suite: readable by root (the grader) only.
+install -m 0600 rubric.toml "$prefix/share/rtoracle-rubric.toml"
+has_modules() { [ -n "$1" ] && [ -x "$1" ] && "$1" -I -c "import numpy, PIL" >/dev/null 2>&1; }
+python=""
+for p in /usr/bin/python3 /usr/local/bin/python3 "$(command -v python3 || true)"; do
+    if has_modules "$p"; then python="$p"; break; fi
+done
+if [ -z "$python" ]; then
+    if command -v apt-get >/dev/null 2>&1; then
+        apt-get update
+        DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+            python3 python3-numpy python3-pil
+        python=/usr/bin/python3
+    else
+        python="$(command -v python3 || true)"
+        if [ -z "$python" ]; then
+            echo "setup.sh: no python3 and no apt-get to install it: the grader cannot run students' code" >&2
+            exit 1
+        fi
+        "$python" -m pip install numpy pillow \
+            || "$python" -m pip install --break-system-packages numpy pillow
+    fi
 fi
+if ! "$python" -I -c "import numpy, PIL"; then
+    echo "setup.sh: $python cannot import numpy and PIL, which students' code needs: the grader would score every submission 0" >&2
+    exit 1
+fi
+printf '%s\n' "$python" > "$prefix/share/rtoracle-python"
+echo "students' code will run with $python ($("$python" -I -c 'import numpy, PIL; print("numpy", numpy.__version__, "Pillow", PIL.__version__)'))"
 "$prefix/bin/rtoracle" --version
 "#;
 
@@ -40,6 +78,8 @@ set -uo pipefail
 prefix="${PREFIX:-/usr/local}"
 root="${AUTOGRADER:-/autograder}"
 sub="$root/submission"
+# The interpreter setup.sh installed and checked (numpy and Pillow).
+python="$(cat "$prefix/share/rtoracle-python" 2>/dev/null || echo /usr/bin/python3)"
 # Students sometimes upload a folder: grade the one that holds RT_object.py.
 if [ ! -e "$sub/RT_object.py" ]; then
     found=$(find "$sub" -maxdepth 3 -name RT_object.py -print -quit 2>/dev/null)
@@ -47,7 +87,7 @@ if [ ! -e "$sub/RT_object.py" ]; then
 fi
 mkdir -p "$root/results"
 "$prefix/bin/rtoracle" grade "$sub" --rubric "$prefix/share/rtoracle-rubric.toml" \
-    --format gradescope --out "$root/results"
+    --python "$python" --format gradescope --out "$root/results"
 status=$?
 if [ "$status" -ne 0 ] || [ ! -s "$root/results/results.json" ]; then
     printf '{"score": 0, "execution_time": 0, "output": "The autograder could not grade this submission (rtoracle exit %s). Please tell your instructor.", "tests": []}\n' "$status" \
@@ -55,6 +95,50 @@ if [ "$status" -ne 0 ] || [ ! -s "$root/results/results.json" ]; then
 fi
 exit 0
 "#;
+
+/// A seed for a secret suite: 8 bytes from the OS (`/dev/urandom`), non-zero, at most
+/// `i64::MAX` (TOML integers are signed 64-bit).
+pub fn secret_seed() -> std::io::Result<u64> {
+    use std::io::Read;
+    let mut file = std::fs::File::open("/dev/urandom")?;
+    loop {
+        let mut bytes = [0u8; 8];
+        file.read_exact(&mut bytes)?;
+        let seed = u64::from_le_bytes(bytes) & (i64::MAX as u64);
+        if seed != 0 {
+            return Ok(seed);
+        }
+    }
+}
+
+/// `rubric_toml` with its top-level `seed` set to `seed`: the `seed = ...` line before the first
+/// table is replaced, or one is added at the top when there is none. Comments and everything
+/// else are kept.
+pub fn with_seed(rubric_toml: &str, seed: u64) -> String {
+    let line = format!("seed = {seed}  # the suite's seed, written by `rtoracle autograder`");
+    let mut out = Vec::new();
+    let mut replaced = false;
+    let mut in_table = false;
+    for l in rubric_toml.lines() {
+        let t = l.trim_start();
+        if t.starts_with('[') {
+            in_table = true;
+        }
+        let key = t.split('=').next().unwrap_or("").trim();
+        if !in_table && !replaced && key == "seed" && t.contains('=') {
+            out.push(line.clone());
+            replaced = true;
+        } else {
+            out.push(l.to_string());
+        }
+    }
+    if !replaced {
+        out.insert(0, line);
+    }
+    let mut text = out.join("\n");
+    text.push('\n');
+    text
+}
 
 /// What stops the package from being built.
 #[derive(Debug, thiserror::Error)]
@@ -126,7 +210,7 @@ pub fn build_package(
     let files: [(&str, &[u8], u32); 4] = [
         ("setup.sh", SETUP_SH.as_bytes(), 0o755),
         ("run_autograder", RUN_AUTOGRADER.as_bytes(), 0o755),
-        ("rubric.toml", rubric_toml.as_bytes(), 0o644),
+        ("rubric.toml", rubric_toml.as_bytes(), 0o600),
         ("rtoracle", &bin, 0o755),
     ];
     for (name, bytes, mode) in files {
@@ -141,6 +225,62 @@ pub fn build_package(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grade::Rubric;
+    use crate::grade::rubric::WEEK04_RUBRIC;
+    use std::collections::BTreeMap;
+
+    #[test]
+    fn the_seed_is_written_into_the_rubric_and_a_secret_one_is_non_zero_and_fresh() {
+        let parse = |t: &str| Rubric::from_toml(t, "test").unwrap();
+        assert_eq!(parse(WEEK04_RUBRIC).seed, 0);
+        let text = with_seed(WEEK04_RUBRIC, 12345);
+        let r = parse(&text);
+        assert_eq!(r.seed, 12345);
+        // Nothing but the seed changed: same groups, and one seed line.
+        assert_eq!(r.groups, parse(WEEK04_RUBRIC).groups);
+        assert_eq!(text.lines().filter(|l| l.starts_with("seed")).count(), 1);
+        // A rubric without a seed line gets one at the top; a group's own keys are untouched.
+        let bare: String = WEEK04_RUBRIC
+            .lines()
+            .filter(|l| !l.starts_with("seed"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        assert_eq!(
+            parse(&with_seed(&bare, i64::MAX as u64)).seed,
+            i64::MAX as u64
+        );
+        let (a, b) = (secret_seed().unwrap(), secret_seed().unwrap());
+        assert!(a != 0 && b != 0 && a != b, "{a} {b}");
+        assert!(a <= i64::MAX as u64 && b <= i64::MAX as u64);
+        assert!(SETUP_SH.contains("install -m 0600 rubric.toml"));
+    }
+
+    /// The family of a case: its id without the trailing number (`sphere-basic-0003` ->
+    /// `sphere-basic`).
+    fn families(seed: u64) -> BTreeMap<String, usize> {
+        let mut by = BTreeMap::new();
+        for c in crate::oracle::default_suite(seed) {
+            let family = c.id.trim_end_matches(|ch: char| ch.is_ascii_digit());
+            *by.entry(family.trim_end_matches('-').to_string())
+                .or_default() += 1;
+        }
+        by
+    }
+
+    #[test]
+    fn every_seed_draws_the_same_families_of_cases() {
+        let public = families(0);
+        assert!(public.len() > 5, "{public:?}");
+        for seed in [1, 2, 99, 1 << 40, i64::MAX as u64, secret_seed().unwrap()] {
+            assert_eq!(families(seed), public, "seed {seed}");
+        }
+        // And the seed matters: another seed gives other vectors.
+        let (a, b) = (
+            crate::oracle::default_suite(0),
+            crate::oracle::default_suite(1),
+        );
+        assert_ne!(a[0].ray, b[0].ray);
+    }
 
     #[test]
     fn the_package_holds_the_scripts_the_binary_and_the_rubric() {

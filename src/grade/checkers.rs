@@ -7,7 +7,9 @@ use std::time::Duration;
 
 use serde_json::Value;
 
-use crate::candidate::check::{FailureKind as CheckKind, Verdict, judge, judge_exact};
+use crate::candidate::check::{
+    FailureKind as CheckKind, Verdict, decide_winding, judge_exact_wound, judge_wound,
+};
 use crate::candidate::report::python_repro;
 use crate::candidate::{
     CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
@@ -240,6 +242,10 @@ impl CodeChecker for CourseCodeChecker {
             }
         };
 
+        // Students' triangles are judged by their own winding; the failures are diagnosed.
+        let winding = decide_winding(&cases, &outcomes);
+        out.triangle_winding = winding;
+        out.diagnosis = crate::candidate::diagnose::diagnose(&cases, &outcomes, winding);
         let mut definite_failures = Vec::new();
         let mut ambiguous_failures = Vec::new();
         for (case, outcome) in cases.iter().zip(&outcomes) {
@@ -247,10 +253,10 @@ impl CodeChecker for CourseCodeChecker {
             let definite = case.expect.class.is_definite();
             let counts = out.per_group.get_mut(&kind).expect("asked for");
             let verdict = if definite {
-                judge(case, outcome)
+                judge_wound(case, outcome, winding)
             } else if case.expect.class == Class::Ambiguous {
                 counts.ambiguous += 1;
-                judge_exact(case, outcome)
+                judge_exact_wound(case, outcome, winding)
             } else {
                 continue;
             };
@@ -413,11 +419,20 @@ mod tests {
     fn an_interpreter_the_drop_user_cannot_run_falls_back_and_says_so() {
         // Python under /root (mode 0700) cannot be run by `nobody`.
         let private = Path::new("/root/.pyenv/versions/3.11.7/bin/python3");
+        let has_numpy = |p: &Path| {
+            std::process::Command::new(p)
+                .args(["-c", "import numpy, PIL"])
+                .status()
+                .is_ok_and(|s| s.success())
+        };
         if !crate::sandbox::running_as_root()
             || !private.exists()
             || crate::sandbox::lookup_user("nobody").is_none()
+            || !has_numpy(private)
         {
-            eprintln!("skipped: needs root, nobody and a Python under /root");
+            eprintln!(
+                "skipped: needs root, nobody and a Python under /root with numpy and PIL (the fixtures import them)"
+            );
             return;
         }
         let checker = CourseCodeChecker {

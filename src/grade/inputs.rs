@@ -103,6 +103,12 @@ pub struct CodeOutcome {
     pub stderr_tail: String,
     /// Facts about the sandbox the code ran in (limits, user, network), for the report.
     pub sandbox: serde_json::Value,
+    /// The known mistakes that explain the failures, per shape ([`crate::candidate::diagnose`]).
+    #[serde(default)]
+    pub diagnosis: Vec<crate::candidate::diagnose::Diagnosis>,
+    /// The winding of the submission's triangles, decided from its answers.
+    #[serde(default)]
+    pub triangle_winding: Option<crate::candidate::check::Winding>,
 }
 
 /// The verdict on one image.

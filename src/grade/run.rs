@@ -121,6 +121,10 @@ pub struct CodeRun {
     pub stderr_tail: String,
     /// The sandbox's facts.
     pub sandbox: serde_json::Value,
+    /// The known mistakes that explain the code's failures, per shape.
+    pub diagnosis: Vec<crate::candidate::diagnose::Diagnosis>,
+    /// The winding of the submission's triangles, when it has any that hit.
+    pub triangle_winding: Option<crate::candidate::check::Winding>,
 }
 
 /// The result model every report format is written from.
@@ -274,6 +278,17 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
         }
         if let Some(f) = smallest_failure(&failures) {
             message.push_str(&format!(" Smallest failing case, {}: {}.", f.id, f.message));
+        }
+        if let Some(d) = outcome.diagnosis.iter().find(|d| d.shape == shape) {
+            message.push_str(&format!(" Diagnosis: {}.", d.sentence()));
+        }
+        if let (crate::oracle::vectors::ShapeKind::Triangle, Some(w)) =
+            (shape, outcome.triangle_winding)
+        {
+            message.push_str(&format!(
+                " Your triangles face {} (front_face is judged by that winding).",
+                w.formula()
+            ));
         }
         let status = if passed == total {
             CheckStatus::Passed
@@ -495,6 +510,8 @@ pub fn grade(
             fatal: outcome.fatal.clone(),
             stderr_tail: outcome.stderr_tail.clone(),
             sandbox: outcome.sandbox.clone(),
+            diagnosis: outcome.diagnosis.clone(),
+            triangle_winding: outcome.triangle_winding,
         },
         reproducibility: Reproducibility {
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -668,6 +685,7 @@ pub(crate) mod fakes {
                 fatal: self.fatal.clone(),
                 stderr_tail: String::new(),
                 sandbox: serde_json::Value::Null,
+                ..Default::default()
             }
         }
         fn describe(&self) -> String {

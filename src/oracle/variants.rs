@@ -623,6 +623,228 @@ pub fn buggy() -> Vec<Variant> {
     ]
 }
 
+// ---- More known mistakes, for the candidate diagnosis (`candidate::diagnose`). ----
+
+/// The course's sphere (as `sphere-course`) with the roots written `-half_b -+ sqrt_disc / a`
+/// (the division binds tighter).
+fn sphere_sqrt_precedence(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let ShapeSpec::Sphere { center, radius } = *shape else {
+        return Ok(None);
+    };
+    let (orig, d) = (ray.origin, ray.direction);
+    let oc = sub(orig, center);
+    let a = dot(d, d);
+    let hb = dot(oc, d);
+    let c = dot(oc, oc) - radius * radius;
+    let disc = hb * hb - a * c;
+    if disc < 0.0 {
+        return Ok(None);
+    }
+    let sq = disc.sqrt();
+    let surrounds = |t: f64| iv[0] < t && t < iv[1];
+    let mut root = -hb - div(sq, a)?;
+    if !surrounds(root) {
+        root = -hb + div(sq, a)?;
+        if !surrounds(root) {
+            return Ok(None);
+        }
+    }
+    let p = add(orig, scale(d, root));
+    let outward = vdiv(sub(p, center), radius)?;
+    Ok(Some(face(d, outward, root, false)))
+}
+
+/// The course's sphere without `set_face_normal`: the outward normal, and `front_face` left
+/// at the `Hitinfo`'s `True`.
+fn sphere_normal_not_flipped(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let hit = sphere_with(SphereOpts::default(), shape, ray, iv)?;
+    Ok(hit.map(|h| VHit {
+        normal: if h.front_face {
+            h.normal
+        } else {
+            h.normal.map(|x| -x)
+        },
+        front_face: true,
+        ..h
+    }))
+}
+
+/// Knobs of the extra quad transcription.
+#[derive(Clone, Copy, Default)]
+struct QuadExtra {
+    beta_uses_v: bool,
+    d_from_u: bool,
+    upper_bounds_only: bool,
+    unnormalised_normal: bool,
+}
+
+/// The course's quad (as `quad-course`) with one of the extra mistakes.
+fn quad_extra(o: QuadExtra, shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let ShapeSpec::Quad { q, u, v } = *shape else {
+        return Ok(None);
+    };
+    let uxv = cross(u, v);
+    let normal = if o.unnormalised_normal {
+        uxv
+    } else {
+        unit(uxv)?
+    };
+    let big_d = if o.d_from_u {
+        dot(normal, u)
+    } else {
+        dot(normal, q)
+    };
+    let w = vdiv(uxv, dot(uxv, uxv))?;
+    let (orig, d) = (ray.origin, ray.direction);
+    let denom = dot(normal, d);
+    if denom.abs() < 1e-8 {
+        return Ok(None);
+    }
+    let t = div(big_d - dot(normal, orig), denom)?;
+    if !(iv[0] <= t && t <= iv[1]) {
+        return Ok(None);
+    }
+    let p = sub(add(orig, scale(d, t)), q);
+    let alpha = dot(w, cross(p, v));
+    let beta = if o.beta_uses_v {
+        dot(w, cross(v, p))
+    } else {
+        dot(w, cross(u, p))
+    };
+    let interior = if o.upper_bounds_only {
+        !(alpha > 1.0 || beta > 1.0)
+    } else {
+        (0.0..=1.0).contains(&alpha) && (0.0..=1.0).contains(&beta)
+    };
+    if !interior {
+        return Ok(None);
+    }
+    Ok(Some(face(d, normal, t, false)))
+}
+
+/// Möller–Trumbore with the course's `near_zero(det)`: `|det| < 1e-8` on the unnormalised
+/// determinant, which misses small triangles (and long rays' grazing ones).
+fn moller_trumbore_absolute_epsilon(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
+    let ShapeSpec::Triangle { a, b, c } = *shape else {
+        return Ok(None);
+    };
+    let (e1, e2) = (sub(b, a), sub(c, a));
+    let d = ray.direction;
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if det.abs() < 1e-8 {
+        return Ok(None);
+    }
+    moller_trumbore(shape, ray, iv)
+}
+
+/// More buggy variants (the diagnosis's catalogue is [`buggy`] and these): each must fail at
+/// least one definite vector of the default suite.
+pub fn buggy_extra() -> Vec<Variant> {
+    vec![
+        Variant {
+            name: "sphere-sqrt-precedence",
+            shape: ShapeKind::Sphere,
+            honest: false,
+            run: sphere_sqrt_precedence,
+        },
+        Variant {
+            name: "sphere-normal-not-flipped",
+            shape: ShapeKind::Sphere,
+            honest: false,
+            run: sphere_normal_not_flipped,
+        },
+        Variant {
+            name: "quad-beta-uses-v",
+            shape: ShapeKind::Quad,
+            honest: false,
+            run: |s, r, i| {
+                let o = QuadExtra {
+                    beta_uses_v: true,
+                    ..Default::default()
+                };
+                quad_extra(o, s, r, i)
+            },
+        },
+        Variant {
+            name: "quad-d-from-u",
+            shape: ShapeKind::Quad,
+            honest: false,
+            run: |s, r, i| {
+                let o = QuadExtra {
+                    d_from_u: true,
+                    ..Default::default()
+                };
+                quad_extra(o, s, r, i)
+            },
+        },
+        Variant {
+            name: "quad-interior-upper-bounds-only",
+            shape: ShapeKind::Quad,
+            honest: false,
+            run: |s, r, i| {
+                let o = QuadExtra {
+                    upper_bounds_only: true,
+                    ..Default::default()
+                };
+                quad_extra(o, s, r, i)
+            },
+        },
+        Variant {
+            name: "quad-unnormalised-normal",
+            shape: ShapeKind::Quad,
+            honest: false,
+            run: |s, r, i| {
+                let o = QuadExtra {
+                    unnormalised_normal: true,
+                    ..Default::default()
+                };
+                quad_extra(o, s, r, i)
+            },
+        },
+        Variant {
+            name: "triangle-absolute-epsilon",
+            shape: ShapeKind::Triangle,
+            honest: false,
+            run: moller_trumbore_absolute_epsilon,
+        },
+    ]
+}
+
+#[cfg(test)]
+mod extra_tests {
+    use super::*;
+    use crate::oracle::default_suite;
+
+    #[test]
+    fn every_extra_buggy_variant_fails_a_definite_vector_and_differs_from_the_others() {
+        let suite = default_suite(0);
+        // The failing vectors and the wrong answers given on them.
+        let fails = |v: &Variant| -> Vec<String> {
+            suite
+                .iter()
+                .filter(|c| c.shape.kind() == v.shape && c.expect.class.is_definite())
+                .filter_map(|c| {
+                    let answer = (v.run)(&c.shape, &c.ray, c.interval);
+                    judge(&c.expect, &answer)
+                        .is_err()
+                        .then(|| format!("{} {answer:?}", c.id))
+                })
+                .collect()
+        };
+        let old: Vec<Vec<String>> = buggy().iter().map(fails).collect();
+        for v in buggy_extra() {
+            let f = fails(&v);
+            assert!(!f.is_empty(), "{} passes every definite vector", v.name);
+            assert!(
+                !old.contains(&f),
+                "{} answers as an existing variant",
+                v.name
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,11 +5,11 @@
 //! so they hold whatever the real suite becomes; the CLI tests that run the built-in suite only
 //! rely on it having definite sphere and quad vectors (marked "suite:").
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use rtoracle::candidate::bench::assemble_fixture;
+use rtoracle::candidate::bench::{assemble_fixture, course_python_or_skip};
 use rtoracle::candidate::generate::random_cases;
 use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
 use rtoracle::oracle::vectors::{Case, ShapeKind};
@@ -21,17 +21,27 @@ fn cases() -> &'static [Case] {
     CASES.get_or_init(|| random_cases(5, 0, 1200, &[ShapeKind::Sphere, ShapeKind::Quad]))
 }
 
+/// The Python the fixtures need (numpy and PIL, as the course's `RT_utility.py`), or `None`
+/// after saying the test is skipped ([`course_python_or_skip`]).
+fn python() -> Option<&'static Path> {
+    static PYTHON: OnceLock<Option<PathBuf>> = OnceLock::new();
+    PYTHON
+        .get_or_init(|| course_python_or_skip("the Python fixture tests"))
+        .as_deref()
+}
+
 fn python_ok() -> bool {
-    let ok = std::process::Command::new("python3")
-        .arg("-c")
-        .arg("pass")
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !ok {
-        eprintln!("skipped: python3 is not available");
-    }
-    ok
+    python().is_some()
+}
+
+/// `rtoracle` with `args` in `dir`, told which Python to run the course adapter with.
+fn run_py(dir: &Path, args: &[&str]) -> std::process::Output {
+    rtoracle()
+        .current_dir(dir)
+        .env("RTORACLE_PYTHON", python().expect("checked"))
+        .args(args)
+        .output()
+        .expect("rtoracle runs")
 }
 
 fn fast() -> RunOptions {
@@ -42,28 +52,317 @@ fn fast() -> RunOptions {
     }
 }
 
+fn course(dir: &Path) -> CandidateCommand {
+    CandidateCommand::python_course_with(dir, python(), false).unwrap()
+}
+
 fn check(variant: &str, options: RunOptions) -> CheckReport {
+    check_on(variant, cases(), options)
+}
+
+fn check_on(variant: &str, cases: &[Case], options: RunOptions) -> CheckReport {
     let dir = assemble_fixture(variant).unwrap();
-    check_command(
-        CandidateCommand::python_course(dir.path()).unwrap(),
-        cases(),
-        options,
-    )
-    .unwrap()
+    check_command(course(dir.path()), cases, options).unwrap()
 }
 
 fn group(r: &CheckReport, kind: ShapeKind) -> rtoracle::candidate::Counts {
     r.by_shape[&kind]
 }
 
-const HONEST: [&str; 6] = [
+const HONEST: [&str; 8] = [
     "honest_reference",
     "honest_contains_surrounds",
     "honest_strict_edges",
     "honest_full_quadratic",
     "honest_denom_exact_zero",
     "honest_normalised_direction",
+    // Later weeks' API: Ray(..., fTime=0.0), Hitinfo(..., tcTex=None), a motion-blur Sphere
+    // defining intersect twice, a Quad filling texture coordinates, RT_object importing
+    // numpy, RT_texture and RT_material; and components in numpy arrays (np.float64, np.bool_).
+    "honest_week10_shapes",
+    "honest_numpy_vectors",
 ];
+
+/// The random sphere and quad cases, then the built-in suite's triangles (which hold the small
+/// triangles an absolute epsilon on the determinant misses).
+fn mixed() -> &'static [Case] {
+    static CASES: OnceLock<Vec<Case>> = OnceLock::new();
+    CASES.get_or_init(|| {
+        let mut all = cases().to_vec();
+        all.extend(
+            rtoracle::oracle::default_suite(0)
+                .into_iter()
+                .filter(|c| c.shape.kind() == ShapeKind::Triangle),
+        );
+        all
+    })
+}
+
+/// Each buggy fixture and the catalogue's mistake that is its bug (by how the fixture is
+/// written: make_variants.py).
+const DIAGNOSED: [(&str, &str); 20] = [
+    ("bug_quad_unnormalised_normal", "quad-unnormalised-normal"),
+    ("bug_far_root_first", "sphere-far-root-first"),
+    ("bug_sphere_no_interval_check", "sphere-no-interval-check"),
+    ("bug_unnormalised_normal", "sphere-unnormalised-normal"),
+    ("bug_abs_radius_normal", "sphere-abs-radius-in-normal"),
+    ("bug_radius_not_squared", "sphere-r-instead-of-r-squared"),
+    ("bug_sqrt_precedence", "sphere-sqrt-precedence"),
+    ("bug_normal_not_flipped", "sphere-normal-not-flipped"),
+    ("bug_alpha_sign", "quad-sign-error-in-alpha"),
+    ("bug_w_is_unit_normal", "quad-w-is-unit-normal"),
+    ("bug_no_parallel_test", "quad-no-parallel-test"),
+    ("bug_wrong_plane_d", "quad-d-from-u"),
+    ("bug_front_face_reversed", "quad-front-face-reversed"),
+    ("bug_beta_uses_v", "quad-beta-uses-v"),
+    ("bug_quad_no_interval_check", "quad-no-interval-check"),
+    (
+        "bug_interior_upper_bounds_only",
+        "quad-interior-upper-bounds-only",
+    ),
+    ("bug_triangle_absolute_epsilon", "triangle-absolute-epsilon"),
+    (
+        "bug_triangle_absolute_epsilon_mat_required_cxb",
+        "triangle-absolute-epsilon",
+    ),
+    // The same mistakes seen twice must still be one diagnosis each (their own group).
+    ("bug_far_root_first", "sphere-far-root-first"),
+    ("bug_alpha_sign", "quad-sign-error-in-alpha"),
+];
+
+#[test]
+fn every_buggy_fixture_is_diagnosed_as_its_own_mistake_and_no_honest_one_is() {
+    if !python_ok() {
+        return;
+    }
+    let mut named = std::collections::BTreeSet::new();
+    for (variant, mistake) in DIAGNOSED {
+        if !named.insert(variant) {
+            continue;
+        }
+        let r = check_on(variant, mixed(), RunOptions::default());
+        assert!(!r.passed(), "{variant} passed");
+        assert_eq!(r.diagnosis.len(), 1, "{variant}: {:?}", r.diagnosis);
+        let d = &r.diagnosis[0];
+        assert_eq!(d.mistake_id, mistake, "{variant}: {d:?}");
+        // It explains the failures of its group, which are all the failures there are.
+        let failing = r
+            .failures
+            .iter()
+            .filter(|f| matches!(f.kind, FailureKind::Mismatch | FailureKind::Error))
+            .count();
+        assert_eq!((d.explained, d.of), (failing, failing), "{variant}");
+        assert!(
+            r.to_text(1)
+                .contains(&format!("diagnosis: {}", d.sentence()))
+        );
+        let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+        assert_eq!(json["diagnosis"][0]["mistake_id"], mistake);
+    }
+    for variant in HONEST.iter().chain(&TRIANGLES_HONEST) {
+        let r = check_on(variant, mixed(), RunOptions::default());
+        assert!(r.passed(), "{variant}:\n{}", r.to_text(3));
+        assert!(r.diagnosis.is_empty(), "{variant}: {:?}", r.diagnosis);
+    }
+}
+
+const TRIANGLES_HONEST: [&str; 4] = [
+    "honest_triangle_course_style",
+    "honest_triangle_mt_bxc",
+    "honest_triangle_mt_mat_required_cxb",
+    "honest_triangle_stub_without_intersect",
+];
+
+fn triangle_cases() -> Vec<Case> {
+    mixed()
+        .iter()
+        .filter(|c| c.shape.kind() == ShapeKind::Triangle)
+        .cloned()
+        .collect()
+}
+
+#[test]
+fn students_triangles_are_run_in_each_constructor_form_and_judged_by_their_own_winding() {
+    if !python_ok() {
+        return;
+    }
+    use rtoracle::candidate::check::Winding;
+    let tris = triangle_cases();
+    let definite = tris.iter().filter(|c| c.expect.class.is_definite()).count();
+    assert!(definite > 100, "{definite}");
+    // (fixture, its winding as written, constructor)
+    for (variant, winding) in [
+        ("honest_triangle_course_style", Winding::BaCa), // Triangle(a, b, c, mMat=None)
+        ("honest_triangle_mt_bxc", Winding::BaCa),       // Triangle(v0, v1, v2, mMat=None)
+        ("honest_triangle_mt_mat_required_cxb", Winding::CaBa), // Triangle(v0, v1, v2, mat)
+    ] {
+        let r = check_on(variant, &tris, RunOptions::default());
+        let g = group(&r, ShapeKind::Triangle);
+        assert_eq!((g.passed, g.not_run), (definite, 0), "{variant}: {g:?}");
+        assert_eq!(r.triangle_winding, Some(winding), "{variant}");
+        assert!(
+            r.to_text(1)
+                .contains(&format!("your triangles face {}", winding.formula())),
+            "{variant}"
+        );
+    }
+    // The reversed fixture's front_face is the opposite of the reference's on every hit it
+    // answers: judged against the reference's winding it would fail them all.
+    let r = check_on(
+        "honest_triangle_mt_mat_required_cxb",
+        &tris,
+        RunOptions::default(),
+    );
+    assert!(r.passed() && r.failures.is_empty());
+    // fuzz judges by the same winding: random triangles (and spheres and quads) all pass.
+    let dir = assemble_fixture("honest_triangle_mt_mat_required_cxb").unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let out = run_py(
+        tmp.path(),
+        &[
+            "fuzz",
+            "--python-course",
+            dir.path().to_str().unwrap(),
+            "--cases",
+            "3000",
+        ],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("0 failed"), "{text}");
+    // A stub with three vertices and no intersect is unsupported: nothing run, nothing failed.
+    let r = check_on(
+        "honest_triangle_stub_without_intersect",
+        &tris,
+        RunOptions::default(),
+    );
+    let g = group(&r, ShapeKind::Triangle);
+    assert_eq!((g.not_run, g.failed + g.errors), (definite, 0), "{g:?}");
+    assert_eq!(r.triangle_winding, None);
+}
+
+#[test]
+fn an_absolute_epsilon_on_the_determinant_misses_exactly_the_small_triangles() {
+    if !python_ok() {
+        return;
+    }
+    let tris = triangle_cases();
+    let det = |c: &Case| {
+        let rtoracle::oracle::vectors::ShapeSpec::Triangle { a, b, c: cc } = c.shape else {
+            unreachable!()
+        };
+        let sub = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+        let cross = |x: [f64; 3], y: [f64; 3]| {
+            [
+                x[1] * y[2] - x[2] * y[1],
+                x[2] * y[0] - x[0] * y[2],
+                x[0] * y[1] - x[1] * y[0],
+            ]
+        };
+        let (e1, e2) = (sub(b, a), sub(cc, a));
+        let p = cross(c.ray.direction, e2);
+        e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2]
+    };
+    // Independently of the fixture: the hits whose determinant is below 1e-8.
+    let expected: Vec<&str> = tris
+        .iter()
+        .filter(|c| c.expect.class == rtoracle::oracle::vectors::Class::Hit && det(c).abs() < 1e-8)
+        .map(|c| c.id.as_str())
+        .collect();
+    assert!(!expected.is_empty());
+    for variant in [
+        "bug_triangle_absolute_epsilon",
+        "bug_triangle_absolute_epsilon_mat_required_cxb",
+    ] {
+        let r = check_on(variant, &tris, RunOptions::default());
+        let failed: Vec<&str> = r.failures.iter().map(|f| f.id.as_str()).collect();
+        assert_eq!(failed, expected, "{variant}");
+        assert!(r.failures.iter().all(|f| f.message.contains("got a miss")));
+        assert_eq!(r.diagnosis[0].mistake_id, "triangle-absolute-epsilon");
+        assert!(
+            r.to_text(1)
+                .contains("your triangle failures are exactly those of an absolute epsilon"),
+            "{}",
+            r.to_text(1)
+        );
+    }
+}
+
+#[test]
+fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
+    if !python_ok() {
+        return;
+    }
+    let r = check(
+        "bug_imports_a_module_the_grader_lacks",
+        RunOptions::default(),
+    );
+    let e = r.import_error.as_ref().expect("an import error");
+    assert_eq!(e.kind, "ModuleNotFoundError");
+    assert_eq!(
+        e.message,
+        "your code imports rtoracle_no_such_module, which the grader does not provide"
+    );
+    // The traceback (what grade's feedback shows) ends with the same words, after the line of
+    // the student's file that imports it.
+    assert!(
+        e.traceback
+            .trim_end()
+            .ends_with(&format!("ModuleNotFoundError: {}", e.message))
+            && e.traceback.contains("import rtoracle_no_such_module"),
+        "{}",
+        e.traceback
+    );
+    let r = check(
+        "bug_imports_a_course_module_not_uploaded",
+        RunOptions::default(),
+    );
+    let e = r.import_error.as_ref().expect("an import error");
+    assert!(
+        e.message
+            .contains("imports RT_camera_not_uploaded, which is not in your submission"),
+        "{}",
+        e.message
+    );
+    // A required module that is missing is the grader's problem: the adapter, told that the
+    // module it cannot import is required, says so.
+    let dir = assemble_fixture("bug_imports_a_module_the_grader_lacks").unwrap();
+    std::fs::write(
+        dir.path().join("adapter.py"),
+        rtoracle::candidate::process::PYTHON_COURSE_ADAPTER,
+    )
+    .unwrap();
+    let mut child = std::process::Command::new(python().unwrap())
+        .args([
+            "-I",
+            "-B",
+            "adapter.py",
+            ".",
+            "--requires",
+            "numpy,PIL,rtoracle_no_such_module",
+        ])
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"{\"hello\":1}\n")
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let hello: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&out.stdout).lines().next().unwrap()).unwrap();
+    let message = hello["error"]["message"].as_str().unwrap();
+    assert!(
+        message.starts_with("the grader's Python lacks rtoracle_no_such_module")
+            && message.contains("not the submission's"),
+        "{message}"
+    );
+}
 
 #[test]
 fn honest_variants_pass_every_definite_vector() {
@@ -235,12 +534,7 @@ fn a_submission_that_cannot_be_imported_reports_it_on_every_case() {
     }
     let start = Instant::now();
     let dir = assemble_fixture("hostile_cannot_import").unwrap();
-    let r = check_command(
-        CandidateCommand::python_course(dir.path()).unwrap(),
-        cases(),
-        RunOptions::default(),
-    )
-    .unwrap();
+    let r = check_command(course(dir.path()), cases(), RunOptions::default()).unwrap();
     assert!(start.elapsed() < Duration::from_secs(5));
     let e = r.import_error.as_ref().expect("an import error");
     assert_eq!(e.kind, "SyntaxError");
@@ -334,7 +628,7 @@ fn check_cli_exit_codes_json_and_text() {
     let h = honest.path().to_str().unwrap();
     let b = buggy.path().to_str().unwrap();
 
-    let out = run_in(
+    let out = run_py(
         tmp.path(),
         &[
             "check",
@@ -356,7 +650,7 @@ fn check_cli_exit_codes_json_and_text() {
     assert_eq!(json["passed"], 300);
     assert_eq!(json["failures"].as_array().unwrap().len(), 0);
 
-    let out = run_in(
+    let out = run_py(
         tmp.path(),
         &[
             "check",
@@ -379,7 +673,7 @@ fn check_cli_exit_codes_json_and_text() {
     }
     assert_eq!(f["kind"], "mismatch");
 
-    let out = run_in(
+    let out = run_py(
         tmp.path(),
         &["check", "--python-course", b, "--vectors", &vectors],
     );
@@ -389,7 +683,7 @@ fn check_cli_exit_codes_json_and_text() {
 
     // suite: the built-in suite has definite sphere and quad vectors; triangles (a stub in the
     // course) are not run and do not fail the verdict.
-    let out = run_in(tmp.path(), &["check", "--python-course", h]);
+    let out = run_py(tmp.path(), &["check", "--python-course", h]);
     assert_eq!(
         out.status.code(),
         Some(0),
@@ -406,7 +700,7 @@ fn a_repro_snippet_reproduces_the_failure_in_python() {
     let r = check("bug_far_root_first", RunOptions::default());
     let f = &r.failures[0];
     let dir = assemble_fixture("bug_far_root_first").unwrap();
-    let out = std::process::Command::new("python3")
+    let out = std::process::Command::new(python().unwrap())
         .arg("-c")
         .arg(&f.repro)
         .current_dir(dir.path())
@@ -483,7 +777,7 @@ fn fuzz_finds_shrinks_and_prints_a_reproduction() {
     }
     let tmp = tempfile::tempdir().unwrap();
     let buggy = assemble_fixture("bug_w_is_unit_normal").unwrap();
-    let out = run_in(
+    let out = run_py(
         tmp.path(),
         &[
             "fuzz",
@@ -510,7 +804,7 @@ fn fuzz_finds_shrinks_and_prints_a_reproduction() {
     assert!(!text.contains("(sphere)"), "{text}");
 
     let honest = assemble_fixture("honest_full_quadratic").unwrap();
-    let out = run_in(
+    let out = run_py(
         tmp.path(),
         &[
             "fuzz",
@@ -545,7 +839,8 @@ fn blame_lands_on_the_right_case_even_when_the_adapter_batches_its_answers() {
     let script =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/adapters/batching_misser.py");
     let command = CandidateCommand::adapter(&format!(
-        "python3 -I {} {die} {hang} {junk}",
+        "{} -I {} {die} {hang} {junk}",
+        python().unwrap().display(),
         script.display()
     ))
     .unwrap();

@@ -308,13 +308,25 @@ fn report_json_holds_checks_repros_metrics_pictures_and_hashes() {
     }
     let sphere = &r["checks"][0];
     assert_eq!(sphere["id"], "sphere.intersect");
+    // The fixture tries the far root first (its source says so): the diagnosis names it, as
+    // data and beside the smallest failing case.
+    assert_eq!(
+        r["code"]["diagnosis"][0]["mistake_id"],
+        "sphere-far-root-first"
+    );
+    assert_eq!(r["code"]["diagnosis"][0]["shape"], "sphere");
+    assert!(sphere["message"].as_str().unwrap().contains(
+        "Diagnosis: your sphere failures are exactly those of taking the far root first"
+    ));
     let f = &sphere["failures"][0];
     assert_eq!(f["kind"], "mismatch");
     let repro = f["repro"].as_str().unwrap();
     // The reproduction runs in the submission folder and shows the wrong answer.
     let sub = b.subs.join("sphere-bug");
     std::fs::write(sub.join("repro.py"), repro).unwrap();
-    let out = std::process::Command::new("python3")
+    // With the Python the grader used (the submission's RT_utility imports numpy and PIL).
+    let python = rtoracle::candidate::bench::course_python().expect("the batch graded with it");
+    let out = std::process::Command::new(python)
         .arg("repro.py")
         .current_dir(&sub)
         .output()
@@ -431,6 +443,19 @@ fn one_submission_writes_the_chosen_formats_and_exits_0() {
             && stdout.contains("sphere.intersect             30 / 30"),
         "{stdout}"
     );
+    // The built-in rubric's seed is the public 0: one warning line says so, and the seed
+    // stays in report.json, so the grade can be re-run.
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        stderr
+            .matches("warning: the rubric uses the public seed 0")
+            .count(),
+        1,
+        "{stderr}"
+    );
+    let r = read_json(&report_dir.join("report.json"));
+    let checker = r["reproducibility"]["code_checker"].as_str().unwrap();
+    assert!(checker.contains("built-in suite seed 0"), "{checker}");
 }
 
 #[test]
@@ -467,6 +492,50 @@ fn grading_that_cannot_run_exits_2_with_one_line_and_writes_nothing() {
     assert_eq!(r["code"]["fatal"], "RT_object.py is not in the submission");
 }
 
+/// The seed of the rubric packed in `zip`.
+fn packaged_seed(zip: &Path) -> u64 {
+    let file = std::fs::File::open(zip).unwrap();
+    let mut archive = zip::ZipArchive::new(file).unwrap();
+    let mut text = String::new();
+    std::io::Read::read_to_string(&mut archive.by_name("rubric.toml").unwrap(), &mut text).unwrap();
+    rtoracle::grade::Rubric::from_toml(&text, "packaged")
+        .unwrap()
+        .seed
+}
+
+#[test]
+fn the_autograder_package_has_a_secret_seed_unless_one_is_chosen() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut seeds = Vec::new();
+    for name in ["a.zip", "b.zip"] {
+        let out = run_in(dir.path(), &["autograder", "--out", name]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stderr).contains("(secret, drawn now)"));
+        seeds.push(packaged_seed(&dir.path().join(name)));
+    }
+    // Drawn from the OS: non-zero, and not the same twice (a 2^-63 chance of a false alarm).
+    assert!(
+        seeds[0] != 0 && seeds[1] != 0 && seeds[0] != seeds[1],
+        "{seeds:?}"
+    );
+    let out = run_in(dir.path(), &["autograder", "--out", "c.zip", "--seed", "7"]);
+    assert!(out.status.success());
+    assert_eq!(packaged_seed(&dir.path().join("c.zip")), 7);
+    // A rubric's own non-zero seed is kept.
+    let rubric = rtoracle::grade::rubric::WEEK04_RUBRIC.replace("seed = 0", "seed = 42");
+    std::fs::write(dir.path().join("r.toml"), rubric).unwrap();
+    let out = run_in(
+        dir.path(),
+        &["autograder", "--out", "d.zip", "--rubric", "r.toml"],
+    );
+    assert!(out.status.success());
+    assert_eq!(packaged_seed(&dir.path().join("d.zip")), 42);
+}
+
 #[test]
 fn the_autograder_package_grades_a_submission_like_gradescope_would() {
     let dir = tempfile::tempdir().unwrap();
@@ -476,6 +545,7 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let seed = packaged_seed(&dir.path().join("autograder.zip"));
     // Unpack as Gradescope does into /autograder/source.
     let root = dir.path().join("autograder");
     let source = root.join("source");
@@ -495,7 +565,24 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
         "{}",
         String::from_utf8_lossy(&setup.stderr)
     );
-    assert!(String::from_utf8_lossy(&setup.stdout).contains(env!("CARGO_PKG_VERSION")));
+    let said = String::from_utf8_lossy(&setup.stdout);
+    assert!(said.contains(env!("CARGO_PKG_VERSION")));
+    // It found (or installed) a Python with numpy and Pillow, checked, and recorded it.
+    assert!(
+        said.contains("students' code will run with") && said.contains("numpy"),
+        "{said}"
+    );
+    let python = std::fs::read_to_string(prefix.join("share/rtoracle-python")).unwrap();
+    let imports = std::process::Command::new(python.trim())
+        .args(["-c", "import numpy, PIL"])
+        .status()
+        .unwrap();
+    assert!(imports.success(), "{python}");
+    // The installed rubric (with the secret seed) is readable by root only.
+    use std::os::unix::fs::PermissionsExt;
+    let installed = prefix.join("share/rtoracle-rubric.toml");
+    let mode = std::fs::metadata(&installed).unwrap().permissions().mode();
+    assert_eq!(mode & 0o777, 0o600);
     // A student who uploaded their folder instead of its files.
     materialize("sphere-bug", &root.join("submission/my-week4")).unwrap();
     let run = std::process::Command::new("bash")
@@ -520,6 +607,16 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
     assert_eq!(tests.len(), 4);
     assert_eq!(tests[0]["status"], "failed");
     assert!(tests[1..].iter().all(|t| t["status"] == "passed"));
+    // Graded with the secret seed, which needs no warning, by the recorded interpreter.
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!stderr.contains("public seed"), "{stderr}");
+    assert!(rtoracle::grade::autograder::RUN_AUTOGRADER.contains("--python \"$python\""));
+    // What students see (results.json) does not give the secret seed away.
+    let text = std::fs::read_to_string(root.join("results/results.json")).unwrap();
+    assert!(
+        !text.contains(&seed.to_string()),
+        "the seed {seed} is in results.json"
+    );
     // Something that is not a Linux x86_64 binary is refused.
     std::fs::write(dir.path().join("notelf"), b"#!/bin/sh\n").unwrap();
     let out = run_in(

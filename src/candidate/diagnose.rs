@@ -1,0 +1,371 @@
+//! A diagnosis of code failures: which known mistake explains a submission's failing vectors.
+//!
+//! When definite vectors of a shape group fail (wrong answers or raised errors; time-outs,
+//! deaths, protocol errors and vectors not run are not evidence), every mistake of the
+//! catalogue for that shape (the oracle's buggy transcriptions of the course's code,
+//! [`variants::buggy`] and [`variants::buggy_extra`]) is replayed on the failing vectors and on
+//! a deterministic sample of the passing ones (up to [`SAMPLE`], evenly spaced in suite order).
+//!
+//! A mistake *explains* a failing vector when the variant fails it the same way: the same
+//! symptom (a hit for a miss, a miss for a hit, a wrong `t`, a wrong normal, a wrong
+//! `front_face`, a raised error), and for a wrong `t` or normal the same wrong value (within
+//! `1e-6` relative for `t`, `1e-4` per normal component). It is named when it explains at least
+//! 95 % of the group's failures and passes all but 1 % of the sampled passing vectors; of
+//! several, the one that explains most (then: disagrees least, then: comes first in the
+//! catalogue). Nothing is named otherwise: the diagnosis never guesses.
+//!
+//! The submission's answers are judged against its own triangle winding
+//! ([`check::Winding`](super::check::Winding)); the variants wind as the reference does and are
+//! judged against the reference's expectation, so a submission's winding never counts as a
+//! symptom.
+
+use serde::{Deserialize, Serialize};
+
+use super::check::{NORMAL_TOL, Winding};
+use super::process::Outcome;
+use super::protocol::Answer;
+use crate::oracle::variants::{self, VHit, Variant};
+use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
+
+/// How many passing vectors of a group are replayed at most.
+pub const SAMPLE: usize = 200;
+
+/// The mistake that explains a shape group's failures.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Diagnosis {
+    /// The shape group.
+    pub shape: ShapeKind,
+    /// The catalogue's id of the mistake (the variant's name, e.g. `"sphere-far-root-first"`).
+    pub mistake_id: String,
+    /// What the mistake is, as a phrase: `"taking the far root first"`.
+    pub description: String,
+    /// How many of the group's failures the mistake reproduces.
+    pub explained: usize,
+    /// How many failures the group has (wrong answers and raised errors).
+    pub of: usize,
+}
+
+impl Diagnosis {
+    /// One sentence for a student: "your failures are exactly those of taking the far root
+    /// first" (or "match those of ..., 11 of 12", when not all are explained).
+    pub fn sentence(&self) -> String {
+        if self.explained == self.of {
+            format!(
+                "your {} failures are exactly those of {} ({} of {})",
+                self.shape, self.description, self.explained, self.of
+            )
+        } else {
+            format!(
+                "your {} failures match those of {} ({} of {} explained)",
+                self.shape, self.description, self.explained, self.of
+            )
+        }
+    }
+}
+
+/// A description for each mistake of the catalogue, as the phrase after "those of".
+pub fn describe(mistake_id: &str) -> String {
+    let known = match mistake_id {
+        "sphere-far-root-first" => "taking the far root first",
+        "sphere-no-interval-check" => "not checking the root against the interval",
+        "sphere-unnormalised-normal" => "not dividing the normal (P - C) by the radius",
+        "sphere-abs-radius-in-normal" => {
+            "dividing the normal by |r| (a negative radius must flip it)"
+        }
+        "sphere-r-instead-of-r-squared" => "using r instead of r^2 in c = |oc|^2 - r^2",
+        "sphere-sign-error-in-b" => "a sign error in half_b",
+        "sphere-disc-without-a" => "leaving a out of the discriminant (half_b^2 - c)",
+        "sphere-front-face-reversed" => "reversing front_face",
+        "sphere-sqrt-precedence" => {
+            "writing -half_b - sqrt_disc / a (the division binds first) for the roots"
+        }
+        "sphere-normal-not-flipped" => {
+            "not calling set_face_normal (the normal never faces the ray)"
+        }
+        "quad-sign-error-in-alpha" => "a sign error in alpha (v x p instead of p x v)",
+        "quad-w-is-unit-normal" => "taking w as the unit normal instead of n / (n . n)",
+        "quad-no-parallel-test" => "having no test for a ray parallel to the plane",
+        "quad-wrong-d" => "computing D with the unnormalised normal (u x v) . Q",
+        "quad-front-face-reversed" => "reversing front_face",
+        "quad-no-interval-check" => "not checking t against the interval",
+        "quad-u-v-swapped-in-beta" => "a sign error in beta (p x u instead of u x p)",
+        "quad-beta-uses-v" => "using v instead of u in beta (v x p)",
+        "quad-unnormalised-normal" => "not normalising the quad's normal u x v",
+        "quad-d-from-u" => "computing D from u instead of Q (D = n . u)",
+        "quad-interior-upper-bounds-only" => {
+            "checking only alpha <= 1 and beta <= 1 (not >= 0) for the interior"
+        }
+        "triangle-missing-third-edge" => "not checking alpha + beta <= 1",
+        "triangle-no-parallel-test" => "having no test for a ray parallel to the triangle",
+        "triangle-absolute-epsilon" => {
+            "an absolute epsilon on the unnormalised determinant (near_zero(det) misses small triangles)"
+        }
+        _ => "",
+    };
+    if known.is_empty() {
+        mistake_id.replace('-', " ")
+    } else {
+        known.to_string()
+    }
+}
+
+/// The catalogue of known mistakes.
+pub fn catalogue() -> Vec<Variant> {
+    let mut list = variants::buggy();
+    list.extend(variants::buggy_extra());
+    list
+}
+
+/// What is wrong with an answer, compared with an expectation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Symptom {
+    Pass,
+    Raised,
+    HitForMiss,
+    MissForHit,
+    WrongT(f64),
+    WrongNormal([f64; 3]),
+    WrongFrontFace,
+}
+
+impl Symptom {
+    fn same(self, other: Symptom) -> bool {
+        match (self, other) {
+            (Symptom::WrongT(a), Symptom::WrongT(b)) => {
+                (a - b).abs() <= 1e-6 * a.abs().max(1.0) || (a.is_nan() && b.is_nan())
+            }
+            (Symptom::WrongNormal(a), Symptom::WrongNormal(b)) => {
+                (0..3).all(|k| (a[k] - b[k]).abs() <= 1e-4 || (a[k].is_nan() && b[k].is_nan()))
+            }
+            (a, b) => a == b,
+        }
+    }
+}
+
+/// The symptom of a hit (or miss, `None`) against a definite `expect`, by `check`'s rules.
+fn symptom(expect: &Expect, hit: Option<VHit>) -> Symptom {
+    match (expect.class, hit) {
+        (Class::Miss, None) => Symptom::Pass,
+        (Class::Miss, Some(_)) => Symptom::HitForMiss,
+        (_, None) => Symptom::MissForHit,
+        (_, Some(h)) => {
+            if let Some(te) = expect.t {
+                let tol = expect.t_tol.unwrap_or(1e-9 * te.abs().max(1.0));
+                if (h.t - te).abs().is_nan() || (h.t - te).abs() > tol {
+                    return Symptom::WrongT(h.t);
+                }
+            }
+            if let Some(ne) = expect.normal {
+                let bad = (0..3).any(|k| {
+                    let off = (h.normal[k] - ne[k]).abs();
+                    off.is_nan() || off > NORMAL_TOL
+                });
+                if bad {
+                    return Symptom::WrongNormal(h.normal);
+                }
+            }
+            if expect.front_face.is_some_and(|f| f != h.front_face) {
+                return Symptom::WrongFrontFace;
+            }
+            Symptom::Pass
+        }
+    }
+}
+
+/// The submission's symptom on a case, or `None` when its outcome is no evidence (no answer, a
+/// malformed one, stray output).
+fn submission_symptom(expect: &Expect, outcome: &Outcome) -> Option<Symptom> {
+    let Outcome::Answered { answer, junk } = outcome else {
+        return None;
+    };
+    if !junk.is_empty() {
+        return None;
+    }
+    if answer.error.is_some() {
+        return Some(Symptom::Raised);
+    }
+    answer.validate().ok()?;
+    Some(symptom(expect, as_hit(answer)))
+}
+
+fn as_hit(answer: &Answer) -> Option<VHit> {
+    if answer.hit != Some(true) {
+        return None;
+    }
+    Some(VHit {
+        t: answer.t.unwrap_or(f64::NAN),
+        normal: answer.normal.unwrap_or([f64::NAN; 3]),
+        front_face: answer.front_face.unwrap_or(false),
+    })
+}
+
+fn variant_symptom(v: &Variant, case: &Case) -> Symptom {
+    match (v.run)(&case.shape, &case.ray, case.interval) {
+        Err(_) => Symptom::Raised,
+        Ok(hit) => symptom(&case.expect, hit),
+    }
+}
+
+/// Diagnoses each shape group whose definite vectors fail: the known mistake that explains its
+/// failures, if any (see the module docs). `winding` is the submission's triangle winding
+/// ([`decide_winding`](super::check::decide_winding)). Deterministic: the same cases and
+/// outcomes give the same diagnosis.
+pub fn diagnose(cases: &[Case], outcomes: &[Outcome], winding: Option<Winding>) -> Vec<Diagnosis> {
+    let catalogue = catalogue();
+    let mut found = Vec::new();
+    for kind in ShapeKind::ALL {
+        let mut failing: Vec<(&Case, Symptom)> = Vec::new();
+        let mut passing: Vec<&Case> = Vec::new();
+        for (case, outcome) in cases.iter().zip(outcomes) {
+            if case.shape.kind() != kind || !case.expect.class.is_definite() {
+                continue;
+            }
+            let expect = match winding {
+                Some(w) => w.expectation(case).expect.clone(),
+                None => case.expect.clone(),
+            };
+            match submission_symptom(&expect, outcome) {
+                Some(Symptom::Pass) => passing.push(case),
+                Some(s) => failing.push((case, s)),
+                None => {}
+            }
+        }
+        if failing.is_empty() {
+            continue;
+        }
+        let sample: Vec<&Case> = if passing.len() <= SAMPLE {
+            passing
+        } else {
+            (0..SAMPLE)
+                .map(|i| passing[i * passing.len() / SAMPLE])
+                .collect()
+        };
+        let mut best: Option<(usize, usize, &Variant)> = None;
+        for v in catalogue.iter().filter(|v| v.shape == kind) {
+            let explained = failing
+                .iter()
+                .filter(|(case, s)| s.same(variant_symptom(v, case)))
+                .count();
+            if explained * 100 < failing.len() * 95 {
+                continue;
+            }
+            let disagree = sample
+                .iter()
+                .filter(|case| variant_symptom(v, case) != Symptom::Pass)
+                .count();
+            if disagree * 100 > sample.len() {
+                continue;
+            }
+            let better = match best {
+                None => true,
+                Some((e, d, _)) => explained > e || (explained == e && disagree < d),
+            };
+            if better {
+                best = Some((explained, disagree, v));
+            }
+        }
+        if let Some((explained, _, v)) = best {
+            found.push(Diagnosis {
+                shape: kind,
+                mistake_id: v.name.to_string(),
+                description: describe(v.name),
+                explained,
+                of: failing.len(),
+            });
+        }
+    }
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::oracle::default_suite;
+
+    fn outcome_of(v: &Variant, case: &Case) -> Outcome {
+        let answer = match (v.run)(&case.shape, &case.ray, case.interval) {
+            Err(e) => Answer::error(e, "division by zero"),
+            Ok(None) => Answer::miss(),
+            Ok(Some(h)) => Answer::hit(h.t, h.normal, h.normal, h.front_face),
+        };
+        Outcome::Answered {
+            answer,
+            junk: vec![],
+        }
+    }
+
+    /// `v`'s answers on its shape, the reference's on the others.
+    fn run(v: &Variant, cases: &[Case]) -> Vec<Outcome> {
+        let honest = variants::honest();
+        cases
+            .iter()
+            .map(|c| {
+                if c.shape.kind() == v.shape {
+                    outcome_of(v, c)
+                } else {
+                    let name = format!("{}-reference", c.shape.kind());
+                    outcome_of(honest.iter().find(|h| h.name == name).unwrap(), c)
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_catalogued_mistake_is_named_for_its_own_answers_and_honest_ones_get_none() {
+        let cases = default_suite(0);
+        for v in catalogue() {
+            let found = diagnose(&cases, &run(&v, &cases), None);
+            assert_eq!(found.len(), 1, "{}: {found:?}", v.name);
+            let d = &found[0];
+            assert_eq!(d.shape, v.shape, "{}", v.name);
+            // Two entries may answer alike on the suite (front_face reversed and a reversed
+            // winding are one for triangles); the named one must then explain all of it too.
+            assert_eq!(d.explained, d.of, "{}: {d:?}", v.name);
+            if d.mistake_id != v.name {
+                let named = catalogue()
+                    .into_iter()
+                    .find(|c| c.name == d.mistake_id)
+                    .unwrap();
+                let same = cases
+                    .iter()
+                    .filter(|c| c.shape.kind() == v.shape && c.expect.class.is_definite())
+                    .all(|c| variant_symptom(&named, c).same(variant_symptom(&v, c)));
+                assert!(same, "{} named {}", v.name, d.mistake_id);
+            }
+        }
+        for v in variants::honest() {
+            let found = diagnose(&cases, &run(&v, &cases), None);
+            assert!(found.is_empty(), "{}: {found:?}", v.name);
+        }
+    }
+
+    #[test]
+    fn an_unexplained_failure_names_nothing_and_the_sentence_says_what_it_names() {
+        let cases = default_suite(0);
+        let reference = variants::honest()
+            .into_iter()
+            .find(|v| v.name == "sphere-reference")
+            .unwrap();
+        let mut outcomes = run(&reference, &cases);
+        // One sphere hit answered with a t no mistake gives.
+        let i = cases
+            .iter()
+            .position(|c| c.shape.kind() == ShapeKind::Sphere && c.expect.class == Class::Hit)
+            .unwrap();
+        if let Outcome::Answered { answer, .. } = &mut outcomes[i] {
+            answer.t = Some(answer.t.unwrap() + 123.0);
+        }
+        assert!(diagnose(&cases, &outcomes, None).is_empty());
+        let d = Diagnosis {
+            shape: ShapeKind::Sphere,
+            mistake_id: "sphere-far-root-first".into(),
+            description: describe("sphere-far-root-first"),
+            explained: 12,
+            of: 12,
+        };
+        assert_eq!(
+            d.sentence(),
+            "your sphere failures are exactly those of taking the far root first (12 of 12)"
+        );
+    }
+}
