@@ -291,6 +291,11 @@ impl CandidateCommand {
         })
     }
 
+    /// Whether this runs the bundled course adapter (failures then get Python reproductions).
+    pub fn is_course_adapter(&self) -> bool {
+        self.course_adapter
+    }
+
     /// The files to copy into the sandbox: the submission's top-level `.py` files (regular
     /// files only: links are not followed out of the folder).
     fn staged_files(&self) -> Result<Vec<(PathBuf, String)>, HarnessError> {
