@@ -1038,10 +1038,8 @@ impl Session {
                 } else {
                     proc.lines.recv_timeout(left)
                 };
-                let protocol = |message: String, junk: Vec<String>| Outcome::Protocol {
-                    message,
-                    junk,
-                };
+                let protocol =
+                    |message: String, junk: Vec<String>| Outcome::Protocol { message, junk };
                 match next {
                     Ok(Line::Parsed(parsed)) => match parsed {
                         ParsedLine::Answer {
@@ -1068,8 +1066,11 @@ impl Session {
                             last = Instant::now();
                             break;
                         }
-                        ParsedLine::Answer { id, .. } | ParsedLine::Malformed { id: Some(id), .. }
-                            if index.get(id.as_str()).is_some_and(|&k| outcomes[k].is_some()) =>
+                        ParsedLine::Answer { id, .. }
+                        | ParsedLine::Malformed { id: Some(id), .. }
+                            if index
+                                .get(id.as_str())
+                                .is_some_and(|&k| outcomes[k].is_some()) =>
                         {
                             let line = format!("a second answer for {}", quote_line(&id));
                             push_junk(&mut junk, line, &mut self.junk_left);

@@ -412,8 +412,8 @@ impl Hello {
     /// A hello from a JSON object (no `id`, a `name` or a `protocol`); `Err` says what is wrong
     /// with its fields. Text fields are capped.
     fn from_value(value: serde_json::Value) -> Result<Hello, String> {
-        let mut hello: Hello = serde_json::from_value(value)
-            .map_err(|e| format!("its hello is malformed: {e}"))?;
+        let mut hello: Hello =
+            serde_json::from_value(value).map_err(|e| format!("its hello is malformed: {e}"))?;
         if hello.name.len() > MAX_QUOTE_CHARS {
             hello.name = crate::escape::truncate(&hello.name, MAX_QUOTE_CHARS);
         }
@@ -495,8 +495,7 @@ mod tests {
         assert!(matches!(parse_line("{'a': 1}"), ParsedLine::Junk(_)));
         assert!(matches!(parse_line(r#"{"a": 1}"#), ParsedLine::Junk(_)));
         // Non-finite numbers as strings.
-        match parse_line(r#"{"id":"x","hit":true,"t":"nan","normal":[0,0,1],"front_face":false}"#)
-        {
+        match parse_line(r#"{"id":"x","hit":true,"t":"nan","normal":[0,0,1],"front_face":false}"#) {
             ParsedLine::Answer { answer, .. } => assert!(answer.t.unwrap().is_nan()),
             other => panic!("{other:?}"),
         }
@@ -512,7 +511,11 @@ mod tests {
                 Some("v1"),
                 "not valid JSON",
             ),
-            (r#"{"id":"v2","hit":"true"}"#, Some("v2"), "not a valid answer"),
+            (
+                r#"{"id":"v2","hit":"true"}"#,
+                Some("v2"),
+                "not a valid answer",
+            ),
             (
                 r#"{"id":"v3","hit":true,"t":1e999,"normal":[0,0,1],"front_face":true}"#,
                 Some("v3"),
@@ -547,11 +550,16 @@ mod tests {
     #[test]
     fn what_is_kept_of_a_line_is_capped() {
         let big = "m".repeat(300_000);
-        let line = format!(r#"{{"id":"v","error":{{"type":"E","message":"{big}","traceback":"{big}"}}}}"#);
+        let line =
+            format!(r#"{{"id":"v","error":{{"type":"E","message":"{big}","traceback":"{big}"}}}}"#);
         match parse_line(&line) {
             ParsedLine::Answer { answer, .. } => {
                 let e = answer.error.unwrap();
-                assert!(e.message.len() < MAX_ERROR_FIELD_BYTES + 40, "{}", e.message.len());
+                assert!(
+                    e.message.len() < MAX_ERROR_FIELD_BYTES + 40,
+                    "{}",
+                    e.message.len()
+                );
                 assert!(e.traceback.len() < MAX_ERROR_FIELD_BYTES + 40);
                 assert!(e.message.ends_with("more bytes]"));
             }
@@ -563,7 +571,9 @@ mod tests {
         }
         let bad = format!(r#"{{"id":"v","hit":tru {big}"#);
         match parse_line(&bad) {
-            ParsedLine::Malformed { quoted, .. } => assert!(quoted.len() <= 2 * MAX_QUOTE_CHARS + 5),
+            ParsedLine::Malformed { quoted, .. } => {
+                assert!(quoted.len() <= 2 * MAX_QUOTE_CHARS + 5)
+            }
             other => panic!("{other:?}"),
         }
     }
@@ -576,7 +586,8 @@ mod tests {
         assert!(v2.check().unwrap_err().contains("\"protocol\": 2"));
         let none = Hello::parse(r#"{"name":"c"}"#).unwrap();
         assert!(none.check().unwrap_err().contains("no \"protocol\""));
-        let typo = Hello::parse(r#"{"name":"c","protocol":1,"shapes":["sphere","quads"]}"#).unwrap();
+        let typo =
+            Hello::parse(r#"{"name":"c","protocol":1,"shapes":["sphere","quads"]}"#).unwrap();
         let problem = typo.check().unwrap_err();
         assert!(
             problem.contains("\"quads\"") && problem.contains("sphere, quad, triangle"),

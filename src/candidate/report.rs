@@ -329,7 +329,11 @@ impl CheckReport {
             }
         }
         if let Some(f) = &self.start_failure {
-            let _ = writeln!(s, "the candidate could not be started: {}", terminal_line(f));
+            let _ = writeln!(
+                s,
+                "the candidate could not be started: {}",
+                terminal_line(f)
+            );
         }
         let _ = writeln!(
             s,
@@ -671,7 +675,10 @@ mod tests {
         assert_eq!(text.matches("raised SyntaxError").count(), 1, "{text}");
         assert_eq!(text.matches("reproduce").count(), 1, "{text}");
         assert!(text.contains(&format!("all {} failures are the same", cases.len())));
-        assert!(!text.contains('\x1b') && text.contains("\\x1b[31m"), "{text}");
+        assert!(
+            !text.contains('\x1b') && text.contains("\\x1b[31m"),
+            "{text}"
+        );
         assert!(!text.contains("\nverdict: PASS"), "{text}");
     }
 

@@ -66,6 +66,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         seed: rubric.seed,
         vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
+        time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
         ..Default::default()
     };
     let images = rtoracle::compare::CompareImageChecker::default();

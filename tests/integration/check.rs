@@ -163,9 +163,13 @@ fn a_submission_hanging_on_misses_costs_three_timeouts_per_group() {
     }
     // What was not run is summarised per shape, not listed.
     assert!(r.failures.iter().all(|f| f.kind != FailureKind::NotRun));
-    assert!(r.not_run_summary.iter().any(|n| n.shape == ShapeKind::Sphere
-        && n.count == group(&r, ShapeKind::Sphere).not_run
-        && n.reason.contains("after 3 timeouts in the sphere group")));
+    assert!(
+        r.not_run_summary
+            .iter()
+            .any(|n| n.shape == ShapeKind::Sphere
+                && n.count == group(&r, ShapeKind::Sphere).not_run
+                && n.reason.contains("after 3 timeouts in the sphere group"))
+    );
     // Every timed-out case is a miss.
     assert!(
         r.failures
@@ -683,7 +687,10 @@ fn a_candidate_flooding_stdout_times_out_with_bounded_memory() {
     let first = &json["failures"][0];
     assert_eq!(first["kind"], "timeout");
     assert!(
-        first["message"].as_str().unwrap().contains(r#""junk", "junk""#),
+        first["message"]
+            .as_str()
+            .unwrap()
+            .contains(r#""junk", "junk""#),
         "{first}"
     );
 }

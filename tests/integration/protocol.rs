@@ -160,7 +160,12 @@ fn a_bare_nan_adapter_gets_protocol_errors_on_the_default_suite_in_seconds() {
     }
     let start = Instant::now();
     let out = rtoracle()
-        .args(["check", "--adapter", &adapter_line("bare-nan '*'"), "--json"])
+        .args([
+            "check",
+            "--adapter",
+            &adapter_line("bare-nan '*'"),
+            "--json",
+        ])
         .output()
         .unwrap();
     let took = start.elapsed();
@@ -188,7 +193,10 @@ fn hellos_with_another_version_no_version_or_an_unknown_shape_exit_2() {
     for (mode, needle) in [
         ("hello-v2", "\"protocol\": 2"),
         ("hello-none", "no \"protocol\""),
-        ("hello-quads", "unknown shape \"quads\"; the known shapes are sphere, quad, triangle"),
+        (
+            "hello-quads",
+            "unknown shape \"quads\"; the known shapes are sphere, quad, triangle",
+        ),
     ] {
         let out = run_in(tmp.path(), &["check", "--adapter", &adapter_line(mode)]);
         assert_bad_input(&out, needle);
