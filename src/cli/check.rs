@@ -78,10 +78,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         report.to_text(args.show)
     };
-    println!("{}", text.trim_end());
+    print_stdout(&format!("{}\n", text.trim_end()))?;
     Ok(ExitCode::from(if report.passed() {
         0
     } else {
         super::FAILED
     }))
+}
+
+/// Writes `text` to stdout; a reader that went away (`| head -1`) is not an error: the rest is
+/// dropped quietly, as ripgrep does.
+pub(super) fn print_stdout(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(anyhow::Error::new(e).context("cannot write to stdout"))
+        }
+        _ => Ok(()),
+    }
 }

@@ -266,3 +266,117 @@ fn past_the_time_budget_the_rest_is_not_run_and_the_report_says_why() {
         "{text}"
     );
 }
+
+#[test]
+fn fuzz_refuses_bounds_that_run_nothing_or_never_end() {
+    let tmp = tempfile::tempdir().unwrap();
+    let target = ["fuzz", "--adapter", "cat"];
+    for (extra, needle) in [
+        (&["--cases", "0"][..], "--cases 0"),
+        (&["--time=1e308"], "--time 1e308"),
+        (&["--time=1e-300"], "--time 1e-300"),
+        (&["--time", "nan"], "--time NaN"),
+        (&["--time", "0"], "--time 0.0"),
+    ] {
+        let args: Vec<&str> = target.iter().chain(extra).copied().collect();
+        let out = run_in(tmp.path(), &args);
+        assert_bad_input(&out, needle);
+    }
+}
+
+#[test]
+fn fuzz_by_time_runs_for_the_time_and_shows_every_kind() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    // Answers "miss" to everything: every definite hit is a missed hit.
+    let start = Instant::now();
+    let out = run_in(
+        tmp.path(),
+        &[
+            "fuzz",
+            "--adapter",
+            &adapter_line("none"),
+            "--time",
+            "2",
+            "--save",
+            "found.jsonl",
+        ],
+    );
+    let took = start.elapsed();
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(took >= Duration::from_secs(2), "{took:?}");
+    assert!(took < Duration::from_secs(2 + 5 + 4), "{took:?}");
+    // More than one round of 1000: the time bounded the run.
+    let run: usize = text.split_whitespace().next().unwrap().parse().unwrap();
+    assert!(run > 1000, "{text}");
+    assert!(text.contains("[missed hit]") && text.contains("(sphere)") && text.contains("(quad)"));
+    // An adapter's report speaks of requests, not of the course's Python.
+    assert!(!text.contains("RT_object"), "{text}");
+    let saved = std::fs::read_to_string(tmp.path().join("found.jsonl")).unwrap();
+    assert_eq!(saved.lines().count(), 2, "{saved}");
+}
+
+#[test]
+fn fuzz_save_with_nothing_failing_writes_nothing() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    // The misbehaving adapter only fails hits; `--cases 1` draws one case, a hit or a miss:
+    // the first seed that draws a miss makes a run where nothing fails.
+    for seed in 0..40 {
+        let seed = seed.to_string();
+        let out = run_in(
+            tmp.path(),
+            &[
+                "fuzz",
+                "--adapter",
+                &adapter_line("none"),
+                "--cases",
+                "1",
+                "--seed",
+                &seed,
+                "--save",
+                "found.jsonl",
+            ],
+        );
+        if out.status.code() == Some(0) {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(stderr.contains("nothing failed, so found.jsonl was not written"));
+            assert!(!tmp.path().join("found.jsonl").exists());
+            return;
+        }
+    }
+    panic!("no seed drew a miss");
+}
+
+#[test]
+fn a_closed_stdout_ends_check_quietly() {
+    if !python_ok() {
+        return;
+    }
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    for extra in [&["--show", "3000"][..], &["--json"]] {
+        let mut child = rtoracle()
+            .args(["check", "--adapter", &adapter_line("bare-nan '*'")])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        // The reader is gone (as with `| head -1`).
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!first.is_empty());
+        assert_eq!(out.status.code(), Some(1), "{extra:?}: {stderr}");
+        assert!(stderr.is_empty(), "{extra:?}: {stderr}");
+    }
+}
