@@ -514,7 +514,7 @@ fn fuzz_finds_shrinks_and_prints_a_reproduction() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("[mismatch]") && text.contains("(quad)"),
+        text.contains("[missed hit]") && text.contains("(quad)"),
         "{text}"
     );
     assert!(text.contains("from RT_object import Quad"), "{text}");
