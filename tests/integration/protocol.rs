@@ -380,3 +380,34 @@ fn a_closed_stdout_ends_check_quietly() {
         assert!(stderr.is_empty(), "{extra:?}: {stderr}");
     }
 }
+
+#[test]
+fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
+    if !python_ok() {
+        return;
+    }
+    use rtoracle::grade::{CodeChecker, CourseCodeChecker};
+    // Hangs on every miss: with a 2 s case timeout and 3 timeouts per group it would cost 12 s
+    // and more; a 3 s budget stops it there.
+    let dir = rtoracle::candidate::bench::assemble_fixture("hostile_hang_on_miss").unwrap();
+    let checker = CourseCodeChecker {
+        time_budget: Some(Duration::from_secs(3)),
+        ..CourseCodeChecker::default()
+    };
+    let start = Instant::now();
+    let out = checker.check(dir.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
+    let took = start.elapsed();
+    assert!(took < Duration::from_secs(6), "took {took:?}");
+    let spheres = &out.per_group[&ShapeKind::Sphere];
+    let quads = &out.per_group[&ShapeKind::Quad];
+    // What ran before the budget was used up keeps its marks.
+    assert!(spheres.passed > 0, "{spheres:?}");
+    assert!(quads.not_run > 0, "{quads:?}");
+    assert!(
+        out.failures
+            .iter()
+            .any(|f| f.message.contains("3 s budget for code checks was used up")),
+        "{:?}",
+        out.failures.iter().map(|f| &f.message).collect::<Vec<_>>()
+    );
+}
