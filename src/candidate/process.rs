@@ -11,9 +11,24 @@
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
 //! takes them while the session reads answers. Candidates may batch their answers; after the
 //! first crash or timeout the session asks for one flush per answer (`"sync": true`) and runs
-//! the cases again from the one it was waiting for, so blame always lands on the right case. The timeout of a case runs from the answer to the
-//! previous case (or from the hello), so a candidate that is merely busy on earlier cases is
-//! never charged for them.
+//! the cases again from the one it was waiting for, so blame always lands on the right case. The
+//! timeout of a case runs from the answer to the previous case (or from the hello), so a
+//! candidate that is merely busy on earlier cases is never charged for them.
+//!
+//! What a session promises:
+//! - **A strict protocol** ([`Session::run`]): every stdout line is judged against the case
+//!   waited for; a malformed answer, an answer with an id in no request, an answer for a later
+//!   request or an oversize line makes that case a `protocol` error at once ([`Outcome::Protocol`]),
+//!   without a restart; an answer for a case already settled is stray output of the waited one,
+//!   which keeps waiting for its own id, so nothing shifts. The hello must say protocol 1 and
+//!   name only known shapes ([`HarnessError::BadHello`] otherwise).
+//! - **Caps on the harness's side**: lines are parsed on the reader thread and only capped text
+//!   is queued ([`LINE_QUEUE`] lines); answer lines over [`MAX_LINE_BYTES`] are skipped, not
+//!   kept; each error field is cut to 4 KiB and, past [`RUN_DETAIL_BYTES`] per session, to
+//!   [`SMALL_ERROR_BYTES`] without traceback; stray lines are quoted briefly, 8 per case and
+//!   [`RUN_JUNK_BYTES`] per session; stderr keeps its last [`STDERR_TAIL_BYTES`].
+//! - **A time budget** ([`RunOptions::budget`]): past it the cases not answered are `not_run`
+//!   with the reason, and the candidate is killed.
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::ffi::{OsStr, OsString};
@@ -44,7 +59,7 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 
 /// Lines read ahead of the session. Each holds at most a few capped texts (see
 /// [`parse_line`]), so what is queued stays within a few tens of MB however big the lines.
-const LINE_QUEUE: usize = 1024;
+pub const LINE_QUEUE: usize = 1024;
 
 /// Bytes of candidate text (error types, messages, tracebacks) kept over one session: past
 /// it, each error keeps [`SMALL_ERROR_BYTES`] of each field and no traceback.

@@ -14,6 +14,12 @@
 //! ```
 //!
 //! Numbers use the vector file's syntax: JSON numbers, or the strings `"inf"`, `"-inf"`, `"nan"`.
+//!
+//! [`parse_line`] tells each stdout line apart: a valid answer, a malformed one (with its id when
+//! it has one: a bare `nan`, a wrong type, a number out of range, a hit without its fields), a
+//! hello, or stray output; every text it keeps is capped ([`MAX_ERROR_FIELD_BYTES`],
+//! [`MAX_QUOTE_CHARS`]), so a line costs bounded memory whatever the candidate writes.
+//! [`Hello::check`] accepts protocol 1 and the [`KNOWN_SHAPES`] only.
 
 use serde::{Deserialize, Serialize};
 
