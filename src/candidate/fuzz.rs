@@ -248,6 +248,10 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
             break;
         }
         let outcomes = run(&cases)?;
+        // Nothing can run any more (every group used up its timeouts or crashes): stop.
+        if outcomes.iter().all(|o| matches!(o, Outcome::NotRun { .. })) {
+            break;
+        }
         report.cases_run += cases.len();
         for (case, outcome) in cases.iter().zip(&outcomes) {
             let Some(detail) = FuzzKind::of(case, outcome) else {
@@ -441,6 +445,23 @@ mod tests {
             ..options
         };
         assert_eq!(fuzz(&mut reference, &options).unwrap().cases_run, 300);
+        // A candidate that can run nothing more ends the run at once, not at the time limit.
+        let options = FuzzOptions {
+            cases: None,
+            time: Some(Duration::from_secs(30)),
+            ..options
+        };
+        let mut exhausted = |c: &[Case]| {
+            Ok(c.iter()
+                .map(|_| Outcome::NotRun {
+                    reason: "not run after 3 timeouts".into(),
+                })
+                .collect())
+        };
+        let start = Instant::now();
+        let report = fuzz(&mut exhausted, &options).unwrap();
+        assert!(start.elapsed() < Duration::from_secs(5));
+        assert_eq!((report.cases_run, report.failed), (0, 0));
     }
 
     #[test]
