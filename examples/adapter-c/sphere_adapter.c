@@ -6,28 +6,49 @@
  * Build: cc -O2 -o sphere_adapter sphere_adapter.c -lm
  * Run:   rtoracle check --adapter ./sphere_adapter --vectors spheres.jsonl
  *
- * The parser is deliberately small: it finds each field by its key and reads numbers with
- * strtod, which understands the protocol's "inf", "-inf" and "nan" strings once the quote is
- * skipped. Numbers are printed with %.17g, enough to read back the same double.
+ * The parser is deliberately small, but it relies on nothing the protocol does not promise:
+ * it finds each field by its key ("key" then optional whitespace and a colon), in whatever order
+ * the keys come and with any whitespace, and reads numbers with strtod, which understands the
+ * protocol's "inf", "-inf" and "nan" strings once the quote is skipped. Numbers are printed with
+ * %.17g, enough to read back the same double; non-finite ones as the strings.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static const char *after(const char *s, const char *key) {
-    const char *p = strstr(s, key);
-    return p ? p + strlen(key) : NULL;
+static const char *skip_space(const char *p) {
+    while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n') p++;
+    return p;
+}
+
+/* The value of the field named key (just after its colon and any whitespace), or NULL. The
+ * keys of the requests are unique words, so the first "key" followed by a colon is the field. */
+static const char *field(const char *s, const char *key) {
+    char quoted[64];
+    snprintf(quoted, sizeof quoted, "\"%s\"", key);
+    for (const char *p = strstr(s, quoted); p; p = strstr(p + 1, quoted)) {
+        const char *q = skip_space(p + strlen(quoted));
+        if (*q == ':') return skip_space(q + 1);
+    }
+    return NULL;
+}
+
+/* Whether the field named key is the JSON string value. */
+static int field_is(const char *s, const char *key, const char *value) {
+    const char *p = field(s, key);
+    size_t n = strlen(value);
+    return p && *p == '"' && strncmp(p + 1, value, n) == 0 && p[1 + n] == '"';
 }
 
 /* Reads n numbers of a JSON array starting at p (just after the key). */
 static int numbers(const char *p, double *out, int n) {
     if (!p) return 0;
-    while (*p && *p != '[') p++;
+    p = skip_space(p);
     if (*p != '[') return 0;
     p++;
     for (int i = 0; i < n; i++) {
-        while (*p == ' ' || *p == ',' || *p == '"') p++;
+        while (*p == ' ' || *p == '\t' || *p == ',' || *p == '"') p++;
         char *end;
         out[i] = strtod(p, &end);
         if (end == p) return 0;
@@ -38,7 +59,7 @@ static int numbers(const char *p, double *out, int n) {
 
 static double number(const char *p) {
     if (!p) return NAN;
-    while (*p == ' ' || *p == ':' || *p == '"') p++;
+    if (*p == '"') p++;
     return strtod(p, NULL);
 }
 
@@ -63,23 +84,25 @@ static double dot(const double *a, const double *b) {
 int main(void) {
     static char line[1 << 16];
     while (fgets(line, sizeof line, stdin)) {
-        if (strstr(line, "\"op\":\"hello\"")) {
+        if (field_is(line, "op", "hello")) {
             printf("{\"name\":\"c-sphere-adapter\",\"protocol\":1,\"shapes\":[\"sphere\"]}\n");
             fflush(stdout);
             continue;
         }
-        /* The id: copy the JSON string as it is. */
-        const char *id = after(line, "\"id\":");
-        const char *id_end = id ? strchr(id + 1, '"') : NULL;
-        if (!id || !id_end) continue;
+        /* The id: copy the JSON string as it is, escapes included. */
+        const char *id = field(line, "id");
+        if (!id || *id != '"') continue;
+        const char *id_end = id + 1;
+        while (*id_end && *id_end != '"') id_end += (*id_end == '\\' && id_end[1]) ? 2 : 1;
+        if (*id_end != '"') continue;
         int id_len = (int)(id_end - id + 1);
 
         double c[3], o[3], d[3], iv[2];
-        double r = number(after(line, "\"radius\":"));
-        if (!strstr(line, "\"type\":\"sphere\"") || !numbers(after(line, "\"center\":"), c, 3) ||
-            !numbers(after(line, "\"origin\":"), o, 3) ||
-            !numbers(after(line, "\"direction\":"), d, 3) ||
-            !numbers(after(line, "\"interval\":"), iv, 2)) {
+        double r = number(field(line, "radius"));
+        if (!field_is(line, "type", "sphere") || !numbers(field(line, "center"), c, 3) ||
+            !numbers(field(line, "origin"), o, 3) ||
+            !numbers(field(line, "direction"), d, 3) ||
+            !numbers(field(line, "interval"), iv, 2)) {
             printf("{\"id\":%.*s,\"error\":{\"type\":\"Unsupported\",\"message\":\"not a sphere request\"}}\n",
                    id_len, id);
             fflush(stdout);

@@ -74,7 +74,7 @@ fn fail(kind: FailureKind, message: impl Into<String>) -> Verdict {
 
 fn with_junk(mut message: String, junk: &[String]) -> String {
     if !junk.is_empty() {
-        message.push_str(&format!("; it printed {:?}", junk.join("\n")));
+        message.push_str(&format!("; it printed {}", junk.join(", ")));
     }
     message
 }
@@ -171,13 +171,16 @@ pub fn judge(case: &Case, outcome: &Outcome) -> Verdict {
         Outcome::Died { message, junk } => {
             fail(FailureKind::Error, with_junk(message.clone(), junk))
         }
+        Outcome::Protocol { message, junk } => {
+            fail(FailureKind::Protocol, with_junk(message.clone(), junk))
+        }
         Outcome::Answered { answer, junk } => {
             if !junk.is_empty() {
                 return fail(
                     FailureKind::Protocol,
                     format!(
-                        "the candidate printed something that is not an answer: {:?}",
-                        junk.join("\n")
+                        "the candidate printed something that is not an answer: {}",
+                        junk.join(", ")
                     ),
                 );
             }

@@ -1,29 +1,39 @@
 //! Differential fuzzing: random definite cases (see [`super::generate`]) run through a
-//! candidate in rounds; each distinct failure (shape group and kind) is shrunk to a small case.
+//! candidate in rounds until a number of cases or a time is reached (whichever first); each
+//! distinct failure, by shape group and [`FuzzKind`] (a hit/miss flip either way, t, normal,
+//! front_face, a raised error, a dead process, a timeout, a protocol error), is shrunk to a
+//! small case that still fails the same way.
+//!
+//! Time: the search stops at the first round boundary past [`FuzzOptions::time`] (rounds are
+//! [`FuzzOptions::round`] cases); shrinking then gets at most [`SHRINK_TIME`] more in all, so a
+//! run with a time limit `T` takes about `T` plus that.
 
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::check::{FailureKind, Verdict, decide_winding, judge_wound};
+use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_wound};
 use super::generate::random_cases_with;
 use super::process::{HarnessError, Outcome};
-use super::report::python_repro;
+use super::report::{expected_in_words, python_repro};
 use crate::oracle::Judging;
-use crate::oracle::vectors::{Case, ShapeKind};
+use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// A candidate as the fuzzer sees it: a batch of cases in, one outcome per case out.
 pub type RunBatch<'a> = dyn FnMut(&[Case]) -> Result<Vec<Outcome>, HarnessError> + 'a;
 
+/// Longest time spent shrinking, over all the failures of one run.
+pub const SHRINK_TIME: Duration = Duration::from_secs(5);
+
 /// What a fuzz run does.
 #[derive(Clone, Debug)]
 pub struct FuzzOptions {
-    /// Stop after this many cases.
-    pub cases: usize,
+    /// Stop after this many cases (`None`: only the time bounds the run).
+    pub cases: Option<usize>,
     /// The seed of the generator.
     pub seed: u64,
-    /// Stop after this much time (checked between rounds).
+    /// Stop after this much time (checked between rounds; `None`: only `cases` bounds the run).
     pub time: Option<Duration>,
     /// Cases per round (one batch through the candidate).
     pub round: usize,
@@ -33,34 +43,123 @@ pub struct FuzzOptions {
     pub shrink_budget: usize,
     /// The profile and precision the cases are classified by.
     pub judging: Judging,
+    /// Whether reproductions are written in the course's Python (the course adapter).
+    pub course_api: bool,
 }
 
 impl Default for FuzzOptions {
     fn default() -> Self {
         FuzzOptions {
-            cases: 10_000,
+            cases: Some(10_000),
             seed: 0,
             time: None,
             round: 1000,
             kinds: ShapeKind::ALL.to_vec(),
             shrink_budget: 2000,
             judging: Judging::COURSE,
+            course_api: true,
         }
+    }
+}
+
+/// How a case failed, finer than [`FailureKind`]: each kind of wrong answer is its own, so a
+/// hit/miss flip is not hidden behind a t mismatch of the same shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FuzzKind {
+    /// A definite hit answered with a miss.
+    MissedHit,
+    /// A definite miss answered with a hit.
+    FalseHit,
+    /// A hit with t beyond the tolerance.
+    T,
+    /// A hit with a wrong normal.
+    Normal,
+    /// A hit with the wrong `front_face`.
+    FrontFace,
+    /// Another mismatch.
+    OtherMismatch,
+    /// The candidate raised an error.
+    Error,
+    /// The candidate's process died.
+    Crash,
+    /// No answer within the timeout.
+    Timeout,
+    /// A line that is not a valid answer.
+    Protocol,
+}
+
+impl FuzzKind {
+    /// The name used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            FuzzKind::MissedHit => "missed hit",
+            FuzzKind::FalseHit => "false hit",
+            FuzzKind::T => "t",
+            FuzzKind::Normal => "normal",
+            FuzzKind::FrontFace => "front_face",
+            FuzzKind::OtherMismatch => "mismatch",
+            FuzzKind::Error => "error",
+            FuzzKind::Crash => "crash",
+            FuzzKind::Timeout => "timeout",
+            FuzzKind::Protocol => "protocol",
+        }
+    }
+
+    /// How `outcome` fails `case` (`None` when it passes, is not scored or was not run).
+    pub fn of(case: &Case, outcome: &Outcome) -> Option<FuzzKind> {
+        Self::of_wound(case, outcome, None)
+    }
+
+    /// [`FuzzKind::of`], judging triangles' `front_face` by the candidate's own `winding`.
+    pub fn of_wound(case: &Case, outcome: &Outcome, winding: Option<Winding>) -> Option<FuzzKind> {
+        let Verdict::Fail { kind, message } = judge_wound(case, outcome, winding) else {
+            return None;
+        };
+        Some(match kind {
+            FailureKind::NotRun => return None,
+            FailureKind::Timeout => FuzzKind::Timeout,
+            FailureKind::Protocol => FuzzKind::Protocol,
+            FailureKind::Error => match outcome {
+                Outcome::Answered { .. } => FuzzKind::Error,
+                _ => FuzzKind::Crash,
+            },
+            FailureKind::Mismatch => {
+                let hit =
+                    matches!(outcome, Outcome::Answered { answer, .. } if answer.hit == Some(true));
+                match (case.expect.class, hit) {
+                    (Class::Hit, false) => FuzzKind::MissedHit,
+                    (Class::Miss, true) => FuzzKind::FalseHit,
+                    // The judge checks t, then the normal, then front_face; its message names
+                    // the first that is wrong.
+                    _ if message.starts_with("t = ") => FuzzKind::T,
+                    _ if message.starts_with("normal = ") => FuzzKind::Normal,
+                    _ if message.starts_with("front_face = ") => FuzzKind::FrontFace,
+                    _ => FuzzKind::OtherMismatch,
+                }
+            }
+        })
     }
 }
 
 /// One failure, as found and as shrunk.
 #[derive(Clone, Debug, Serialize)]
 pub struct FuzzFailure {
-    /// What kind of failure.
+    /// What kind of failure, as the check report counts it.
     pub kind: FailureKind,
+    /// What kind of failure, finely.
+    pub detail: FuzzKind,
     /// The message for the minimal case.
     pub message: String,
     /// The random case that failed first.
     pub original: Case,
     /// The minimal case that still fails the same way.
     pub minimal: Case,
-    /// A Python snippet reproducing the minimal case with the course's API.
+    /// The minimal case's expected answer in words.
+    pub expected_text: String,
+    /// A Python snippet reproducing the minimal case with the course's API (course adapter
+    /// only; empty otherwise: the minimal case's vector line is the reproduction).
+    #[serde(skip_serializing_if = "String::is_empty")]
     pub repro: String,
 }
 
@@ -71,28 +170,56 @@ pub struct FuzzReport {
     pub cases_run: usize,
     /// Cases that failed.
     pub failed: usize,
+    /// Seconds spent on the search (shrinking not included).
+    pub search_seconds: f64,
+    /// How many failed, per shape and kind (every kind met, shown or not).
+    pub by_kind: Vec<KindCount>,
     /// One shrunk failure per shape group and kind, in the order found.
     pub failures: Vec<FuzzFailure>,
 }
 
+/// How many cases of one shape failed one way.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct KindCount {
+    /// The shape group.
+    pub shape: ShapeKind,
+    /// The kind of failure.
+    pub kind: FuzzKind,
+    /// How many cases.
+    pub count: usize,
+}
+
 impl FuzzReport {
-    /// A text rendering with every reproduction.
+    /// A text rendering with every reproduction (candidate text escaped for the terminal).
     pub fn to_text(&self) -> String {
+        use crate::escape::terminal_line;
         let mut s = format!(
-            "{} random definite cases run, {} failed\n",
-            self.cases_run, self.failed
+            "{} random definite cases run in {:.1} s, {} failed\n",
+            self.cases_run, self.search_seconds, self.failed
         );
+        for k in &self.by_kind {
+            s.push_str(&format!(
+                "  {} {}: {} failed\n",
+                k.shape,
+                k.kind.name(),
+                k.count
+            ));
+        }
         for f in &self.failures {
             s.push_str(&format!(
-                "\n[{}] {} ({}): {}\n  minimal case (vector line):\n    {}\n  reproduce (run in the submission folder):\n",
-                f.kind.name(),
-                f.minimal.id,
+                "\n[{}] {} ({}): {}\n  minimal case (vector line):\n    {}\n  expected: {}\n",
+                f.detail.name(),
+                terminal_line(&f.minimal.id),
                 f.minimal.shape.kind(),
-                f.message,
-                f.minimal.to_json_line()
+                terminal_line(&f.message),
+                f.minimal.to_json_line(),
+                f.expected_text
             ));
-            for line in f.repro.lines() {
-                s.push_str(&format!("    {line}\n"));
+            if !f.repro.is_empty() {
+                s.push_str("  reproduce (run in the submission folder):\n");
+                for line in f.repro.lines() {
+                    s.push_str(&format!("    {line}\n"));
+                }
             }
         }
         s
@@ -105,61 +232,90 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
     let mut report = FuzzReport {
         cases_run: 0,
         failed: 0,
+        search_seconds: 0.0,
+        by_kind: Vec::new(),
         failures: Vec::new(),
     };
-    let mut found: Vec<(Case, FailureKind)> = Vec::new();
-    let mut seen: BTreeSet<(ShapeKind, FailureKind)> = BTreeSet::new();
+    let mut found: Vec<(Case, FuzzKind, FailureKind)> = Vec::new();
+    let mut seen: BTreeSet<(ShapeKind, FuzzKind)> = BTreeSet::new();
     let mut stream = 0u64;
     // Students' triangles are judged by their own winding, decided on the first round that hits.
     let mut winding = None;
-    while report.cases_run < options.cases {
-        if options.time.is_some_and(|t| start.elapsed() >= t) {
+    loop {
+        let left = match options.cases {
+            Some(n) => n.saturating_sub(report.cases_run),
+            None => usize::MAX,
+        };
+        // At least one round, however short the time.
+        let out_of_time =
+            report.cases_run > 0 && options.time.is_some_and(|t| start.elapsed() >= t);
+        if left == 0 || out_of_time {
             break;
         }
-        let n = options.round.min(options.cases - report.cases_run);
+        let n = options.round.max(1).min(left);
         let cases = random_cases_with(options.seed, stream, n, &options.kinds, options.judging);
         stream += 1;
         if cases.is_empty() {
             break;
         }
         let outcomes = run(&cases)?;
+        // Nothing can run any more (every group used up its timeouts or crashes): stop.
+        if outcomes.iter().all(|o| matches!(o, Outcome::NotRun { .. })) {
+            break;
+        }
         report.cases_run += cases.len();
         winding = winding.or_else(|| decide_winding(&cases, &outcomes));
         for (case, outcome) in cases.iter().zip(&outcomes) {
-            if let Verdict::Fail { kind, .. } = judge_wound(case, outcome, winding) {
-                if kind == FailureKind::NotRun {
-                    continue;
-                }
-                report.failed += 1;
-                if seen.insert((case.shape.kind(), kind)) {
-                    found.push((case.clone(), kind));
-                }
+            let Some(detail) = FuzzKind::of_wound(case, outcome, winding) else {
+                continue;
+            };
+            report.failed += 1;
+            let shape = case.shape.kind();
+            match report
+                .by_kind
+                .iter_mut()
+                .find(|k| k.shape == shape && k.kind == detail)
+            {
+                Some(k) => k.count += 1,
+                None => report.by_kind.push(KindCount {
+                    shape,
+                    kind: detail,
+                    count: 1,
+                }),
+            }
+            if seen.insert((shape, detail)) {
+                let kind = match judge_wound(case, outcome, winding) {
+                    Verdict::Fail { kind, .. } => kind,
+                    _ => FailureKind::Mismatch,
+                };
+                found.push((case.clone(), detail, kind));
             }
         }
     }
-    for (case, kind) in found {
+    report.search_seconds = start.elapsed().as_secs_f64();
+    let shrink_until = Instant::now() + SHRINK_TIME;
+    for (case, detail, kind) in found {
         // Timeouts and deaths cost a restart per try: keep them as found.
-        let keep =
-            kind == FailureKind::Timeout || (kind == FailureKind::Error && !is_raised(&case, run));
-        let minimal = if keep {
+        let keep = matches!(detail, FuzzKind::Timeout | FuzzKind::Crash);
+        let minimal = if keep || Instant::now() >= shrink_until {
             case.clone()
         } else {
-            let mut fails = |batch: &[Case]| -> Vec<Option<FailureKind>> {
+            let mut fails = |batch: &[Case]| -> Vec<Option<FuzzKind>> {
+                if Instant::now() >= shrink_until {
+                    return vec![None; batch.len()];
+                }
                 match run(batch) {
                     Ok(outcomes) => batch
                         .iter()
                         .zip(&outcomes)
-                        .map(|(c, o)| match judge_wound(c, o, winding) {
-                            Verdict::Fail { kind, .. } => Some(kind),
-                            _ => None,
-                        })
+                        .map(|(c, o)| FuzzKind::of_wound(c, o, winding))
                         .collect(),
                     Err(_) => vec![None; batch.len()],
                 }
             };
             super::shrink::shrink_with(
                 &case,
-                kind,
+                detail,
                 &mut fails,
                 options.shrink_budget,
                 options.judging,
@@ -174,21 +330,19 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
         };
         report.failures.push(FuzzFailure {
             kind,
+            detail,
             message,
-            repro: python_repro(&minimal),
+            expected_text: expected_in_words(&minimal.expect),
+            repro: if options.course_api {
+                python_repro(&minimal)
+            } else {
+                String::new()
+            },
             original: case,
             minimal,
         });
     }
     Ok(report)
-}
-
-/// Whether an `error` failure is a raised error (cheap to shrink) rather than a dead process.
-fn is_raised(case: &Case, run: &mut RunBatch<'_>) -> bool {
-    matches!(
-        run(std::slice::from_ref(case)).ok().as_deref(),
-        Some([Outcome::Answered { answer, .. }]) if answer.error.is_some()
-    )
 }
 
 #[cfg(test)]
@@ -213,7 +367,7 @@ mod tests {
     #[test]
     fn the_reference_survives_and_a_bug_is_found_and_shrunk() {
         let options = FuzzOptions {
-            cases: 3000,
+            cases: Some(3000),
             seed: 1,
             ..FuzzOptions::default()
         };
@@ -238,5 +392,144 @@ mod tests {
         };
         assert!(bits(&f.minimal) <= bits(&f.original));
         assert!(f.repro.contains("from RT_object import Sphere"));
+        assert_eq!(f.detail, FuzzKind::Normal);
+    }
+
+    /// Misses every sphere hit from inside, and is off in t on quads seen from the front.
+    struct TwoBugs;
+    impl Candidate for TwoBugs {
+        fn intersect(&mut self, shape: &ShapeSpec, ray: &RaySpec, interval: [f64; 2]) -> Answer {
+            let mut a = Reference.intersect(shape, ray, interval);
+            match (shape, a.front_face) {
+                (ShapeSpec::Sphere { .. }, Some(false)) => Answer::miss(),
+                (ShapeSpec::Quad { .. }, Some(true)) => {
+                    a.t = a.t.map(|t| t * (1.0 + 1e-3) + 1e-3);
+                    a
+                }
+                _ => a,
+            }
+        }
+    }
+
+    #[test]
+    fn every_failing_kind_of_a_shape_is_shown_and_shrunk_apart() {
+        let options = FuzzOptions {
+            cases: Some(3000),
+            seed: 2,
+            course_api: false,
+            ..FuzzOptions::default()
+        };
+        let mut buggy = |c: &[Case]| Ok(run_candidate(&mut TwoBugs, c));
+        let report = fuzz(&mut buggy, &options).unwrap();
+        let shown: BTreeSet<(ShapeKind, FuzzKind)> = report
+            .failures
+            .iter()
+            .map(|f| (f.minimal.shape.kind(), f.detail))
+            .collect();
+        assert!(
+            shown.contains(&(ShapeKind::Sphere, FuzzKind::MissedHit))
+                && shown.contains(&(ShapeKind::Quad, FuzzKind::T)),
+            "{}",
+            report.to_text()
+        );
+        // Each shown failure still fails its own way, and the counts add up.
+        for f in &report.failures {
+            let o = run_candidate(&mut TwoBugs, std::slice::from_ref(&f.minimal));
+            assert_eq!(FuzzKind::of(&f.minimal, &o[0]), Some(f.detail));
+            assert!(f.repro.is_empty(), "no Python for a non-course candidate");
+        }
+        let counted: usize = report.by_kind.iter().map(|k| k.count).sum();
+        assert_eq!(counted, report.failed);
+    }
+
+    #[test]
+    fn a_time_limit_alone_runs_until_the_time_is_up() {
+        let options = FuzzOptions {
+            cases: None,
+            time: Some(Duration::from_millis(300)),
+            round: 200,
+            ..FuzzOptions::default()
+        };
+        let start = Instant::now();
+        let mut reference = |c: &[Case]| Ok(run_candidate(&mut Reference, c));
+        let report = fuzz(&mut reference, &options).unwrap();
+        assert!(start.elapsed() >= Duration::from_millis(300));
+        // Far more than one round: the case count bounded nothing.
+        assert!(report.cases_run > 400, "{}", report.cases_run);
+        assert_eq!(report.cases_run % 200, 0);
+        // Both bounds: whichever first.
+        let options = FuzzOptions {
+            cases: Some(300),
+            ..options
+        };
+        assert_eq!(fuzz(&mut reference, &options).unwrap().cases_run, 300);
+        // A candidate that can run nothing more ends the run at once, not at the time limit.
+        let options = FuzzOptions {
+            cases: None,
+            time: Some(Duration::from_secs(30)),
+            ..options
+        };
+        let mut exhausted = |c: &[Case]| {
+            Ok(c.iter()
+                .map(|_| Outcome::NotRun {
+                    reason: "not run after 3 timeouts".into(),
+                })
+                .collect())
+        };
+        let start = Instant::now();
+        let report = fuzz(&mut exhausted, &options).unwrap();
+        assert!(start.elapsed() < Duration::from_secs(5));
+        assert_eq!((report.cases_run, report.failed), (0, 0));
+    }
+
+    #[test]
+    fn failure_kinds_are_told_apart() {
+        let case = crate::candidate::test_cases::basic_cases().remove(0);
+        let good = Answer::hit(4.0, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], true);
+        let answered = |a: Answer| Outcome::Answered {
+            answer: a,
+            junk: vec![],
+        };
+        let with = |f: &dyn Fn(&mut Answer)| {
+            let mut a = good.clone();
+            f(&mut a);
+            FuzzKind::of(&case, &answered(a))
+        };
+        assert_eq!(FuzzKind::of(&case, &answered(good.clone())), None);
+        assert_eq!(with(&|a| a.t = Some(4.5)), Some(FuzzKind::T));
+        assert_eq!(
+            with(&|a| a.normal = Some([1.0, 0.0, 0.0])),
+            Some(FuzzKind::Normal)
+        );
+        assert_eq!(
+            with(&|a| a.front_face = Some(false)),
+            Some(FuzzKind::FrontFace)
+        );
+        assert_eq!(
+            FuzzKind::of(&case, &answered(Answer::miss())),
+            Some(FuzzKind::MissedHit)
+        );
+        assert_eq!(
+            FuzzKind::of(&case, &answered(Answer::error("E", "m"))),
+            Some(FuzzKind::Error)
+        );
+        let died = Outcome::Died {
+            message: "x".into(),
+            junk: vec![],
+        };
+        assert_eq!(FuzzKind::of(&case, &died), Some(FuzzKind::Crash));
+        let timeout = Outcome::Timeout { junk: vec![] };
+        assert_eq!(FuzzKind::of(&case, &timeout), Some(FuzzKind::Timeout));
+        let protocol = Outcome::Protocol {
+            message: "x".into(),
+            junk: vec![],
+        };
+        assert_eq!(FuzzKind::of(&case, &protocol), Some(FuzzKind::Protocol));
+        let mut miss = case.clone();
+        miss.expect.class = Class::Miss;
+        assert_eq!(
+            FuzzKind::of(&miss, &answered(good)),
+            Some(FuzzKind::FalseHit)
+        );
     }
 }

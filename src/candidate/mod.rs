@@ -48,6 +48,7 @@ pub fn check_session(session: &mut Session, cases: &[Case]) -> Result<CheckRepor
             stderr_tail: session.stderr_tail(),
             restarts: session.restarts(),
             sandbox: Some(session.sandbox_facts()),
+            course_api: session.command().is_course_adapter(),
         },
     ))
 }

@@ -11,11 +11,26 @@
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
 //! takes them while the session reads answers. Candidates may batch their answers; after the
 //! first crash or timeout the session asks for one flush per answer (`"sync": true`) and runs
-//! the cases again from the one it was waiting for, so blame always lands on the right case. The timeout of a case runs from the answer to the
-//! previous case (or from the hello), so a candidate that is merely busy on earlier cases is
-//! never charged for them.
+//! the cases again from the one it was waiting for, so blame always lands on the right case. The
+//! timeout of a case runs from the answer to the previous case (or from the hello), so a
+//! candidate that is merely busy on earlier cases is never charged for them.
+//!
+//! What a session promises:
+//! - **A strict protocol** ([`Session::run`]): every stdout line is judged against the case
+//!   waited for; a malformed answer, an answer with an id in no request, an answer for a later
+//!   request or an oversize line makes that case a `protocol` error at once ([`Outcome::Protocol`]),
+//!   without a restart; an answer for a case already settled is stray output of the waited one,
+//!   which keeps waiting for its own id, so nothing shifts. The hello must say protocol 1 and
+//!   name only known shapes ([`HarnessError::BadHello`] otherwise).
+//! - **Caps on the harness's side**: lines are parsed on the reader thread and only capped text
+//!   is queued ([`LINE_QUEUE`] lines); answer lines over [`MAX_LINE_BYTES`] are skipped, not
+//!   kept; each error field is cut to 4 KiB and, past [`RUN_DETAIL_BYTES`] per session, to
+//!   [`SMALL_ERROR_BYTES`] without traceback; stray lines are quoted briefly, 8 per case and
+//!   [`RUN_JUNK_BYTES`] per session; stderr keeps its last [`STDERR_TAIL_BYTES`].
+//! - **A time budget** ([`RunOptions::budget`]): past it the cases not answered are `not_run`
+//!   with the reason, and the candidate is killed.
 
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::ffi::{OsStr, OsString};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::process::ExitStatusExt;
@@ -26,7 +41,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use super::protocol::{
-    Answer, CandidateError, HELLO_LINE, Hello, ParsedLine, Request, parse_answer_line,
+    Answer, CandidateError, HELLO_LINE, Hello, MAX_QUOTE_CHARS, ParsedLine, Request, parse_line,
+    quote_line,
 };
 use crate::oracle::vectors::{Case, ShapeKind};
 use crate::sandbox::{Sandbox, SandboxFacts, SandboxPolicy};
@@ -37,11 +53,23 @@ const ADAPTER_NAME: &str = "rtoracle_python_course.py";
 /// How many bytes of the candidate's stderr are kept for the report.
 pub const STDERR_TAIL_BYTES: usize = 4096;
 
-/// Longest stdout line kept (longer ones are truncated, so junk cannot fill memory).
-const MAX_LINE_BYTES: usize = 1 << 20;
+/// Longest answer line accepted: a longer one is a protocol error of the case waiting, and is
+/// skipped up to its newline without being kept (only its first bytes are quoted).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
 
-/// Longest piece of junk quoted in a report.
-const JUNK_QUOTE: usize = 200;
+/// Lines read ahead of the session. Each holds at most a few capped texts (see
+/// [`parse_line`]), so what is queued stays within a few tens of MB however big the lines.
+pub const LINE_QUEUE: usize = 1024;
+
+/// Bytes of candidate text (error types, messages, tracebacks) kept over one session: past
+/// it, each error keeps [`SMALL_ERROR_BYTES`] of each field and no traceback.
+pub const RUN_DETAIL_BYTES: usize = 256 * 1024;
+
+/// What each error field keeps once [`RUN_DETAIL_BYTES`] are used up.
+pub const SMALL_ERROR_BYTES: usize = 200;
+
+/// Bytes of stray output quoted over one session; past it stray lines are counted, not kept.
+pub const RUN_JUNK_BYTES: usize = 64 * 1024;
 
 /// The embedded adapter for the course's Python API.
 pub const PYTHON_COURSE_ADAPTER: &str = include_str!("python_course.py");
@@ -59,6 +87,9 @@ pub struct RunOptions {
     pub max_crashes_per_group: u32,
     /// The sandbox's limits and switches.
     pub limits: SandboxPolicy,
+    /// Wall time allowed for the whole session (the hello and every case, restarts included):
+    /// past it the cases not yet answered are `not_run` with the reason. `None`: no limit.
+    pub budget: Option<Duration>,
 }
 
 impl Default for RunOptions {
@@ -69,6 +100,7 @@ impl Default for RunOptions {
             max_timeouts_per_group: 3,
             max_crashes_per_group: 50,
             limits: SandboxPolicy::default(),
+            budget: None,
         }
     }
 }
@@ -82,6 +114,14 @@ pub enum Outcome {
         /// The answer.
         answer: Answer,
         /// Stray output before the answer.
+        junk: Vec<String>,
+    },
+    /// A line that is not a valid answer to this case's request (a malformed answer, an answer
+    /// with another id, an oversize line): a protocol error, decided when the line arrived.
+    Protocol {
+        /// What was wrong, with the line quoted.
+        message: String,
+        /// Stray output before it.
         junk: Vec<String>,
     },
     /// No answer within the timeout: the candidate was killed and restarted.
@@ -123,6 +163,14 @@ pub enum HarnessError {
         program: String,
         /// What happened, with the end of its stderr.
         message: String,
+    },
+    /// The candidate's hello cannot be accepted (another protocol version, an unknown shape).
+    #[error("the candidate {program} cannot be checked: {problem}")]
+    BadHello {
+        /// The program.
+        program: String,
+        /// What is wrong with its hello.
+        problem: String,
     },
     /// The adapter command line is unusable.
     #[error("the adapter command {command:?} {problem}")]
@@ -258,6 +306,11 @@ impl CandidateCommand {
         })
     }
 
+    /// Whether this runs the bundled course adapter (failures then get Python reproductions).
+    pub fn is_course_adapter(&self) -> bool {
+        self.course_adapter
+    }
+
     /// The files to copy into the sandbox: the submission's top-level `.py` files (regular
     /// files only: links are not followed out of the folder).
     fn staged_files(&self) -> Result<Vec<(PathBuf, String)>, HarnessError> {
@@ -372,8 +425,11 @@ impl Tail {
     }
 }
 
+/// What the reader thread passes on: each stdout line parsed (and capped) on that thread.
 enum Line {
-    Text(String),
+    Parsed(ParsedLine),
+    /// A line longer than [`MAX_LINE_BYTES`]: its first characters, quoted.
+    Oversize(String),
     Eof,
 }
 
@@ -416,7 +472,7 @@ impl Proc {
             }
         });
         // Bounded: a candidate that floods stdout is slowed down, not buffered without end.
-        let (ltx, lrx) = mpsc::sync_channel(4096);
+        let (ltx, lrx) = mpsc::sync_channel(LINE_QUEUE);
         std::thread::spawn(move || read_lines(stdout, ltx));
         let stderr_done = std::thread::spawn(move || {
             let mut buf = [0u8; 8192];
@@ -490,27 +546,46 @@ impl Drop for Proc {
 fn read_lines(stdout: ChildStdout, tx: SyncSender<Line>) {
     let mut reader = BufReader::with_capacity(1 << 16, stdout);
     let mut line: Vec<u8> = Vec::new();
+    // Set once the line in hand passed MAX_LINE_BYTES: the rest up to the newline is dropped.
+    let mut oversize = false;
+    let finish = |line: &[u8], oversize: bool| {
+        let text = String::from_utf8_lossy(line);
+        if oversize {
+            Line::Oversize(quote_line(&text))
+        } else {
+            Line::Parsed(parse_line(&text))
+        }
+    };
     loop {
         let (done, used) = match reader.fill_buf() {
             Ok([]) => {
                 if !line.is_empty() {
-                    let _ = tx.send(Line::Text(String::from_utf8_lossy(&line).into_owned()));
+                    let _ = tx.send(finish(&line, oversize));
                 }
                 let _ = tx.send(Line::Eof);
                 return;
             }
-            Ok(buf) => match buf.iter().position(|&b| b == b'\n') {
-                Some(i) => {
-                    let room = MAX_LINE_BYTES.saturating_sub(line.len());
-                    line.extend_from_slice(&buf[..i.min(room)]);
-                    (true, i + 1)
+            Ok(buf) => {
+                let (end, done) = match buf.iter().position(|&b| b == b'\n') {
+                    Some(i) => (i, true),
+                    None => (buf.len(), false),
+                };
+                let room = MAX_LINE_BYTES.saturating_sub(line.len());
+                if end > room {
+                    oversize = true;
                 }
-                None => {
-                    let room = MAX_LINE_BYTES.saturating_sub(line.len());
-                    line.extend_from_slice(&buf[..buf.len().min(room)]);
-                    (false, buf.len())
+                // Only the start of an oversize line is kept, for the quotation.
+                let keep = if oversize {
+                    (4 * MAX_QUOTE_CHARS).saturating_sub(line.len())
+                } else {
+                    room
+                };
+                line.extend_from_slice(&buf[..end.min(keep)]);
+                if oversize && line.len() > 4 * MAX_QUOTE_CHARS {
+                    line.truncate(4 * MAX_QUOTE_CHARS);
                 }
-            },
+                (done, if done { end + 1 } else { end })
+            }
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(_) => {
                 let _ = tx.send(Line::Eof);
@@ -519,9 +594,10 @@ fn read_lines(stdout: ChildStdout, tx: SyncSender<Line>) {
         };
         reader.consume(used);
         if done {
-            let text = String::from_utf8_lossy(&line).into_owned();
+            let item = finish(&line, oversize);
             line.clear();
-            if tx.send(Line::Text(text)).is_err() {
+            oversize = false;
+            if tx.send(item).is_err() {
                 return;
             }
         }
@@ -554,22 +630,31 @@ fn describe_status(status: Option<ExitStatus>) -> String {
 /// Most stray lines quoted for one case; the rest are counted.
 const MAX_JUNK_LINES: usize = 8;
 
-/// Records a stray line, keeping memory bounded however much a candidate prints.
-fn push_junk(junk: &mut Vec<String>, line: &str) {
-    if junk.len() < MAX_JUNK_LINES {
-        junk.push(quote(line));
-    } else if junk.len() == MAX_JUNK_LINES {
-        junk.push("(more lines not shown)".into());
+/// Records a stray line (already quoted and capped), keeping memory bounded however much a
+/// candidate prints: at most [`MAX_JUNK_LINES`] per case and [`RUN_JUNK_BYTES`] per session
+/// (`budget` holds what is left of it).
+fn push_junk(junk: &mut Vec<String>, line: String, budget: &mut usize) {
+    if junk.len() < MAX_JUNK_LINES && line.len() <= *budget {
+        *budget -= line.len();
+        junk.push(line);
+    } else if junk.last().map(String::as_str) != Some(MORE_JUNK) {
+        junk.push(MORE_JUNK.into());
     }
 }
 
-fn quote(s: &str) -> String {
-    let mut q: String = s.chars().take(JUNK_QUOTE).collect();
-    if q.len() < s.len() {
-        q.push_str("...");
+/// A line that is stray output where it came, in words.
+fn describe_line(line: ParsedLine) -> String {
+    match line {
+        ParsedLine::Junk(text) => text,
+        ParsedLine::Hello(_) => "another hello".into(),
+        ParsedLine::BadHello(problem) => format!("a line like a hello ({problem})"),
+        ParsedLine::Answer { id, .. } => format!("an answer for {}", quote_line(&id)),
+        ParsedLine::Malformed { quoted, .. } => quoted,
     }
-    q
 }
+
+/// The note that ends a case's stray lines when some were not kept.
+const MORE_JUNK: &str = "(more lines not shown)";
 
 /// A candidate process and its bookkeeping, restarted as needed.
 ///
@@ -591,6 +676,14 @@ pub struct Session {
     sync: bool,
     sandbox: Sandbox,
     facts: Option<SandboxFacts>,
+    /// When the session started (its time budget runs from here).
+    started: Instant,
+    /// Set when the time budget ran out: the reason given to every case not answered.
+    budget_used: Option<String>,
+    /// What is left of [`RUN_DETAIL_BYTES`].
+    detail_left: usize,
+    /// What is left of [`RUN_JUNK_BYTES`].
+    junk_left: usize,
 }
 
 impl Session {
@@ -617,6 +710,10 @@ impl Session {
             sync: false,
             sandbox,
             facts: None,
+            started: Instant::now(),
+            budget_used: None,
+            detail_left: RUN_DETAIL_BYTES,
+            junk_left: RUN_JUNK_BYTES,
         };
         match session.launch()? {
             Ok(hello) => session.hello = hello,
@@ -719,16 +816,31 @@ impl Session {
                 proc.lines.recv_timeout(left)
             };
             match next {
-                Ok(Line::Text(line)) => {
-                    if let Some(mut hello) = Hello::parse(&line) {
-                        self.proc = Some(proc);
-                        if let Some(error) = &mut hello.error {
-                            self.localise(error);
-                        }
-                        return Ok(Ok(hello));
+                Ok(Line::Parsed(ParsedLine::Hello(mut hello))) => {
+                    if let Err(problem) = hello.check() {
+                        let _ = proc.kill();
+                        return Err(HarnessError::BadHello {
+                            program: self.command.label.clone(),
+                            problem,
+                        });
                     }
-                    push_junk(&mut junk, &line);
+                    self.proc = Some(proc);
+                    if let Some(error) = &mut hello.error {
+                        self.localise(error);
+                    }
+                    return Ok(Ok(hello));
                 }
+                Ok(Line::Parsed(ParsedLine::BadHello(problem))) => {
+                    let _ = proc.kill();
+                    return Err(HarnessError::BadHello {
+                        program: self.command.label.clone(),
+                        problem,
+                    });
+                }
+                Ok(Line::Parsed(other)) => {
+                    push_junk(&mut junk, describe_line(other), &mut self.junk_left)
+                }
+                Ok(Line::Oversize(head)) => push_junk(&mut junk, head, &mut self.junk_left),
                 Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
                     let mut proc = proc;
                     let status = proc.exit_status();
@@ -750,7 +862,7 @@ impl Session {
     fn failure_message(&self, what: String, junk: &[String]) -> String {
         let mut message = what;
         if !junk.is_empty() {
-            message.push_str(&format!("; it printed {:?}", junk.join("\n")));
+            message.push_str(&format!("; it printed {}", junk.join(", ")));
         }
         let tail = self.stderr_tail();
         let tail = tail.trim();
@@ -781,14 +893,24 @@ impl Session {
                     .then(|| format!("{}\n", Request::for_case(c).to_line()))
             })
             .collect();
+        // Where each id is (the first case with it), to tell late, early and unknown answers.
+        let mut index: HashMap<&str, usize> = HashMap::with_capacity(cases.len());
+        for (i, case) in cases.iter().enumerate() {
+            index.entry(case.id.as_str()).or_insert(i);
+        }
         loop {
+            self.check_budget();
             // Cases still to run, skipping exhausted groups.
             let mut pending = Vec::new();
             for (i, case) in cases.iter().enumerate() {
                 if outcomes[i].is_some() {
                     continue;
                 }
-                if let Some(reason) = self.exhausted.get(&case.shape.kind()) {
+                if let Some(reason) = &self.budget_used {
+                    outcomes[i] = Some(Outcome::NotRun {
+                        reason: reason.clone(),
+                    });
+                } else if let Some(reason) = self.exhausted.get(&case.shape.kind()) {
                     outcomes[i] = Some(Outcome::NotRun {
                         reason: reason.clone(),
                     });
@@ -831,12 +953,58 @@ impl Session {
                 }
             }
             proc.send(bytes);
-            self.collect(cases, &pending, &mut outcomes);
+            self.collect(cases, &pending, &mut outcomes, &index);
         }
         Ok(outcomes
             .into_iter()
             .map(|o| o.expect("every case has an outcome"))
             .collect())
+    }
+
+    /// When the time budget runs out, if there is one.
+    fn budget_deadline(&self) -> Option<Instant> {
+        self.options.budget.map(|b| self.started + b)
+    }
+
+    /// Marks the budget used up when its deadline has passed (and kills the candidate).
+    fn check_budget(&mut self) {
+        if self.budget_used.is_some() {
+            return;
+        }
+        if let (Some(deadline), Some(budget)) = (self.budget_deadline(), self.options.budget) {
+            if Instant::now() >= deadline {
+                self.budget_used = Some(format!(
+                    "the submission's {} s budget for code checks was used up",
+                    budget.as_secs_f64()
+                ));
+                if let Some(proc) = self.proc.take() {
+                    let _ = proc.kill();
+                }
+            }
+        }
+    }
+
+    /// Whether the time budget ran out (the cases not answered by then are `not_run`).
+    pub fn budget_used_up(&self) -> Option<&str> {
+        self.budget_used.as_deref()
+    }
+
+    /// An answer as the session keeps it: the error's tracebacks renamed to the submission's
+    /// files, its fields capped further once the session's [`RUN_DETAIL_BYTES`] are used up.
+    fn keep(&mut self, mut answer: Answer) -> Answer {
+        if let Some(error) = answer.error.take() {
+            let mut error = if self.detail_left == 0 {
+                let mut e = error.capped_to(SMALL_ERROR_BYTES);
+                e.traceback.clear();
+                e
+            } else {
+                error
+            };
+            self.localise(&mut error);
+            self.detail_left = self.detail_left.saturating_sub(error.text_len());
+            answer.error = Some(error);
+        }
+        answer
     }
 
     /// Reads the answers to `pending`, in order, until all are in or the process is lost.
@@ -846,42 +1014,150 @@ impl Session {
     /// and the real culprit may be a later case. The session switches to sync mode and the
     /// cases are run again from the one it was waiting for; from then on the case waited for
     /// is the one blamed.
-    fn collect(&mut self, cases: &[Case], pending: &[usize], outcomes: &mut [Option<Outcome>]) {
+    ///
+    /// Every line is judged against the case waited for (the strict protocol):
+    /// - its valid answer settles it; stray lines before it make it a `protocol` error;
+    /// - a malformed answer carrying its id (or no id), an answer with an id that is not in
+    ///   the run, or an oversize line settle it at once as a `protocol` error;
+    /// - an answer for a case already settled (late, or a duplicate) is stray output of the
+    ///   case waited for, which keeps waiting for its own answer;
+    /// - an answer for a later case settles the waited case as a `protocol` error (answers
+    ///   come in request order) and is kept for that later case.
+    fn collect(
+        &mut self,
+        cases: &[Case],
+        pending: &[usize],
+        outcomes: &mut [Option<Outcome>],
+        index: &HashMap<&str, usize>,
+    ) {
         let timeout = self.options.timeout;
         let mut last = Instant::now();
+        let mut early: HashMap<usize, Outcome> = HashMap::new();
         for &i in pending {
             let case = &cases[i];
+            if let Some(outcome) = early.remove(&i) {
+                outcomes[i] = Some(outcome);
+                continue;
+            }
             let mut junk: Vec<String> = Vec::new();
             loop {
+                let case_deadline = last + timeout;
+                let (until, by_budget) = match self.budget_deadline() {
+                    Some(b) if b < case_deadline => (b, true),
+                    _ => (case_deadline, false),
+                };
                 let proc = self.proc.as_mut().expect("a running candidate");
-                let left = (last + timeout).saturating_duration_since(Instant::now());
+                let left = until.saturating_duration_since(Instant::now());
                 let next = if left.is_zero() {
                     Err(RecvTimeoutError::Timeout)
                 } else {
                     proc.lines.recv_timeout(left)
                 };
+                let protocol =
+                    |message: String, junk: Vec<String>| Outcome::Protocol { message, junk };
                 match next {
-                    Ok(Line::Text(line)) => match parse_answer_line(&line) {
+                    Ok(Line::Parsed(parsed)) => match parsed {
                         ParsedLine::Answer {
                             id,
-                            mut answer,
+                            answer,
                             junk: prefix,
                         } if id == case.id => {
-                            if let Some(error) = &mut answer.error {
-                                self.localise(error);
-                            }
                             if !prefix.is_empty() {
-                                push_junk(&mut junk, &prefix);
+                                push_junk(&mut junk, prefix, &mut self.junk_left);
                             }
+                            let answer = self.keep(answer);
                             outcomes[i] = Some(Outcome::Answered { answer, junk });
                             last = Instant::now();
                             break;
                         }
-                        ParsedLine::Answer { id, .. } => {
-                            push_junk(&mut junk, &format!("an answer for id {id:?}: {line}"));
+                        ParsedLine::Malformed {
+                            id,
+                            problem,
+                            quoted,
+                        } if id.is_none() || id.as_deref() == Some(case.id.as_str()) => {
+                            let message =
+                                format!("a malformed answer ({problem}): the line was {quoted}");
+                            outcomes[i] = Some(protocol(message, junk));
+                            last = Instant::now();
+                            break;
                         }
-                        ParsedLine::Junk(text) => push_junk(&mut junk, &text),
+                        ParsedLine::Answer { id, .. }
+                        | ParsedLine::Malformed { id: Some(id), .. }
+                            if index
+                                .get(id.as_str())
+                                .is_some_and(|&k| outcomes[k].is_some()) =>
+                        {
+                            let line = format!("a second answer for {}", quote_line(&id));
+                            push_junk(&mut junk, line, &mut self.junk_left);
+                        }
+                        ParsedLine::Answer {
+                            id,
+                            answer,
+                            junk: prefix,
+                        } if index.get(id.as_str()).is_some_and(|&k| k > i) => {
+                            let k = index[id.as_str()];
+                            let mut later_junk = Vec::new();
+                            if !prefix.is_empty() {
+                                push_junk(&mut later_junk, prefix, &mut self.junk_left);
+                            }
+                            let answer = self.keep(answer);
+                            early.insert(
+                                k,
+                                Outcome::Answered {
+                                    answer,
+                                    junk: later_junk,
+                                },
+                            );
+                            let message = format!(
+                                "no answer to this request before the answer for the later \
+                                 request {} (answers come in request order)",
+                                quote_line(&id)
+                            );
+                            outcomes[i] = Some(protocol(message, junk));
+                            last = Instant::now();
+                            break;
+                        }
+                        ParsedLine::Answer { id, answer, .. } => {
+                            let line = serde_json::to_string(&answer).unwrap_or_default();
+                            let message = format!(
+                                "an answer with id {} instead of {}: {}",
+                                quote_line(&id),
+                                quote_line(&case.id),
+                                quote_line(&line)
+                            );
+                            outcomes[i] = Some(protocol(message, junk));
+                            last = Instant::now();
+                            break;
+                        }
+                        ParsedLine::Malformed {
+                            id: Some(id),
+                            problem,
+                            quoted,
+                        } => {
+                            let message = format!(
+                                "a malformed answer with id {} instead of {} ({problem}): the \
+                                 line was {quoted}",
+                                quote_line(&id),
+                                quote_line(&case.id)
+                            );
+                            outcomes[i] = Some(protocol(message, junk));
+                            last = Instant::now();
+                            break;
+                        }
+                        other => {
+                            push_junk(&mut junk, describe_line(other), &mut self.junk_left);
+                        }
                     },
+                    Ok(Line::Oversize(head)) => {
+                        let message = format!(
+                            "a line longer than {} MiB (answer lines are at most that): it \
+                             began {head}",
+                            MAX_LINE_BYTES >> 20
+                        );
+                        outcomes[i] = Some(protocol(message, junk));
+                        last = Instant::now();
+                        break;
+                    }
                     Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
                         let mut proc = self.proc.take().expect("a running candidate");
                         let status = proc.exit_status();
@@ -896,6 +1172,10 @@ impl Session {
                         );
                         outcomes[i] = Some(Outcome::Died { message, junk });
                         self.count(CountKind::Crash, case.shape.kind());
+                        return;
+                    }
+                    Err(RecvTimeoutError::Timeout) if by_budget => {
+                        self.check_budget();
                         return;
                     }
                     Err(RecvTimeoutError::Timeout) => {
@@ -1014,12 +1294,22 @@ mod tests {
     #[test]
     fn stray_output_is_quoted_briefly_and_bounded() {
         let mut junk = Vec::new();
+        let mut left = RUN_JUNK_BYTES;
         for _ in 0..1000 {
-            push_junk(&mut junk, &"x".repeat(10_000));
+            push_junk(&mut junk, quote_line(&"x".repeat(10_000)), &mut left);
         }
         assert_eq!(junk.len(), MAX_JUNK_LINES + 1);
-        assert_eq!(junk[0].len(), JUNK_QUOTE + 3);
-        assert_eq!(junk[MAX_JUNK_LINES], "(more lines not shown)");
+        assert_eq!(junk[0].len(), MAX_QUOTE_CHARS + 5);
+        assert_eq!(junk[MAX_JUNK_LINES], MORE_JUNK);
+        // Over a session: once the total is used up, lines are only counted.
+        let mut left = 3 * (MAX_QUOTE_CHARS + 5);
+        let mut kept = 0;
+        for _ in 0..100 {
+            let mut junk = Vec::new();
+            push_junk(&mut junk, quote_line(&"y".repeat(500)), &mut left);
+            kept += (junk[0] != MORE_JUNK) as usize;
+        }
+        assert_eq!(kept, 3);
     }
 
     #[test]

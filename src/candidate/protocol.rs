@@ -14,6 +14,12 @@
 //! ```
 //!
 //! Numbers use the vector file's syntax: JSON numbers, or the strings `"inf"`, `"-inf"`, `"nan"`.
+//!
+//! [`parse_line`] tells each stdout line apart: a valid answer, a malformed one (with its id when
+//! it has one: a bare `nan`, a wrong type, a number out of range, a hit without its fields), a
+//! hello, or stray output; every text it keeps is capped ([`MAX_ERROR_FIELD_BYTES`],
+//! [`MAX_QUOTE_CHARS`]), so a line costs bounded memory whatever the candidate writes.
+//! [`Hello::check`] accepts protocol 1 and the [`KNOWN_SHAPES`] only.
 
 use serde::{Deserialize, Serialize};
 
@@ -180,6 +186,56 @@ impl Answer {
     }
 }
 
+/// Longest text kept of each field of a candidate's error (type, message, traceback), on the
+/// harness's side: what the candidate sends beyond it is cut ([`crate::escape::truncate`]).
+pub const MAX_ERROR_FIELD_BYTES: usize = 4096;
+
+/// Longest quotation of a line that is not a valid answer (a protocol error's evidence).
+pub const MAX_QUOTE_CHARS: usize = 200;
+
+/// The shapes the protocol knows, as named in a hello.
+pub const KNOWN_SHAPES: [&str; 3] = ["sphere", "quad", "triangle"];
+
+impl CandidateError {
+    /// The error with each field cut to [`MAX_ERROR_FIELD_BYTES`].
+    pub fn capped(self) -> Self {
+        self.capped_to(MAX_ERROR_FIELD_BYTES)
+    }
+
+    /// The error with each field cut to `max` bytes.
+    pub fn capped_to(self, max: usize) -> Self {
+        let cut = |s: String| {
+            if s.len() <= max {
+                s
+            } else {
+                crate::escape::truncate(&s, max)
+            }
+        };
+        CandidateError {
+            kind: cut(self.kind),
+            message: cut(self.message),
+            traceback: cut(self.traceback),
+        }
+    }
+
+    /// Bytes of text the error holds.
+    pub fn text_len(&self) -> usize {
+        self.kind.len() + self.message.len() + self.traceback.len()
+    }
+}
+
+/// `s` quoted for a report: at most [`MAX_QUOTE_CHARS`] characters (with `...` when cut), in
+/// Rust string syntax, so control characters show as escapes.
+pub fn quote_line(s: &str) -> String {
+    let q: String = s.chars().take(MAX_QUOTE_CHARS).collect();
+    let cut = q.len() < s.len();
+    let mut q = format!("{q:?}");
+    if cut {
+        q.push_str("...");
+    }
+    q
+}
+
 /// An answer line: the id and the answer (fields spelled out: `flatten` is slow).
 #[derive(Debug, Deserialize)]
 struct AnswerLine {
@@ -208,7 +264,7 @@ impl AnswerLine {
                 point: self.point,
                 normal: self.normal,
                 front_face: self.front_face,
-                error: self.error,
+                error: self.error.map(CandidateError::capped),
             },
         )
     }
@@ -217,44 +273,119 @@ impl AnswerLine {
 /// What one stdout line turned out to be.
 #[derive(Debug, PartialEq)]
 pub enum ParsedLine {
-    /// An answer, with any junk that preceded it on the same line (a `print` without newline).
+    /// A valid answer, with any junk that preceded it on the same line (a `print` without
+    /// newline).
     Answer {
         /// The id the answer carries.
         id: String,
-        /// The answer.
+        /// The answer (well formed: [`Answer::validate`] holds; error fields capped).
         answer: Answer,
-        /// Text before the answer on the same line (empty when the line was clean).
+        /// Text before the answer on the same line, quoted ([`quote_line`]); empty when the
+        /// line was clean.
         junk: String,
     },
-    /// Not an answer.
+    /// A line meant as an answer that is not a valid one: not JSON (a bare `nan`), a field of
+    /// the wrong type (`"hit":"true"`), a number out of range (`1e999`), a hit without a normal. `id` is the id it carries, when one can be read from it.
+    Malformed {
+        /// The id, when the line names one.
+        id: Option<String>,
+        /// What is wrong, in words.
+        problem: String,
+        /// The line, quoted and capped ([`quote_line`]).
+        quoted: String,
+    },
+    /// A hello answer.
+    Hello(Hello),
+    /// A line that looks like a hello but is not a valid one.
+    BadHello(String),
+    /// Not an answer: stray output, quoted and capped ([`quote_line`]).
     Junk(String),
 }
 
-/// Parses one stdout line. A line that is not an answer but contains one after some junk (a
-/// stray `print(..., end="")`) yields the answer and the junk.
-pub fn parse_answer_line(line: &str) -> ParsedLine {
-    let trimmed = line.trim_end_matches(['\r', '\n']);
-    if let Ok(a) = serde_json::from_str::<AnswerLine>(trimmed) {
-        let (id, answer) = a.split();
-        return ParsedLine::Answer {
-            id,
-            answer,
-            junk: String::new(),
-        };
+/// Keys of an answer object.
+const ANSWER_KEYS: [&str; 7] = ["id", "hit", "t", "point", "normal", "front_face", "error"];
+
+/// Reads `"id":"..."` out of text that is not valid JSON (a bare `nan` further on).
+fn lenient_id(text: &str) -> Option<String> {
+    let rest = &text[text.find("\"id\"")? + 4..];
+    let rest = rest.trim_start().strip_prefix(':')?.trim_start();
+    let rest = rest.strip_prefix('"')?;
+    let end = rest.find(['"', '\\'])?;
+    Some(rest[..end].to_string())
+}
+
+fn malformed(id: Option<String>, problem: String, line: &str) -> ParsedLine {
+    ParsedLine::Malformed {
+        id,
+        problem,
+        quoted: quote_line(line),
     }
-    if let Some(pos) = trimmed.find("{\"id\"") {
-        if pos > 0 {
-            if let Ok(a) = serde_json::from_str::<AnswerLine>(&trimmed[pos..]) {
-                let (id, answer) = a.split();
-                return ParsedLine::Answer {
-                    id,
-                    answer,
-                    junk: trimmed[..pos].to_string(),
-                };
+}
+
+/// Parses one stdout line: an answer, a malformed answer, a hello, or junk. A line that is
+/// not an answer but contains one after some junk (a stray `print(..., end="")`) yields the
+/// answer and the junk. Every text kept from the line is capped, so what a line costs in memory
+/// is bounded whatever the candidate writes.
+pub fn parse_line(line: &str) -> ParsedLine {
+    let trimmed = line.trim_end_matches(['\r', '\n']);
+    // The fast path: a clean answer.
+    if let Ok(a) = serde_json::from_str::<AnswerLine>(trimmed) {
+        return answer_or_malformed(a, "", trimmed);
+    }
+    let (prefix, object) = if trimmed.trim_start().starts_with('{') {
+        ("", trimmed.trim_start())
+    } else if let Some(pos) = trimmed.find("{\"id\"") {
+        (&trimmed[..pos], &trimmed[pos..])
+    } else {
+        return ParsedLine::Junk(quote_line(trimmed));
+    };
+    match serde_json::from_str::<serde_json::Value>(object) {
+        Ok(serde_json::Value::Object(map)) => {
+            if !map.contains_key("id") {
+                if map.contains_key("name") || map.contains_key("protocol") {
+                    return match Hello::from_value(serde_json::Value::Object(map)) {
+                        Ok(hello) => ParsedLine::Hello(hello),
+                        Err(problem) => ParsedLine::BadHello(problem),
+                    };
+                }
+                if ANSWER_KEYS.iter().any(|k| map.contains_key(*k)) {
+                    return malformed(None, "an answer without an \"id\"".into(), trimmed);
+                }
+                return ParsedLine::Junk(quote_line(trimmed));
+            }
+            let Some(id) = map.get("id").and_then(|v| v.as_str()).map(str::to_string) else {
+                return malformed(None, "its \"id\" is not a string".into(), trimmed);
+            };
+            match serde_json::from_value::<AnswerLine>(serde_json::Value::Object(map)) {
+                Ok(a) => answer_or_malformed(a, prefix, trimmed),
+                Err(e) => malformed(Some(id), format!("not a valid answer: {e}"), trimmed),
             }
         }
+        Ok(_) => ParsedLine::Junk(quote_line(trimmed)),
+        Err(e) => match lenient_id(object) {
+            Some(id) => malformed(Some(id), format!("not valid JSON: {e}"), trimmed),
+            None if object.starts_with("{\"id\"") => {
+                malformed(None, format!("not valid JSON: {e}"), trimmed)
+            }
+            None => ParsedLine::Junk(quote_line(trimmed)),
+        },
     }
-    ParsedLine::Junk(trimmed.to_string())
+}
+
+fn answer_or_malformed(a: AnswerLine, junk: &str, line: &str) -> ParsedLine {
+    let (id, answer) = a.split();
+    match answer.validate() {
+        Ok(()) => ParsedLine::Answer {
+            id,
+            answer,
+            junk: if junk.is_empty() {
+                String::new()
+            } else {
+                quote_line(junk)
+            },
+        },
+        Err(problem) => malformed(Some(id), problem, line),
+    }
 }
 
 /// The candidate's answer to the hello.
@@ -276,14 +407,60 @@ pub struct Hello {
 }
 
 impl Hello {
-    /// Parses a hello answer line; `None` when the line is not one.
+    /// Parses a hello answer line; `None` when the line is not one (or not a valid one).
     pub fn parse(line: &str) -> Option<Hello> {
-        let value: serde_json::Value = serde_json::from_str(line.trim()).ok()?;
-        let obj = value.as_object()?;
-        if obj.contains_key("id") || !(obj.contains_key("name") || obj.contains_key("protocol")) {
-            return None;
+        match parse_line(line) {
+            ParsedLine::Hello(h) => Some(h),
+            _ => None,
         }
-        serde_json::from_value(value).ok()
+    }
+
+    /// A hello from a JSON object (no `id`, a `name` or a `protocol`); `Err` says what is wrong
+    /// with its fields. Text fields are capped.
+    fn from_value(value: serde_json::Value) -> Result<Hello, String> {
+        let mut hello: Hello =
+            serde_json::from_value(value).map_err(|e| format!("its hello is malformed: {e}"))?;
+        if hello.name.len() > MAX_QUOTE_CHARS {
+            hello.name = crate::escape::truncate(&hello.name, MAX_QUOTE_CHARS);
+        }
+        hello.error = hello.error.map(CandidateError::capped);
+        if let Some(shapes) = &mut hello.shapes {
+            shapes.truncate(16);
+            for s in shapes.iter_mut() {
+                if s.len() > 40 {
+                    *s = crate::escape::truncate(s, 40);
+                }
+            }
+        }
+        Ok(hello)
+    }
+
+    /// `Ok` when the hello can be accepted: protocol version [`PROTOCOL_VERSION`] and only known
+    /// shape names; otherwise one line saying what is wrong.
+    pub fn check(&self) -> Result<(), String> {
+        match self.protocol {
+            Some(PROTOCOL_VERSION) => {}
+            Some(v) => {
+                return Err(format!(
+                    "its hello says \"protocol\": {v}, but rtoracle speaks protocol {PROTOCOL_VERSION}"
+                ));
+            }
+            None => {
+                return Err(format!(
+                    "its hello has no \"protocol\" (rtoracle speaks protocol {PROTOCOL_VERSION}: answer {{\"protocol\":{PROTOCOL_VERSION},...}})"
+                ));
+            }
+        }
+        if let Some(shapes) = &self.shapes {
+            if let Some(bad) = shapes.iter().find(|s| !KNOWN_SHAPES.contains(&s.as_str())) {
+                return Err(format!(
+                    "its hello names an unknown shape {}; the known shapes are {}",
+                    quote_line(bad),
+                    KNOWN_SHAPES.join(", ")
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Whether the candidate supports `kind`.
@@ -303,7 +480,7 @@ mod tests {
     fn answers_parse_with_and_without_junk() {
         let line =
             r#"{"id":"v1","hit":true,"t":4.0,"point":[0,0,1],"normal":[0,0,1],"front_face":true}"#;
-        match parse_answer_line(line) {
+        match parse_line(line) {
             ParsedLine::Answer { id, answer, junk } => {
                 assert_eq!(id, "v1");
                 assert_eq!(answer.t, Some(4.0));
@@ -312,21 +489,120 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
-        match parse_answer_line(&format!("debug 1 2{line}")) {
-            ParsedLine::Answer { junk, .. } => assert_eq!(junk, "debug 1 2"),
+        match parse_line(&format!("debug 1 2{line}")) {
+            ParsedLine::Answer { junk, .. } => assert_eq!(junk, "\"debug 1 2\""),
             other => panic!("{other:?}"),
         }
         assert_eq!(
-            parse_answer_line("hello world"),
-            ParsedLine::Junk("hello world".into())
+            parse_line("hello world"),
+            ParsedLine::Junk("\"hello world\"".into())
         );
+        // A dict printed by the submission is stray output, not an answer.
+        assert!(matches!(parse_line("{'a': 1}"), ParsedLine::Junk(_)));
+        assert!(matches!(parse_line(r#"{"a": 1}"#), ParsedLine::Junk(_)));
         // Non-finite numbers as strings.
-        match parse_answer_line(
-            r#"{"id":"x","hit":true,"t":"nan","normal":[0,0,1],"front_face":false}"#,
-        ) {
+        match parse_line(r#"{"id":"x","hit":true,"t":"nan","normal":[0,0,1],"front_face":false}"#) {
             ParsedLine::Answer { answer, .. } => assert!(answer.t.unwrap().is_nan()),
             other => panic!("{other:?}"),
         }
+    }
+
+    /// Each way an answer line can be wrong is a malformed answer, with the id when it has one.
+    #[test]
+    fn malformed_lines_are_told_apart_from_junk_and_keep_their_id() {
+        let cases = [
+            // printf("%.17g") of a NaN: not JSON.
+            (
+                r#"{"id":"v1","hit":true,"t":nan,"normal":[0,0,1],"front_face":true}"#,
+                Some("v1"),
+                "not valid JSON",
+            ),
+            (
+                r#"{"id":"v2","hit":"true"}"#,
+                Some("v2"),
+                "not a valid answer",
+            ),
+            (
+                r#"{"id":"v3","hit":true,"t":1e999,"normal":[0,0,1],"front_face":true}"#,
+                Some("v3"),
+                "number out of range",
+            ),
+            (
+                r#"{"id":"v4","hit":true,"t":1.0}"#,
+                Some("v4"),
+                "lacks normal, front_face",
+            ),
+            (r#"{"id":"v5"}"#, Some("v5"), "neither"),
+            (r#"{"hit":false}"#, None, "without an \"id\""),
+            (r#"{"id":7,"hit":false}"#, None, "not a string"),
+            (r#"{"id":"v8","hit":fals"#, Some("v8"), "not valid JSON"),
+        ];
+        for (line, want_id, want_problem) in cases {
+            match parse_line(line) {
+                ParsedLine::Malformed {
+                    id,
+                    problem,
+                    quoted,
+                } => {
+                    assert_eq!(id.as_deref(), want_id, "{line}");
+                    assert!(problem.contains(want_problem), "{line}: {problem}");
+                    assert!(quoted.starts_with('"') && quoted.len() <= 2 * line.len() + 2);
+                }
+                other => panic!("{line}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn what_is_kept_of_a_line_is_capped() {
+        let big = "m".repeat(300_000);
+        let line =
+            format!(r#"{{"id":"v","error":{{"type":"E","message":"{big}","traceback":"{big}"}}}}"#);
+        match parse_line(&line) {
+            ParsedLine::Answer { answer, .. } => {
+                let e = answer.error.unwrap();
+                assert!(
+                    e.message.len() < MAX_ERROR_FIELD_BYTES + 40,
+                    "{}",
+                    e.message.len()
+                );
+                assert!(e.traceback.len() < MAX_ERROR_FIELD_BYTES + 40);
+                assert!(e.message.ends_with("more bytes]"));
+            }
+            other => panic!("{other:?}"),
+        }
+        match parse_line(&big) {
+            ParsedLine::Junk(q) => assert!(q.len() <= MAX_QUOTE_CHARS + 5),
+            other => panic!("{other:?}"),
+        }
+        let bad = format!(r#"{{"id":"v","hit":tru {big}"#);
+        match parse_line(&bad) {
+            ParsedLine::Malformed { quoted, .. } => {
+                assert!(quoted.len() <= 2 * MAX_QUOTE_CHARS + 5)
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn hellos_are_validated() {
+        let ok = Hello::parse(r#"{"name":"c","protocol":1,"shapes":["sphere","quad"]}"#).unwrap();
+        assert_eq!(ok.check(), Ok(()));
+        let v2 = Hello::parse(r#"{"name":"c","protocol":2}"#).unwrap();
+        assert!(v2.check().unwrap_err().contains("\"protocol\": 2"));
+        let none = Hello::parse(r#"{"name":"c"}"#).unwrap();
+        assert!(none.check().unwrap_err().contains("no \"protocol\""));
+        let typo =
+            Hello::parse(r#"{"name":"c","protocol":1,"shapes":["sphere","quads"]}"#).unwrap();
+        let problem = typo.check().unwrap_err();
+        assert!(
+            problem.contains("\"quads\"") && problem.contains("sphere, quad, triangle"),
+            "{problem}"
+        );
+        assert!(matches!(
+            parse_line(r#"{"name":"c","protocol":"one"}"#),
+            ParsedLine::BadHello(_)
+        ));
     }
 
     #[test]

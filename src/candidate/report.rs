@@ -1,11 +1,25 @@
-//! The check report: counts overall and per shape group, every failure with a reproduction, the
-//! candidate's import error and the end of its stderr; JSON (serde) and text renderings.
+//! The check report: counts overall and per shape group, every failure with what was asked and
+//! what was expected, the candidate's import error and the end of its stderr; JSON (serde) and
+//! text renderings.
 //!
 //! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
 //! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
 //! `errors` counts raised errors, dead processes and protocol errors. `ambiguous` counts the
-//! `ambiguous` and `any` vectors, which are run and reported but never scored; `ambiguous_passed`
-//! counts the `ambiguous` ones answered with the exact answer.
+//! `ambiguous` vectors and `any` the `any` vectors (degenerate or non-finite inputs); both are
+//! run and reported but never scored. `ambiguous_passed` counts the `ambiguous` vectors answered
+//! with the exact answer (so `ambiguous_passed <= ambiguous`).
+//!
+//! What the report promises about text from the candidate: every message, traceback, name and
+//! stderr line was capped by the harness when it was read ([`super::protocol`],
+//! [`super::process`]), and [`CheckReport::to_text`] writes each through
+//! [`crate::escape::terminal_line`] or [`crate::escape::terminal_text`], so nothing a candidate
+//! prints can move the cursor, colour the terminal or fake a line of the report.
+//!
+//! A failure shows the request line as sent and the expected answer in words, which any
+//! adapter author can use; a Python reproduction against the course's API only for the bundled
+//! course adapter. Vectors not run are summarised per shape and reason (`not_run_summary`), not
+//! listed one by one. When every failure is the same error (a submission that cannot be
+//! imported), the text says it once.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -16,6 +30,7 @@ use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_exact_wo
 use super::diagnose::Diagnosis;
 use super::process::Outcome;
 use super::protocol::{Answer, CandidateError};
+use crate::escape::{terminal_line, terminal_text};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
 use crate::sandbox::SandboxFacts;
 
@@ -34,15 +49,20 @@ pub struct Counts {
     pub timeouts: usize,
     /// Definite vectors not run.
     pub not_run: usize,
-    /// `ambiguous` and `any` vectors (not scored).
+    /// `ambiguous` vectors (not scored).
     pub ambiguous: usize,
     /// `ambiguous` vectors answered with the exact answer ([`judge_exact`]).
     pub ambiguous_passed: usize,
+    /// `any` vectors: degenerate or non-finite inputs, where any answer (or an error) is
+    /// accepted (not scored).
+    #[serde(default)]
+    pub any: usize,
 }
 
 impl Counts {
-    fn add(&mut self, verdict: &Verdict) {
+    fn add(&mut self, class: Class, verdict: &Verdict) {
         match verdict {
+            Verdict::NotScored if class == Class::Any => self.any += 1,
             Verdict::NotScored => self.ambiguous += 1,
             Verdict::Pass => {
                 self.total += 1;
@@ -71,7 +91,7 @@ impl Counts {
     }
 }
 
-/// One definite vector that did not pass.
+/// One definite vector that was run and did not pass.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Failure {
     /// The vector's id.
@@ -84,14 +104,31 @@ pub struct Failure {
     pub kind: FailureKind,
     /// The oracle's answer.
     pub expected: Expect,
+    /// The oracle's answer in words (`a hit at t = 4.0 (+- 4.0e-9), normal (0.0, 0.0, 1.0),
+    /// front_face true`).
+    #[serde(default)]
+    pub expected_text: String,
     /// The candidate's answer, when it gave one.
     pub actual: Option<Answer>,
     /// One line saying what went wrong.
     pub message: String,
-    /// A Python snippet that reproduces the case against the course's API.
+    /// A Python snippet that reproduces the case against the course's API (the course adapter
+    /// only; empty for other candidates).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub repro: String,
-    /// The request line, for reproducing it with any adapter.
+    /// The request line, as sent, for reproducing it with any adapter.
     pub request: String,
+}
+
+/// Definite vectors of one shape not run, for one reason.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct NotRunSummary {
+    /// The shape group.
+    pub shape: ShapeKind,
+    /// How many definite vectors.
+    pub count: usize,
+    /// Why they were not run.
+    pub reason: String,
 }
 
 /// The result of checking a candidate against a suite.
@@ -108,8 +145,11 @@ pub struct CheckReport {
     pub counts: Counts,
     /// Counts per shape group (all three groups are always present).
     pub by_shape: BTreeMap<ShapeKind, Counts>,
-    /// Every definite vector that did not pass, in suite order.
+    /// Every definite vector that was run and did not pass, in suite order.
     pub failures: Vec<Failure>,
+    /// The definite vectors not run, per shape and reason, in the order first met.
+    #[serde(default)]
+    pub not_run_summary: Vec<NotRunSummary>,
     /// The error that kept the candidate from answering anything (a submission that cannot be
     /// imported), also reported on every case.
     pub import_error: Option<CandidateError>,
@@ -147,6 +187,9 @@ pub struct RunInfo {
     pub restarts: u32,
     /// The sandbox's facts, for a candidate run as a process.
     pub sandbox: Option<SandboxFacts>,
+    /// Whether the candidate is the course's Python API (through the bundled adapter): its
+    /// failures then carry a Python reproduction.
+    pub course_api: bool,
 }
 
 /// Judges every outcome and builds the report.
@@ -158,32 +201,59 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         .map(|&k| (k, Counts::default()))
         .collect();
     let mut failures = Vec::new();
+    let mut not_run: Vec<NotRunSummary> = Vec::new();
     let winding = decide_winding(cases, outcomes);
     for (case, outcome) in cases.iter().zip(outcomes) {
         let verdict = judge_wound(case, outcome, winding);
+        let class = case.expect.class;
         let group = by_shape.get_mut(&case.shape.kind()).expect("every kind");
-        counts.add(&verdict);
-        group.add(&verdict);
+        counts.add(class, &verdict);
+        group.add(class, &verdict);
         if judge_exact_wound(case, outcome, winding) == Verdict::Pass {
             counts.ambiguous_passed += 1;
             group.ambiguous_passed += 1;
         }
-        if let Verdict::Fail { kind, message } = verdict {
-            let actual = match outcome {
-                Outcome::Answered { answer, .. } => Some(answer.clone()),
-                _ => None,
-            };
-            failures.push(Failure {
-                id: case.id.clone(),
-                shape: case.shape.kind(),
-                tags: case.expect.tags.clone(),
-                kind,
-                expected: case.expect.clone(),
-                actual,
+        match verdict {
+            Verdict::Fail {
+                kind: FailureKind::NotRun,
                 message,
-                repro: python_repro(case),
-                request: super::protocol::Request::for_case(case).to_line(),
-            });
+            } => {
+                let shape = case.shape.kind();
+                match not_run
+                    .iter_mut()
+                    .find(|s| s.shape == shape && s.reason == message)
+                {
+                    Some(s) => s.count += 1,
+                    None => not_run.push(NotRunSummary {
+                        shape,
+                        count: 1,
+                        reason: message,
+                    }),
+                }
+            }
+            Verdict::Fail { kind, message } => {
+                let actual = match outcome {
+                    Outcome::Answered { answer, .. } => Some(answer.clone()),
+                    _ => None,
+                };
+                failures.push(Failure {
+                    id: case.id.clone(),
+                    shape: case.shape.kind(),
+                    tags: case.expect.tags.clone(),
+                    kind,
+                    expected: case.expect.clone(),
+                    expected_text: expected_in_words(&case.expect),
+                    actual,
+                    message,
+                    repro: if info.course_api {
+                        python_repro(case)
+                    } else {
+                        String::new()
+                    },
+                    request: super::protocol::Request::for_case(case).to_line(),
+                });
+            }
+            _ => {}
         }
     }
     CheckReport {
@@ -192,6 +262,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         counts,
         by_shape,
         failures,
+        not_run_summary: not_run,
         import_error: info.import_error,
         start_failure: info.start_failure,
         stderr_tail: info.stderr_tail,
@@ -199,6 +270,47 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         sandbox: info.sandbox,
         triangle_winding: winding,
         diagnosis: super::diagnose::diagnose(cases, outcomes, winding),
+    }
+}
+
+/// A float as Rust prints it (shortest round trip), `inf`, `-inf` or `nan`.
+fn num(x: f64) -> String {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf".into() } else { "-inf".into() }
+    } else {
+        format!("{x:?}")
+    }
+}
+
+/// The expected answer of a vector in words, for any language.
+pub fn expected_in_words(e: &Expect) -> String {
+    match e.class {
+        Class::Miss => "a miss".to_string(),
+        Class::Hit => {
+            let mut s = String::from("a hit");
+            if let Some(t) = e.t {
+                s.push_str(&format!(" at t = {}", num(t)));
+                if let Some(tol) = e.t_tol {
+                    s.push_str(&format!(" (+- {tol:.1e})"));
+                }
+            }
+            if let Some(n) = e.normal {
+                s.push_str(&format!(
+                    ", normal ({}, {}, {}) (unit, facing the ray)",
+                    num(n[0]),
+                    num(n[1]),
+                    num(n[2])
+                ));
+            }
+            if let Some(f) = e.front_face {
+                s.push_str(&format!(", front_face {f}"));
+            }
+            s
+        }
+        Class::Ambiguous => "ambiguous (not scored)".to_string(),
+        Class::Any => "anything (not scored)".to_string(),
     }
 }
 
@@ -214,34 +326,60 @@ impl CheckReport {
         serde_json::to_string_pretty(self).expect("a report always serialises")
     }
 
-    /// A summary table and the first `max_failures` failures with their reproductions.
+    /// A summary table and the first `max_failures` failures, each with its request and
+    /// expected answer (or its Python reproduction for the course adapter). Every text from
+    /// the candidate is escaped for the terminal.
     pub fn to_text(&self, max_failures: usize) -> String {
         let mut s = String::new();
-        let _ = writeln!(s, "candidate: {}", self.candidate);
+        let _ = writeln!(s, "candidate: {}", terminal_line(&self.candidate));
         if let Some(j) = &self.judged_by {
             let _ = writeln!(s, "judged by: {j}");
         }
         if let Some(e) = &self.import_error {
-            let _ = writeln!(s, "the submission could not be imported: {e}");
+            let _ = writeln!(
+                s,
+                "the submission could not be imported: {}",
+                terminal_line(&e.to_string())
+            );
             if !e.traceback.is_empty() {
-                for line in e.traceback.trim_end().lines() {
+                for line in terminal_text(e.traceback.trim_end()).lines() {
                     let _ = writeln!(s, "    {line}");
                 }
             }
         }
         if let Some(f) = &self.start_failure {
-            let _ = writeln!(s, "the candidate could not be started: {f}");
+            let _ = writeln!(
+                s,
+                "the candidate could not be started: {}",
+                terminal_line(f)
+            );
         }
         let _ = writeln!(
             s,
-            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10}",
-            "shape", "total", "passed", "failed", "errors", "timeouts", "not_run", "ambiguous"
+            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
+            "shape",
+            "total",
+            "passed",
+            "failed",
+            "errors",
+            "timeouts",
+            "not_run",
+            "ambiguous",
+            "any"
         );
         let row = |s: &mut String, name: &str, c: &Counts| {
             let _ = writeln!(
                 s,
-                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10}",
-                name, c.total, c.passed, c.failed, c.errors, c.timeouts, c.not_run, c.ambiguous
+                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
+                name,
+                c.total,
+                c.passed,
+                c.failed,
+                c.errors,
+                c.timeouts,
+                c.not_run,
+                c.ambiguous,
+                c.any
             );
         };
         for (kind, c) in &self.by_shape {
@@ -270,48 +408,47 @@ impl CheckReport {
             let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
         }
         if let Some(note) = self.sandbox.as_ref().and_then(|f| f.note.as_ref()) {
-            let _ = writeln!(s, "sandbox: {note}");
+            let _ = writeln!(s, "sandbox: {}", terminal_line(note));
         }
-        // Vectors not run: one line per reason.
-        let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();
-        for f in self
-            .failures
-            .iter()
-            .filter(|f| f.kind == FailureKind::NotRun)
+        // Vectors not run: one line per shape and reason.
+        for n in &self.not_run_summary {
+            let _ = writeln!(
+                s,
+                "not run: {} {} vectors: {}",
+                n.count,
+                n.shape,
+                terminal_line(&n.reason)
+            );
+        }
+        let shown = &self.failures;
+        if shown.is_empty() {
+        } else if shown.len() > 1
+            && shown
+                .iter()
+                .all(|f| f.kind == shown[0].kind && f.message == shown[0].message)
         {
-            *reasons.entry(f.message.as_str()).or_default() += 1;
-        }
-        for (reason, n) in reasons {
-            let _ = writeln!(s, "not run: {n} vectors: {reason}");
-        }
-        let shown: Vec<&Failure> = self
-            .failures
-            .iter()
-            .filter(|f| f.kind != FailureKind::NotRun)
-            .collect();
-        if !shown.is_empty() {
+            // One cause for all (an import error): said once, with one example.
+            let f = &shown[0];
+            let _ = writeln!(
+                s,
+                "\nall {} failures are the same: [{}] {}",
+                shown.len(),
+                f.kind.name(),
+                terminal_line(&f.message)
+            );
+            if max_failures > 0 && self.import_error.is_none() {
+                let _ = writeln!(s, "for example {} ({}):", terminal_line(&f.id), f.shape);
+                self.write_case(&mut s, f);
+            }
+        } else {
             let _ = writeln!(
                 s,
                 "\nfirst {} of {} failures:",
                 shown.len().min(max_failures),
                 shown.len()
             );
-            for f in shown.into_iter().take(max_failures) {
-                let _ = writeln!(
-                    s,
-                    "\n[{}] {} ({}): {}",
-                    f.kind.name(),
-                    f.id,
-                    f.shape,
-                    f.message
-                );
-                if !f.tags.is_empty() {
-                    let _ = writeln!(s, "  tags: {}", f.tags.join(", "));
-                }
-                let _ = writeln!(s, "  reproduce (run in the submission folder):");
-                for line in f.repro.lines() {
-                    let _ = writeln!(s, "    {line}");
-                }
+            for f in shown.iter().take(max_failures) {
+                self.write_failure(&mut s, f);
             }
         }
         let tail = self.stderr_tail.trim_end();
@@ -325,10 +462,38 @@ impl CheckReport {
                 .into_iter()
                 .rev()
             {
-                let _ = writeln!(s, "    {line}");
+                let _ = writeln!(s, "    {}", terminal_line(line));
             }
         }
         s
+    }
+
+    fn write_failure(&self, s: &mut String, f: &Failure) {
+        let _ = writeln!(
+            s,
+            "\n[{}] {} ({}): {}",
+            f.kind.name(),
+            terminal_line(&f.id),
+            f.shape,
+            terminal_line(&f.message)
+        );
+        self.write_case(s, f);
+    }
+
+    /// A failure's tags and how to reproduce it.
+    fn write_case(&self, s: &mut String, f: &Failure) {
+        if !f.tags.is_empty() {
+            let _ = writeln!(s, "  tags: {}", terminal_line(&f.tags.join(", ")));
+        }
+        if f.repro.is_empty() {
+            let _ = writeln!(s, "  request: {}", terminal_line(&f.request));
+            let _ = writeln!(s, "  expected: {}", f.expected_text);
+        } else {
+            let _ = writeln!(s, "  reproduce (run in the submission folder):");
+            for line in f.repro.lines() {
+                let _ = writeln!(s, "    {}", terminal_line(line));
+            }
+        }
     }
 }
 
@@ -454,7 +619,16 @@ mod tests {
         assert_eq!((c.total, c.passed, c.timeouts, c.not_run), (5, 3, 1, 1));
         assert_eq!(report.by_shape[&ShapeKind::Sphere].timeouts, 1);
         assert_eq!(report.by_shape[&ShapeKind::Quad].not_run, 1);
-        assert_eq!(report.failures.len(), 2);
+        // Failures list what ran; what did not is summarised per shape and reason.
+        assert_eq!(report.failures.len(), 1);
+        assert_eq!(
+            report.not_run_summary,
+            [NotRunSummary {
+                shape: ShapeKind::Quad,
+                count: 1,
+                reason: "r".into()
+            }]
+        );
         let json: serde_json::Value = serde_json::from_str(&report.to_json()).unwrap();
         for key in [
             "total",
@@ -469,7 +643,68 @@ mod tests {
             assert!(json["by_shape"]["triangle"][key].is_u64(), "{key}");
         }
         assert_eq!(json["failures"][0]["kind"], "timeout");
-        assert_eq!(json["failures"][1]["kind"], "not_run");
+        assert_eq!(json["not_run_summary"][0]["count"], 1);
+        // Not the course adapter: no Python, but the request and the expected answer.
+        assert!(json["failures"][0].get("repro").is_none());
+        assert!(
+            json["failures"][0]["request"]
+                .as_str()
+                .unwrap()
+                .starts_with("{\"id\":")
+        );
+        let text = report.to_text(5);
+        assert!(text.contains("  request: {\"id\":") && text.contains("  expected: a "));
+        assert!(!text.contains("RT_object"), "{text}");
+    }
+
+    #[test]
+    fn any_is_counted_apart_from_ambiguous() {
+        let mut cases = crate::candidate::test_cases::basic_cases();
+        cases[0].expect.class = Class::Any;
+        cases[1].expect.class = Class::Ambiguous;
+        cases[1].expect.t = None;
+        // Every case answered with a miss: the ambiguous one (a miss exactly) passes exactly;
+        // the `any` one is not counted as ambiguous, passed or not.
+        let outcomes: Vec<Outcome> = cases
+            .iter()
+            .map(|_| Outcome::Answered {
+                answer: Answer::miss(),
+                junk: vec![],
+            })
+            .collect();
+        let r = build_report(&cases, &outcomes, RunInfo::default());
+        assert_eq!(
+            (r.counts.any, r.counts.ambiguous, r.counts.ambiguous_passed),
+            (1, 1, 1)
+        );
+        assert_eq!(r.counts.total, cases.len() - 2);
+    }
+
+    #[test]
+    fn one_error_on_every_case_is_said_once_and_candidate_text_is_escaped() {
+        let cases = crate::candidate::test_cases::basic_cases();
+        let error = Answer::error("SyntaxError", "bad\x1b[31m input");
+        let outcomes: Vec<Outcome> = cases
+            .iter()
+            .map(|_| Outcome::Answered {
+                answer: error.clone(),
+                junk: vec![],
+            })
+            .collect();
+        let info = RunInfo {
+            candidate: "evil\nverdict: PASS".into(),
+            course_api: true,
+            ..RunInfo::default()
+        };
+        let text = build_report(&cases, &outcomes, info).to_text(10);
+        assert_eq!(text.matches("raised SyntaxError").count(), 1, "{text}");
+        assert_eq!(text.matches("reproduce").count(), 1, "{text}");
+        assert!(text.contains(&format!("all {} failures are the same", cases.len())));
+        assert!(
+            !text.contains('\x1b') && text.contains("\\x1b[31m"),
+            "{text}"
+        );
+        assert!(!text.contains("\nverdict: PASS"), "{text}");
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! same kind of failure. Candidates for one number are tried as one batch, so a shrink costs
 //! a few dozen round trips.
 
+#[cfg(doc)]
 use super::check::FailureKind;
 use super::generate::oracle_expect_with;
 use crate::oracle::Judging;
@@ -100,21 +101,22 @@ fn with_numbers(case: &Case, v: &[f64], judging: Judging) -> Option<Case> {
 }
 
 /// Shrinks `case`, which fails with `kind`. `fails` runs a batch of cases and says, for each,
-/// how it fails (`None` when it passes). At most `budget` cases are tried.
-pub fn shrink(
+/// how it fails (`None` when it passes), in any classification of failures `K` (the report's
+/// [`FailureKind`], or the fuzzer's finer one). At most `budget` cases are tried.
+pub fn shrink<K: PartialEq>(
     case: &Case,
-    kind: FailureKind,
-    fails: &mut dyn FnMut(&[Case]) -> Vec<Option<FailureKind>>,
+    kind: K,
+    fails: &mut dyn FnMut(&[Case]) -> Vec<Option<K>>,
     budget: usize,
 ) -> Case {
     shrink_with(case, kind, fails, budget, Judging::COURSE)
 }
 
 /// [`shrink`], keeping only cases that are definite under `judging`.
-pub fn shrink_with(
+pub fn shrink_with<K: PartialEq>(
     case: &Case,
-    kind: FailureKind,
-    fails: &mut dyn FnMut(&[Case]) -> Vec<Option<FailureKind>>,
+    kind: K,
+    fails: &mut dyn FnMut(&[Case]) -> Vec<Option<K>>,
     budget: usize,
     judging: Judging,
 ) -> Case {
@@ -146,7 +148,7 @@ pub fn shrink_with(
             }
             tried += options.len();
             let verdicts = fails(&options);
-            if let Some(pos) = verdicts.iter().position(|k| *k == Some(kind)) {
+            if let Some(pos) = verdicts.iter().position(|k| k.as_ref() == Some(&kind)) {
                 best = options.swap_remove(pos);
                 changed = true;
             }
@@ -161,6 +163,7 @@ pub fn shrink_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::candidate::check::FailureKind;
     use crate::oracle::vectors::Class;
 
     #[test]

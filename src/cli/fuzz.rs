@@ -10,6 +10,15 @@ use rtoracle::candidate::fuzz::{FuzzOptions, fuzz};
 use rtoracle::candidate::{RunOptions, Session};
 use rtoracle::oracle::vectors::ShapeKind;
 
+/// Cases run when neither `--cases` nor `--time` is given.
+const DEFAULT_CASES: usize = 10_000;
+
+/// Longest `--time`: a week.
+const MAX_TIME_SECS: f64 = 7.0 * 24.0 * 3600.0;
+
+/// Shortest `--time`: a millisecond (one round is always run).
+const MIN_TIME_SECS: f64 = 1e-3;
+
 /// `rtoracle fuzz`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -17,13 +26,15 @@ pub struct Args {
     target: super::check::Target,
     #[command(flatten)]
     judging: super::check::JudgingArgs,
-    /// How many random cases to run.
-    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::count)]
-    cases: usize,
+    /// How many random cases to run (default 10000 when --time is not given; with both,
+    /// whichever comes first).
+    #[arg(long, value_name = "N", value_parser = super::num::count)]
+    cases: Option<usize>,
     /// Seed of the generator.
     #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
-    /// Stop after this many seconds (checked between rounds of 1000 cases).
+    /// Run for this many seconds (checked between rounds of 1000 cases; shrinking what was
+    /// found takes at most 5 s more).
     #[arg(long, value_name = "SECS", value_parser = super::num::seconds)]
     time: Option<f64>,
     /// Time allowed per case, in milliseconds.
@@ -33,19 +44,35 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     /// Also write the minimal failing cases to this vector file (JSON lines), for
-    /// `rtoracle check --vectors`.
+    /// `rtoracle check --vectors`; nothing is written when nothing fails.
     #[arg(long, value_name = "FILE")]
     save: Option<std::path::PathBuf>,
 }
 
+/// `--time` as a duration, or why it cannot be one.
+fn time_limit(secs: Option<f64>) -> anyhow::Result<Option<Duration>> {
+    match secs {
+        None => Ok(None),
+        Some(s) if s.is_finite() && (MIN_TIME_SECS..=MAX_TIME_SECS).contains(&s) => {
+            Ok(Some(Duration::from_secs_f64(s)))
+        }
+        Some(s) => anyhow::bail!(
+            "--time {s:?}: give a number of seconds from {MIN_TIME_SECS} to {MAX_TIME_SECS} (a week)"
+        ),
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.timeout_ms == 0 {
-        anyhow::bail!("--timeout-ms must be positive");
+        anyhow::bail!("--timeout-ms 0: the limit must be at least 1 ms");
     }
-    let time = match args.time {
-        None => None,
-        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
-        Some(s) => anyhow::bail!("--time must be a positive number of seconds, not {s}"),
+    if args.cases == Some(0) {
+        anyhow::bail!("--cases 0: at least one case is needed");
+    }
+    let time = time_limit(args.time)?;
+    let cases = match (args.cases, time) {
+        (None, None) => Some(DEFAULT_CASES),
+        (cases, _) => cases,
     };
     args.target.check()?;
     if let Some(path) = &args.save {
@@ -57,7 +84,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let mut session = Session::start(args.target.command()?, options).context("fuzz")?;
     if let Some(e) = &session.hello().error {
-        errln!("rtoracle: the submission cannot be imported: {e}");
+        errln!(
+            "rtoracle: the submission cannot be imported: {}",
+            rtoracle::escape::terminal_line(&e.to_string())
+        );
     }
     let kinds: Vec<ShapeKind> = ShapeKind::ALL
         .into_iter()
@@ -68,22 +98,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let fuzz_options = FuzzOptions {
         kinds,
-        cases: args.cases,
+        cases,
         seed: args.seed,
         time,
         judging: args.judging.judging(args.target.default_profile()),
+        course_api: session.command().is_course_adapter(),
         ..FuzzOptions::default()
     };
     // Progress on stderr when it is a terminal: cases run (shrinking included).
     let progress = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::with_draw_target(
-            Some(fuzz_options.cases as u64),
+            fuzz_options.cases.map(|n| n as u64),
             ProgressDrawTarget::stderr(),
         );
-        bar.set_style(
-            ProgressStyle::with_template("fuzzing {bar:40} {pos}/{len} cases, {elapsed}")
-                .expect("a valid progress template"),
-        );
+        let template = if fuzz_options.cases.is_some() {
+            "fuzzing {bar:40} {pos}/{len} cases, {elapsed}"
+        } else {
+            "fuzzing {pos} cases, {elapsed}"
+        };
+        bar.set_style(ProgressStyle::with_template(template).expect("a valid progress template"));
         bar
     } else {
         ProgressBar::hidden()
@@ -99,12 +132,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     .context("fuzz")?;
     progress.finish_and_clear();
     if let Some(path) = &args.save {
-        let text: String = report
-            .failures
-            .iter()
-            .map(|f| f.minimal.to_json_line() + "\n")
-            .collect();
-        rtoracle::image_io::write_atomically(path, text.as_bytes())?;
+        if report.failures.is_empty() {
+            errln!(
+                "rtoracle: nothing failed, so {} was not written",
+                path.display()
+            );
+        } else {
+            let text: String = report
+                .failures
+                .iter()
+                .map(|f| f.minimal.to_json_line() + "\n")
+                .collect();
+            rtoracle::image_io::write_atomically(path, text.as_bytes())?;
+        }
     }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?)?;
@@ -116,4 +156,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         super::FAILED
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_limits_outside_a_millisecond_to_a_week_are_refused() {
+        for bad in [1e308, 1e-300, f64::NAN, f64::INFINITY, 0.0, -1.0, 1e6] {
+            let err = time_limit(Some(bad)).unwrap_err().to_string();
+            assert!(err.starts_with("--time "), "{err}");
+        }
+        assert_eq!(time_limit(Some(6.0)).unwrap(), Some(Duration::from_secs(6)));
+        assert_eq!(time_limit(None).unwrap(), None);
+    }
 }

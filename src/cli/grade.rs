@@ -116,6 +116,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
         python: args.python.clone(),
+        time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
         ..Default::default()
     };
     // Said once the grading is done, so bad input stays one line on stderr.
@@ -144,7 +145,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.out.join("gradebook.csv").display()
         );
         if let Some(w) = public_seed {
-            eprintln!("{w}");
+            errln!("{w}");
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -174,7 +175,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         args.out.display()
     );
     if let Some(w) = public_seed {
-        eprintln!("{w}");
+        errln!("{w}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -38,6 +38,9 @@ pub struct CourseCodeChecker {
     pub import_timeout: Duration,
     /// After this many timeouts in a group, the rest of the group is not run.
     pub max_timeouts_per_group: u32,
+    /// Wall time for all of a submission's code checks (the rubric's
+    /// `code_time_budget_seconds`); past it the rest is not run. `None`: no limit.
+    pub time_budget: Option<Duration>,
     /// The sandbox's limits.
     pub policy: SandboxPolicy,
     /// The interpreter (default: `$RTORACLE_PYTHON`, else `/usr/bin/python3` or
@@ -53,6 +56,7 @@ impl Default for CourseCodeChecker {
             case_timeout: Duration::from_secs(2),
             import_timeout: Duration::from_secs(5),
             max_timeouts_per_group: 3,
+            time_budget: Some(Duration::from_secs(60)),
             policy: SandboxPolicy::grading(),
             python: None,
         }
@@ -102,6 +106,7 @@ impl CourseCodeChecker {
             hello_timeout: self.import_timeout,
             max_timeouts_per_group: self.max_timeouts_per_group,
             limits: self.policy.clone(),
+            budget: self.time_budget,
             ..RunOptions::default()
         }
     }

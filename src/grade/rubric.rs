@@ -4,6 +4,7 @@
 //! ```toml
 //! name = "week04"
 //! seed = 0                       # seed of the vector suite
+//! code_time_budget_seconds = 60  # wall time for all of a submission's code checks
 //!
 //! [[group]]
 //! id = "sphere"                  # check ids start with the group id
@@ -36,6 +37,7 @@ use crate::oracle::vectors::ShapeKind;
 pub const WEEK04_RUBRIC: &str = r#"# The built-in week-4 rubric: 100 points.
 name = "week04"
 seed = 0
+code_time_budget_seconds = 60 # wall time for all of a submission's code checks
 
 [[group]]
 id = "sphere"
@@ -150,6 +152,10 @@ pub struct Rubric {
     /// The seed of the vector suite.
     #[serde(default)]
     pub seed: u64,
+    /// Wall time allowed for all of a submission's code checks (start-up and every vector):
+    /// past it the vectors not yet answered are `not_run`, and the grade of the rest stands.
+    #[serde(default = "default_code_time_budget")]
+    pub code_time_budget_seconds: f64,
     /// The groups, in report order.
     #[serde(rename = "group")]
     pub groups: Vec<Group>,
@@ -159,6 +165,10 @@ pub struct Rubric {
     /// SHA-256 (hex) of the TOML text it was read from.
     #[serde(skip)]
     pub sha256: String,
+}
+
+fn default_code_time_budget() -> f64 {
+    60.0
 }
 
 /// Why a rubric cannot be used (one line, naming the file).
@@ -237,6 +247,12 @@ impl Rubric {
         };
         if self.groups.is_empty() {
             return Err(invalid("the rubric has no [[group]]".into()));
+        }
+        let budget = self.code_time_budget_seconds;
+        if !(budget.is_finite() && budget > 0.0 && budget <= 86_400.0) {
+            return Err(invalid(format!(
+                "code_time_budget_seconds = {budget}: it must be more than 0 and at most 86400"
+            )));
         }
         let mut ids = BTreeSet::new();
         for g in &self.groups {

@@ -8,5 +8,6 @@ mod golden;
 mod grade;
 mod oracle;
 mod oracle_props;
+mod protocol;
 mod readme;
 mod render;

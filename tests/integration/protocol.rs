@@ -1,0 +1,413 @@
+//! The strict adapter protocol, the harness's own caps and the time budget, against the small
+//! misbehaving adapter of tests/fixtures/adapters/misbehaving.py (it answers "miss" to
+//! everything, so on a run of definite misses every case it does not spoil passes).
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use rtoracle::candidate::generate::random_cases;
+use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
+use rtoracle::oracle::vectors::{Case, Class, ShapeKind};
+
+use crate::common::*;
+
+/// `/usr/bin/python3` when it exists (it is what CI installs), else `python3`.
+fn python() -> &'static str {
+    if Path::new("/usr/bin/python3").is_file() {
+        "/usr/bin/python3"
+    } else {
+        "python3"
+    }
+}
+
+fn python_ok() -> bool {
+    let ok = std::process::Command::new(python())
+        .args(["-c", "pass"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !ok {
+        eprintln!("skipped: python3 is not available");
+    }
+    ok
+}
+
+fn adapter_line(args: &str) -> String {
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/adapters/misbehaving.py");
+    format!("{} -I {} {args}", python(), script.display())
+}
+
+fn adapter(args: &str) -> CandidateCommand {
+    CandidateCommand::adapter(&adapter_line(args)).unwrap()
+}
+
+/// 60 definite misses (spheres and quads).
+fn misses() -> Vec<Case> {
+    random_cases(11, 0, 600, &[ShapeKind::Sphere, ShapeKind::Quad])
+        .into_iter()
+        .filter(|c| c.expect.class == Class::Miss)
+        .take(60)
+        .collect()
+}
+
+fn options() -> RunOptions {
+    RunOptions {
+        timeout: Duration::from_millis(1500),
+        hello_timeout: Duration::from_secs(5),
+        ..RunOptions::default()
+    }
+}
+
+/// Runs `mode` spoiling the answer to case 20 of [`misses`]; returns the report and the cases.
+fn spoil(mode: &str) -> (CheckReport, Vec<Case>, Duration) {
+    let cases = misses();
+    let start = Instant::now();
+    let report = check_command(
+        adapter(&format!("{mode} {}", cases[20].id)),
+        &cases,
+        options(),
+    )
+    .unwrap();
+    (report, cases, start.elapsed())
+}
+
+/// The common evidence: exactly the cases `blamed` fail, each as a protocol error, at once (no
+/// timeout, no restart), and every other case passes.
+fn assert_protocol_errors(mode: &str, blamed: &[usize], needle: &str) {
+    let (r, cases, took) = spoil(mode);
+    let failed: Vec<(&str, FailureKind)> =
+        r.failures.iter().map(|f| (f.id.as_str(), f.kind)).collect();
+    let want: Vec<(&str, FailureKind)> = blamed
+        .iter()
+        .map(|&i| (cases[i].id.as_str(), FailureKind::Protocol))
+        .collect();
+    assert_eq!(failed, want, "{mode}:\n{}", r.to_text(5));
+    assert_eq!(r.counts.timeouts, 0, "{mode}");
+    assert_eq!(r.restarts, 0, "{mode}");
+    assert_eq!(r.counts.passed, cases.len() - blamed.len(), "{mode}");
+    assert!(
+        r.failures[0].message.contains(needle),
+        "{mode}: {}",
+        r.failures[0].message
+    );
+    // Decided when the line came, not after a timeout of 1.5 s.
+    assert!(took < Duration::from_millis(1400), "{mode} took {took:?}");
+}
+
+#[test]
+fn an_answer_with_another_id_is_a_protocol_error_of_its_case_only() {
+    if python_ok() {
+        assert_protocol_errors("other-id", &[20], "\"no-such-request\"");
+    }
+}
+
+#[test]
+fn a_missing_answer_is_blamed_on_its_case_when_the_next_answer_comes() {
+    if python_ok() {
+        assert_protocol_errors("skip", &[20], "answers come in request order");
+    }
+}
+
+#[test]
+fn a_duplicate_answer_is_a_protocol_error_of_the_case_it_arrives_during() {
+    // The second answer for case 20 arrives while case 21 waits: 21 is charged, and still gets
+    // its own answer, so nothing after it shifts.
+    if python_ok() {
+        assert_protocol_errors("duplicate", &[21], "a second answer for");
+    }
+}
+
+#[test]
+fn a_string_where_a_bool_belongs_is_a_protocol_error() {
+    if python_ok() {
+        assert_protocol_errors("hit-string", &[20], "invalid type: string \"true\"");
+    }
+}
+
+#[test]
+fn a_bare_nan_is_a_protocol_error() {
+    if python_ok() {
+        assert_protocol_errors("bare-nan", &[20], "not valid JSON");
+    }
+}
+
+#[test]
+fn a_hit_without_its_fields_is_a_protocol_error() {
+    if python_ok() {
+        assert_protocol_errors("missing", &[20], "lacks normal, front_face");
+    }
+}
+
+#[test]
+fn a_non_finite_number_written_as_a_number_is_a_protocol_error() {
+    if python_ok() {
+        assert_protocol_errors("overflow", &[20], "number out of range");
+    }
+}
+
+#[test]
+fn an_oversize_line_is_a_protocol_error() {
+    if python_ok() {
+        assert_protocol_errors("oversize", &[20], "longer than 1 MiB");
+    }
+}
+
+#[test]
+fn a_bare_nan_adapter_gets_protocol_errors_on_the_default_suite_in_seconds() {
+    if !python_ok() {
+        return;
+    }
+    let start = Instant::now();
+    let out = rtoracle()
+        .args([
+            "check",
+            "--adapter",
+            &adapter_line("bare-nan '*'"),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    assert!(took < Duration::from_secs(15), "took {took:?}");
+    assert_eq!(out.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["timeouts"], 0);
+    assert_eq!(json["restarts"], 0);
+    // Every definite sphere and quad vector is a protocol error (triangles are not run).
+    for shape in ["sphere", "quad"] {
+        let g = &json["by_shape"][shape];
+        assert!(g["total"].as_u64().unwrap() > 500);
+        assert_eq!(g["errors"], g["total"], "{shape}");
+    }
+    let failures = json["failures"].as_array().unwrap();
+    assert!(failures.iter().all(|f| f["kind"] == "protocol"));
+}
+
+#[test]
+fn hellos_with_another_version_no_version_or_an_unknown_shape_exit_2() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    for (mode, needle) in [
+        ("hello-v2", "\"protocol\": 2"),
+        ("hello-none", "no \"protocol\""),
+        (
+            "hello-quads",
+            "unknown shape \"quads\"; the known shapes are sphere, quad, triangle",
+        ),
+    ] {
+        let out = run_in(tmp.path(), &["check", "--adapter", &adapter_line(mode)]);
+        assert_bad_input(&out, needle);
+        let out = run_in(
+            tmp.path(),
+            &["fuzz", "--adapter", &adapter_line(mode), "--cases", "10"],
+        );
+        assert_bad_input(&out, needle);
+    }
+}
+
+/// Peak resident memory of this process, in KiB (VmHWM), where /proc has it.
+fn peak_rss_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+#[test]
+fn huge_messages_are_capped_by_the_harness() {
+    if !python_ok() {
+        return;
+    }
+    // 300 KB of message and 300 KB of traceback on each of 600 definite cases: 360 MB sent.
+    let cases: Vec<Case> = random_cases(12, 0, 700, &[ShapeKind::Sphere, ShapeKind::Quad])
+        .into_iter()
+        .filter(|c| c.expect.class.is_definite())
+        .take(600)
+        .collect();
+    assert_eq!(cases.len(), 600);
+    let r = check_command(adapter("huge-error '*'"), &cases, options()).unwrap();
+    assert_eq!(r.counts.errors, 600, "{}", r.to_text(1));
+    let json = r.to_json();
+    // Uncapped, the report would hold the 600 messages at least once: 180 MB.
+    assert!(json.len() < 4_000_000, "report of {} bytes", json.len());
+    for f in &r.failures {
+        let e = f.actual.as_ref().unwrap().error.as_ref().unwrap();
+        assert!(e.message.len() <= 4096 + 40 && e.traceback.len() <= 4096 + 40);
+    }
+    if let Some(kib) = peak_rss_kib() {
+        eprintln!("peak RSS of the test process: {kib} KiB");
+    }
+}
+
+#[test]
+fn past_the_time_budget_the_rest_is_not_run_and_the_report_says_why() {
+    if !python_ok() {
+        return;
+    }
+    let cases = misses();
+    // Each answer takes 0.3 s, under the 1.5 s case timeout; the budget allows about 5.
+    let options = RunOptions {
+        budget: Some(Duration::from_millis(1500)),
+        ..options()
+    };
+    let start = Instant::now();
+    let r = check_command(adapter("slow '*' 0.3"), &cases, options).unwrap();
+    let took = start.elapsed();
+    assert!(took < Duration::from_secs(4), "took {took:?}");
+    let c = r.counts;
+    assert!(c.passed >= 1 && c.passed <= 5, "{}", r.to_text(3));
+    assert_eq!(c.not_run, cases.len() - c.passed);
+    assert_eq!((c.timeouts, c.errors, c.failed), (0, 0, 0));
+    let text = r.to_text(3);
+    assert!(
+        text.contains("the submission's 1.5 s budget for code checks was used up"),
+        "{text}"
+    );
+}
+
+#[test]
+fn fuzz_refuses_bounds_that_run_nothing_or_never_end() {
+    let tmp = tempfile::tempdir().unwrap();
+    let target = ["fuzz", "--adapter", "cat"];
+    for (extra, needle) in [
+        (&["--cases", "0"][..], "--cases 0"),
+        (&["--time=1e308"], "--time 1e308"),
+        (&["--time=1e-300"], "--time 1e-300"),
+        (&["--time", "nan"], "--time NaN"),
+        (&["--time", "0"], "--time 0.0"),
+    ] {
+        let args: Vec<&str> = target.iter().chain(extra).copied().collect();
+        let out = run_in(tmp.path(), &args);
+        assert_bad_input(&out, needle);
+    }
+}
+
+#[test]
+fn fuzz_by_time_runs_for_the_time_and_shows_every_kind() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    // Answers "miss" to everything: every definite hit is a missed hit.
+    let start = Instant::now();
+    let out = run_in(
+        tmp.path(),
+        &[
+            "fuzz",
+            "--adapter",
+            &adapter_line("none"),
+            "--time",
+            "2",
+            "--save",
+            "found.jsonl",
+        ],
+    );
+    let took = start.elapsed();
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(took >= Duration::from_secs(2), "{took:?}");
+    assert!(took < Duration::from_secs(2 + 5 + 4), "{took:?}");
+    // More than one round of 1000: the time bounded the run.
+    let run: usize = text.split_whitespace().next().unwrap().parse().unwrap();
+    assert!(run > 1000, "{text}");
+    assert!(text.contains("[missed hit]") && text.contains("(sphere)") && text.contains("(quad)"));
+    // An adapter's report speaks of requests, not of the course's Python.
+    assert!(!text.contains("RT_object"), "{text}");
+    let saved = std::fs::read_to_string(tmp.path().join("found.jsonl")).unwrap();
+    assert_eq!(saved.lines().count(), 2, "{saved}");
+}
+
+#[test]
+fn fuzz_save_with_nothing_failing_writes_nothing() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    // The misbehaving adapter only fails hits; `--cases 1` draws one case, a hit or a miss:
+    // the first seed that draws a miss makes a run where nothing fails.
+    for seed in 0..40 {
+        let seed = seed.to_string();
+        let out = run_in(
+            tmp.path(),
+            &[
+                "fuzz",
+                "--adapter",
+                &adapter_line("none"),
+                "--cases",
+                "1",
+                "--seed",
+                &seed,
+                "--save",
+                "found.jsonl",
+            ],
+        );
+        if out.status.code() == Some(0) {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(stderr.contains("nothing failed, so found.jsonl was not written"));
+            assert!(!tmp.path().join("found.jsonl").exists());
+            return;
+        }
+    }
+    panic!("no seed drew a miss");
+}
+
+#[test]
+fn a_closed_stdout_ends_check_quietly() {
+    if !python_ok() {
+        return;
+    }
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    for extra in [&["--show", "3000"][..], &["--json"]] {
+        let mut child = rtoracle()
+            .args(["check", "--adapter", &adapter_line("bare-nan '*'")])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        // The reader is gone (as with `| head -1`).
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!first.is_empty());
+        assert_eq!(out.status.code(), Some(1), "{extra:?}: {stderr}");
+        assert!(stderr.is_empty(), "{extra:?}: {stderr}");
+    }
+}
+
+#[test]
+fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
+    if !python_ok() {
+        return;
+    }
+    use rtoracle::grade::{CodeChecker, CourseCodeChecker};
+    // Hangs on every miss: with a 2 s case timeout and 3 timeouts per group it would cost 12 s
+    // and more; a 3 s budget stops it there.
+    let dir = rtoracle::candidate::bench::assemble_fixture("hostile_hang_on_miss").unwrap();
+    let checker = CourseCodeChecker {
+        time_budget: Some(Duration::from_secs(3)),
+        ..CourseCodeChecker::default()
+    };
+    let start = Instant::now();
+    let out = checker.check(dir.path(), &[ShapeKind::Sphere, ShapeKind::Quad]);
+    let took = start.elapsed();
+    assert!(took < Duration::from_secs(6), "took {took:?}");
+    let spheres = &out.per_group[&ShapeKind::Sphere];
+    let quads = &out.per_group[&ShapeKind::Quad];
+    // What ran before the budget was used up keeps its marks.
+    assert!(spheres.passed > 0, "{spheres:?}");
+    assert!(quads.not_run > 0, "{quads:?}");
+    assert!(
+        out.failures
+            .iter()
+            .any(|f| f.message.contains("3 s budget for code checks was used up")),
+        "{:?}",
+        out.failures.iter().map(|f| &f.message).collect::<Vec<_>>()
+    );
+}
