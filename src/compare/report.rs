@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use super::heatmap::heatmap_image;
 use super::{CandidateImage, CompareError, Comparison, Encoding, Golden};
+use crate::escape::html;
 use crate::image_io::{ImageError, Rgb8Image, write_atomically, write_png};
 
 /// How many regions get crops.
@@ -73,12 +74,6 @@ fn side_by_side(
     }
 }
 
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-}
-
 fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
     let mut h = String::new();
     let verdict = if c.passed() { "PASS" } else { "FAIL" };
@@ -96,17 +91,13 @@ fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
         scene = c
             .scene
             .as_ref()
-            .map(|s| format!(" ({})", html_escape(s)))
+            .map(|s| format!(" ({})", html(s)))
             .unwrap_or_default(),
-        enc = c.encoding,
+        enc = html(&c.encoding),
         alpha = c.alpha
     );
     if let Some(d) = &c.diagnosis {
-        let _ = writeln!(
-            h,
-            "<h2>Diagnosis</h2><p><b>{}</b></p>",
-            html_escape(&d.summary)
-        );
+        let _ = writeln!(h, "<h2>Diagnosis</h2><p><b>{}</b></p>", html(&d.summary));
     }
     h.push_str("<h2>Scales</h2><table><tr><th>scale</th><th>tests</th><th>smallest adjusted p</th><th>threshold</th><th>largest |z|</th><th>failing</th></tr>\n");
     for s in &c.scales {
