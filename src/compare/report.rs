@@ -131,9 +131,93 @@ fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
     h
 }
 
-/// Writes the report folder. When `dir` does not exist it is built beside it under a temporary
-/// name and renamed into place, so it appears whole or not at all; when it exists each file is
-/// written atomically.
+/// Whether `name` is a file of a compare report folder.
+fn is_report_file(name: &str) -> bool {
+    matches!(name, "report.json" | "heatmap.png" | "index.html")
+        || name
+            .strip_prefix("region-")
+            .and_then(|n| n.strip_suffix(".png"))
+            .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Checks, before any work, that `dir` may be replaced by a fresh report folder: missing, or a
+/// folder holding only a compare report's files (so no file of the user's is removed).
+pub fn check_report_dir(dir: &Path) -> Result<(), CompareError> {
+    let bad = |message: String| CompareError::Input {
+        path: dir.to_path_buf(),
+        message,
+    };
+    match std::fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(bad(format!("cannot be read ({})", e.kind()))),
+        Ok(m) if !m.is_dir() => Err(bad("exists and is not a folder".into())),
+        Ok(_) => {
+            let entries = std::fs::read_dir(dir)
+                .map_err(|e| bad(format!("cannot be read ({})", e.kind())))?;
+            for e in entries.flatten() {
+                let name = e.file_name().to_string_lossy().to_string();
+                let file = e.file_type().map(|t| t.is_file()).unwrap_or(false);
+                if !(file && is_report_file(&name)) {
+                    return Err(bad(format!(
+                        "holds {}, which is not part of a compare report; the folder is replaced whole, so choose an empty or new one",
+                        crate::escape::terminal_line(&name)
+                    )));
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Puts the finished folder `tmp` where `dest` is, whole: a missing `dest` is a rename; an
+/// existing one is exchanged atomically with `renameat2`'s `RENAME_EXCHANGE` and the old one
+/// removed (with `tmp`), so no file of an earlier run survives. Where the exchange is not
+/// available, the old folder is renamed aside first and removed after.
+pub fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> std::io::Result<()> {
+    use std::os::unix::ffi::OsStrExt;
+    if std::fs::symlink_metadata(dest).is_err() {
+        let path = tmp.keep();
+        return std::fs::rename(&path, dest).inspect_err(|_| {
+            let _ = std::fs::remove_dir_all(&path);
+        });
+    }
+    let c =
+        |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(std::io::Error::other);
+    let (a, b) = (c(tmp.path())?, c(dest)?);
+    // SAFETY: two valid NUL-terminated paths; renameat2 only reads them.
+    let rc = unsafe {
+        libc::renameat2(
+            libc::AT_FDCWD,
+            a.as_ptr(),
+            libc::AT_FDCWD,
+            b.as_ptr(),
+            libc::RENAME_EXCHANGE,
+        )
+    };
+    if rc == 0 {
+        // `tmp` now holds the old folder: dropping it removes it.
+        return Ok(());
+    }
+    let old = tmp.path().with_extension("old");
+    std::fs::rename(dest, &old)?;
+    let path = tmp.keep();
+    match std::fs::rename(&path, dest) {
+        Ok(()) => {
+            let _ = std::fs::remove_dir_all(&old);
+            Ok(())
+        }
+        Err(e) => {
+            let _ = std::fs::rename(&old, dest);
+            let _ = std::fs::remove_dir_all(&path);
+            Err(e)
+        }
+    }
+}
+
+/// Writes the report folder: built beside `dir` under a temporary name (removed on Ctrl-C or
+/// SIGTERM) and swapped in whole, so it appears whole or not at all and nothing of an earlier
+/// report (say a stale `region-7.png`) survives. An existing `dir` must pass
+/// [`check_report_dir`].
 pub fn write_report(
     dir: &Path,
     comparison: &Comparison,
@@ -147,22 +231,17 @@ pub fn write_report(
             message: e.to_string(),
         })
     };
-    let fresh = !dir.exists();
-    let (target, staging): (PathBuf, Option<tempfile::TempDir>) = if fresh {
-        let parent = match dir.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        let tmp = tempfile::Builder::new()
-            .prefix(".rtoracle-report-")
-            .tempdir_in(parent)
-            .map_err(io)?;
-        (tmp.path().to_path_buf(), Some(tmp))
-    } else if dir.is_dir() {
-        (dir.to_path_buf(), None)
-    } else {
-        return Err(io(std::io::Error::other("exists and is not a folder")));
+    check_report_dir(dir)?;
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
     };
+    let tmp = tempfile::Builder::new()
+        .prefix(".rtoracle-report-")
+        .tempdir_in(parent)
+        .map_err(io)?;
+    let _cleanup = crate::interrupt::remove_on_interrupt(tmp.path());
+    let target: PathBuf = tmp.path().to_path_buf();
     write_atomically(&target.join("report.json"), to_json(comparison).as_bytes())?;
     write_png(&target.join("heatmap.png"), &heatmap_image(comparison))?;
     let cand = candidate.to_rgb8(encoding);
@@ -187,12 +266,9 @@ pub fn write_report(
         &target.join("index.html"),
         index_html(comparison, &crops).as_bytes(),
     )?;
-    if let Some(tmp) = staging {
-        let path = tmp.keep();
-        std::fs::rename(&path, dir).map_err(|e| {
-            let _ = std::fs::remove_dir_all(&path);
-            io(e)
-        })?;
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o755));
     }
-    Ok(())
+    swap_in(tmp, dir).map_err(io)
 }

@@ -711,57 +711,16 @@ pub(crate) fn staging_dir(
     Ok((tmp, guard))
 }
 
-/// Puts the finished folder `tmp` where `dest` is, whole: a missing `dest` is a rename; an
-/// existing one (checked by [`check_replaceable`]) is exchanged atomically with `renameat2`'s
-/// `RENAME_EXCHANGE` and the old one removed, so no file of an earlier run survives. The
-/// folder is made readable by everyone (reports are read by other users).
+/// Puts the finished folder `tmp` where `dest` is, whole (see
+/// [`crate::compare::report::swap_in`]), readable by everyone (reports are read by other users).
+/// The one place grading swaps folders, so it can later use a shared output helper.
 pub(crate) fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> Result<(), GradeError> {
-    use std::os::unix::ffi::OsStrExt;
     use std::os::unix::fs::PermissionsExt;
-    let out = |e: std::io::Error| GradeError::Output {
+    let _ = std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755));
+    crate::compare::report::swap_in(tmp, dest).map_err(|e| GradeError::Output {
         path: dest.to_path_buf(),
         message: e.to_string(),
-    };
-    let _ = std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755));
-    if std::fs::symlink_metadata(dest).is_err() {
-        let path = tmp.keep();
-        return std::fs::rename(&path, dest).map_err(|e| {
-            let _ = std::fs::remove_dir_all(&path);
-            out(e)
-        });
-    }
-    let c =
-        |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(std::io::Error::other);
-    let (a, b) = (c(tmp.path()).map_err(out)?, c(dest).map_err(out)?);
-    // SAFETY: two valid NUL-terminated paths; renameat2 only reads them.
-    let rc = unsafe {
-        libc::renameat2(
-            libc::AT_FDCWD,
-            a.as_ptr(),
-            libc::AT_FDCWD,
-            b.as_ptr(),
-            libc::RENAME_EXCHANGE,
-        )
-    };
-    if rc == 0 {
-        // `tmp` now holds the old folder: dropping it removes it.
-        return Ok(());
-    }
-    // No exchange here (an old kernel or file system): move the old folder aside, then rename.
-    let old = tmp.path().with_extension("old");
-    std::fs::rename(dest, &old).map_err(out)?;
-    let path = tmp.keep();
-    match std::fs::rename(&path, dest) {
-        Ok(()) => {
-            let _ = std::fs::remove_dir_all(&old);
-            Ok(())
-        }
-        Err(e) => {
-            let _ = std::fs::rename(&old, dest);
-            let _ = std::fs::remove_dir_all(&path);
-            Err(out(e))
-        }
-    }
+    })
 }
 
 /// Grades into a fresh temporary folder and swaps it in whole as `out_dir` (see [`swap_in`]):
