@@ -302,3 +302,31 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
     }
     md
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ties are shared between shapes: with ten sphere vectors and two quad vectors all failed
+    /// by 3 submissions, the ten listed include both quad ones (alphabetically "quad-" came
+    /// after every "a-sphere-" id and was never listed).
+    #[test]
+    fn most_failed_vectors_take_turns_between_shapes_on_ties() {
+        let mut v = BTreeMap::new();
+        for i in 0..10 {
+            v.insert(
+                format!("a-sphere-{i:02}"),
+                (ShapeKind::Sphere, 3, String::new()),
+            );
+        }
+        for i in 0..2 {
+            v.insert(format!("quad-{i:02}"), (ShapeKind::Quad, 3, String::new()));
+        }
+        v.insert("a-sphere-top".into(), (ShapeKind::Sphere, 5, String::new()));
+        let listed: Vec<String> = most_failed(v, 10).into_iter().map(|r| r.0).collect();
+        assert_eq!(listed[0], "a-sphere-top");
+        assert!(listed.contains(&"quad-00".to_string()), "{listed:?}");
+        assert!(listed.contains(&"quad-01".to_string()), "{listed:?}");
+        assert_eq!(listed.len(), 10);
+    }
+}

@@ -921,6 +921,48 @@ mod tests {
         assert!(c.message.contains("1 of 4 sphere test vectors answered correctly (1 raised an exception, 1 timed out, 1 not run)."), "{}", c.message);
     }
 
+    fn failure(id: &str, kind: FailureKind) -> FailureSummary {
+        FailureSummary {
+            id: id.into(),
+            shape: crate::oracle::vectors::ShapeKind::Sphere,
+            tags: vec![],
+            kind,
+            definite: true,
+            expected: serde_json::Value::Null,
+            actual: serde_json::Value::Null,
+            message: format!("{kind:?}"),
+            repro: String::new(),
+        }
+    }
+
+    #[test]
+    fn the_smallest_failing_case_was_run_and_crashes_are_not_time_outs() {
+        let not_run = failure("a", FailureKind::NotRun);
+        let timeout = failure("b", FailureKind::Timeout);
+        let pair = [not_run.clone(), timeout];
+        assert_eq!(smallest_failure(&pair).unwrap().id, "b");
+        assert!(smallest_failure(&[not_run]).is_none());
+        let sphere = GroupCounts {
+            definite_total: 3,
+            passed: 1,
+            crashes: 1,
+            not_run: 1,
+            ..Default::default()
+        };
+        let r = run(
+            &Rubric::week04(),
+            &FakeCode::new(sphere, counts(1, 1)),
+            &all_pass(),
+        );
+        assert!(
+            r.checks[0].message.contains(
+                "1 of 3 sphere test vectors answered correctly (1 crashed Python, 1 not run)."
+            ),
+            "{}",
+            r.checks[0].message
+        );
+    }
+
     #[test]
     fn all_or_nothing_ambiguous_scoring_and_visibility_follow_the_rubric() {
         let text = crate::grade::rubric::WEEK04_RUBRIC
