@@ -372,7 +372,7 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
             0.0,
             CheckStatus::Error,
             if why.starts_with(file.as_str()) {
-                format!("{why}; it scores 0.")
+                format!("{why}. It scores 0.")
             } else {
                 format!("{file} could not be compared and scores 0: {why}.")
             },

@@ -553,6 +553,13 @@ fn fewer_samples_than_claimed_fail_the_noise_check() {
             assert!(!c1.passed() && !n1.passed, "{scene} seed {seed}: {n1:?}");
             assert!(n1.effective_spp.unwrap() < 10.0, "{scene}: {n1:?}");
             let n41 = c41.noise.as_ref().expect("enough noisy pixels");
+            eprintln!(
+                "{scene} seed {seed}: 1 spp as 41: effective {:.2}, p {:.1e}; 41 spp: effective {:.1}, p {:.3}",
+                n1.effective_spp.unwrap(),
+                n1.p,
+                n41.effective_spp.unwrap_or(f64::NAN),
+                n41.p
+            );
             assert!(c41.passed() && n41.passed, "{scene} seed {seed}: {n41:?}");
             assert!(n41.p > 1e3 * n41.threshold, "{scene}: {n41:?}");
         }

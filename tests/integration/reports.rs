@@ -337,13 +337,13 @@ fn a_fifo_or_a_symlink_where_an_image_should_be_scores_0_without_blocking() {
     assert_eq!(sphere["score"], 0.0);
     assert_eq!(
         sphere["message"],
-        "week04_sphere.png is a FIFO, not a regular file; it scores 0."
+        "week04_sphere.png is a FIFO, not a regular file. It scores 0."
     );
     let quad = check("image.week04-quad");
     assert_eq!(quad["score"], 0.0);
     assert_eq!(
         quad["message"],
-        "week04_quad.png is a symbolic link, not a regular file; it scores 0."
+        "week04_quad.png is a symbolic link, not a regular file. It scores 0."
     );
     // The code is graded as usual.
     assert_eq!(check("sphere.intersect")["score"], 30.0);

@@ -52,7 +52,7 @@ pub(crate) fn check_body(c: &CheckResult, repro: bool, quote: fn(&str) -> String
             .then(|| c.failures.first())
             .flatten()
     });
-    let sentence = smallest.map(smallest_case_sentence);
+    let sentence = smallest_failure(&c.failures).map(smallest_case_sentence);
     // The harness's own sentence (counts, the rubric's names, the comparison's words) is kept as
     // it reads; the vector's message it ends with is shown below in a block. A code check that
     // could not run quotes Python in its message: that one is escaped whole.
@@ -66,7 +66,12 @@ pub(crate) fn check_body(c: &CheckResult, repro: bool, quote: fn(&str) -> String
     if let Some(f) = smallest {
         let _ = write!(
             md,
-            "\nThe smallest failing case, `{}`{}, gave:\n\n{}",
+            "\n{}, `{}`{}, gave:\n\n{}",
+            if c.status == CheckStatus::Skipped {
+                "The first case that differs from the exact answer"
+            } else {
+                "The smallest failing case"
+            },
             f.id.replace('`', "'"),
             if f.tags.is_empty() {
                 String::new()
