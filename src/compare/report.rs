@@ -143,6 +143,7 @@ fn is_report_file(name: &str) -> bool {
 /// Checks, before any work, that `dir` may be replaced by a fresh report folder: missing, or a
 /// folder holding only a compare report's files (so no file of the user's is removed).
 pub fn check_report_dir(dir: &Path) -> Result<(), CompareError> {
+    let dir = &resolve_link(dir);
     let bad = |message: String| CompareError::Input {
         path: dir.to_path_buf(),
         message,
@@ -199,7 +200,10 @@ pub fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> std::io::Result<()> {
         return Ok(());
     }
     let old = tmp.path().with_extension("old");
-    std::fs::rename(dest, &old)?;
+    if std::fs::rename(dest, &old).is_err() {
+        // `dest` cannot be renamed (a mount point, say): empty it and copy the new folder in.
+        return copy_into(tmp.path(), dest);
+    }
     let path = tmp.keep();
     match std::fs::rename(&path, dest) {
         Ok(()) => {
@@ -211,6 +215,39 @@ pub fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> std::io::Result<()> {
             let _ = std::fs::remove_dir_all(&path);
             Err(e)
         }
+    }
+}
+
+/// Empties `dest` (already checked to hold only reports) and copies the files of `src`, and of
+/// its folders one level down, into it.
+fn copy_into(src: &Path, dest: &Path) -> std::io::Result<()> {
+    for e in std::fs::read_dir(dest)?.flatten() {
+        if e.file_type()?.is_dir() {
+            std::fs::remove_dir_all(e.path())?;
+        } else {
+            std::fs::remove_file(e.path())?;
+        }
+    }
+    for e in std::fs::read_dir(src)?.flatten() {
+        let to = dest.join(e.file_name());
+        if e.file_type()?.is_dir() {
+            std::fs::create_dir(&to)?;
+            for f in std::fs::read_dir(e.path())?.flatten() {
+                std::fs::copy(f.path(), to.join(f.file_name()))?;
+            }
+        } else {
+            std::fs::copy(e.path(), &to)?;
+        }
+    }
+    Ok(())
+}
+
+/// `path`, or the folder it links to when it is a symbolic link (so swapping a folder in
+/// replaces the folder, not the link).
+pub fn resolve_link(path: &Path) -> PathBuf {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => path.canonicalize().unwrap_or_else(|_| path.into()),
+        _ => path.to_path_buf(),
     }
 }
 
@@ -231,6 +268,7 @@ pub fn write_report(
             message: e.to_string(),
         })
     };
+    let dir = &resolve_link(dir);
     check_report_dir(dir)?;
     let parent = match dir.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
@@ -271,4 +309,77 @@ pub fn write_report(
         let _ = std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o755));
     }
     swap_in(tmp, dir).map_err(io)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn folder_with(parent: &Path, files: &[&str]) -> tempfile::TempDir {
+        let t = tempfile::Builder::new().tempdir_in(parent).unwrap();
+        for f in files {
+            std::fs::write(t.path().join(f), f.as_bytes()).unwrap();
+        }
+        t
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().to_string())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn swapping_in_replaces_the_old_folder_whole_through_a_link_too() {
+        let root = tempfile::tempdir().unwrap();
+        let dest = root.path().join("rep");
+        std::fs::create_dir(&dest).unwrap();
+        std::fs::write(dest.join("region-7.png"), b"stale").unwrap();
+        swap_in(folder_with(root.path(), &["report.json"]), &dest).unwrap();
+        assert_eq!(names(&dest), ["report.json"]);
+        // Only the new folder is left beside it.
+        assert_eq!(names(root.path()), ["rep"]);
+        // Through a symbolic link, the folder it points to is replaced and the link stays.
+        let link = root.path().join("link");
+        std::os::unix::fs::symlink(&dest, &link).unwrap();
+        let target = resolve_link(&link);
+        swap_in(folder_with(root.path(), &["index.html"]), &target).unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(names(&link), ["index.html"]);
+    }
+
+    #[test]
+    fn copying_into_a_folder_that_cannot_be_renamed_leaves_only_the_new_files() {
+        let root = tempfile::tempdir().unwrap();
+        let dest = folder_with(root.path(), &["heatmap.png", "region-3.png"]);
+        let src = folder_with(root.path(), &["report.json"]);
+        std::fs::create_dir(src.path().join("sub")).unwrap();
+        std::fs::write(src.path().join("sub/feedback.md"), b"x").unwrap();
+        copy_into(src.path(), dest.path()).unwrap();
+        assert_eq!(names(dest.path()), ["report.json", "sub"]);
+        assert_eq!(names(&dest.path().join("sub")), ["feedback.md"]);
+    }
+
+    #[test]
+    fn only_a_compare_report_may_be_replaced() {
+        let root = tempfile::tempdir().unwrap();
+        let ok = folder_with(
+            root.path(),
+            &["report.json", "heatmap.png", "region-12.png"],
+        );
+        assert!(check_report_dir(ok.path()).is_ok());
+        assert!(check_report_dir(&root.path().join("new")).is_ok());
+        let mine = folder_with(root.path(), &["report.json", "region-x.png"]);
+        let e = check_report_dir(mine.path()).unwrap_err().to_string();
+        assert!(e.contains("holds region-x.png"), "{e}");
+    }
 }

@@ -58,6 +58,7 @@ pub fn grade_batch(
     if !dir.is_dir() {
         return Err(GradeError::NoSubmission(dir.to_path_buf()));
     }
+    let out = &crate::compare::report::resolve_link(out);
     let subs = submissions(dir, Some(out))?;
     check_replaceable(out)?;
     // Everything is written into a fresh folder beside `out` and swapped in whole at the end.

@@ -737,6 +737,7 @@ pub fn grade_to_dir(
     if !submission.is_dir() {
         return Err(GradeError::NoSubmission(submission.to_path_buf()));
     }
+    let out_dir = &crate::compare::report::resolve_link(out_dir);
     check_replaceable(out_dir)?;
     let (tmp, _guard) = staging_dir(out_dir)?;
     let report = grade_into(submission, rubric, code, images, tmp.path(), formats)?;

@@ -380,3 +380,57 @@ fn a_reused_out_folder_keeps_nothing_stale() {
     assert_bad_input(&run, "notes.txt");
     assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
 }
+
+/// SIGTERM in the middle of a grade exits 143 and leaves neither the report folder nor its
+/// temporary folder (before, a folder with only heatmaps was left).
+#[test]
+fn sigterm_mid_grade_leaves_no_report_folder_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let sub = dir.path().join("sub");
+    rtoracle::grade::bench::materialize("hang", &sub).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtoracle"))
+        .current_dir(dir.path())
+        .args(["grade", "sub", "--out", "out"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // The hanging submission keeps the grade busy for seconds (a 2 s case timeout, twice).
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(20) {
+        let staging = std::fs::read_dir(dir.path()).unwrap().flatten().any(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(".out.rtoracle-")
+        });
+        if staging || child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the grade ended before the signal"
+    );
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            let _ = child.kill();
+            panic!("no exit after SIGTERM");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(143));
+    let left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n != "sub")
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
