@@ -38,11 +38,13 @@ pub struct Args {
     report: Option<PathBuf>,
 }
 
-fn summary(c: &Comparison, candidate: &Path) -> String {
+/// The summary printed without `--json`; `pictures` says whether `--heatmap` or `--report` was
+/// given (a FAIL without them says how to see where it fails).
+fn summary(c: &Comparison, candidate: &Path, pictures: bool) -> String {
     let mut s = format!(
         "{} {}: {}x{}, {} spp against a {} spp golden{}, {} encoding\n",
         if c.passed() { "PASS" } else { "FAIL" },
-        candidate.display(),
+        rtoracle::escape::terminal_line(&candidate.display().to_string()),
         c.width,
         c.height,
         c.candidate_spp,
@@ -74,11 +76,25 @@ fn summary(c: &Comparison, candidate: &Path) -> String {
             r.x, r.y, r.width, r.height, r.scale, r.channel, r.adjusted_p, r.z
         ));
     }
-    if c.regions.len() > 5 {
-        s.push_str(&format!("  ... and {} more regions\n", c.regions.len() - 5));
+    let total = c.regions_total.max(c.regions.len());
+    if total > 5 {
+        s.push_str(&format!("  ... and {} more regions\n", total - 5));
+    }
+    if let Some(n) = c.noise.as_ref().filter(|n| !n.passed) {
+        s.push_str(&format!(
+            "  noise: the pixels differ from the golden as much as a render of about {} spp would, not {} spp (p {:.2e} < {:.0e})\n",
+            n.effective_spp
+                .map_or_else(|| "fewer".to_string(), |e| format!("{e:.1}")),
+            n.claimed_spp,
+            n.p,
+            n.threshold
+        ));
     }
     if let Some(d) = &c.diagnosis {
         s.push_str(&format!("  diagnosis: {}\n", d.summary));
+    }
+    if !c.passed() && !pictures {
+        s.push_str("  to see where: add --heatmap FILE.png (the signed z map) or --report DIR (crops and index.html)\n");
     }
     s
 }
@@ -100,6 +116,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if let Some(r) = &args.report {
         rtoracle::output::check_output_dir(r, "--report")?;
+        report::check_report_dir(r)?;
     }
     // The candidate first: a bad candidate is reported before any golden work.
     let candidate = CandidateImage::load(&args.candidate)?;
@@ -140,7 +157,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         outln!("{}", report::to_json(&comparison))?;
     } else {
-        out!("{}", summary(&comparison, &args.candidate))?;
+        let pictures = args.heatmap.is_some() || args.report.is_some();
+        out!("{}", summary(&comparison, &args.candidate, pictures))?;
     }
     Ok(ExitCode::from(if comparison.passed() { 0 } else { 1 }))
 }

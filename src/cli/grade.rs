@@ -3,6 +3,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
+use rtoracle::escape::terminal_line;
 use rtoracle::grade::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
 use rtoracle::oracle::vectors::read_vectors;
 
@@ -135,8 +136,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let graded = entries.iter().filter(|e| e.result.is_ok()).count();
         for e in &entries {
             match &e.result {
-                Ok(r) => outln!("{}: {} / {}", e.name, r.score, r.max_score)?,
-                Err(msg) => outln!("{}: not graded: {msg}", e.name)?,
+                Ok(r) => outln!("{}: {} / {}", terminal_line(&e.name), r.score, r.max_score)?,
+                Err(msg) => outln!(
+                    "{}: not graded: {}",
+                    terminal_line(&e.name),
+                    terminal_line(msg)
+                )?,
             }
         }
         errln!(
@@ -153,10 +158,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let submission = args.submission.as_ref().expect("clap requires it");
     let report =
         pool.install(|| grade_to_dir(submission, &rubric, &code, &images, &args.out, &formats))?;
-    for c in &report.checks {
+    // Unscored checks are listed only when some ambiguous vector differs (no `0 / 0` rows).
+    for c in report
+        .checks
+        .iter()
+        .filter(|c| c.status != rtoracle::grade::CheckStatus::Skipped || !c.failures.is_empty())
+    {
+        if c.status == rtoracle::grade::CheckStatus::Skipped {
+            outln!("{:<24} {:>15} not scored", terminal_line(&c.id), "")?;
+            continue;
+        }
         outln!(
             "{:<24} {:>6} / {:<6} {}",
-            c.id,
+            terminal_line(&c.id),
             c.score,
             c.max_score,
             c.status.name()
@@ -170,7 +184,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )?;
     errln!(
         "graded {} in {:.2} s; reports in {}",
-        report.submission,
+        terminal_line(&report.submission),
         report.execution_time,
         args.out.display()
     );

@@ -28,7 +28,13 @@ pub fn heatmap_image(comparison: &Comparison) -> Rgb8Image {
             data[3 * (y * w + x)..3 * (y * w + x) + 3].copy_from_slice(&OUTLINE);
         }
     };
-    for r in &comparison.regions {
+    // Every failing region, not only the ones the report lists.
+    let regions = if comparison.outline.len() >= comparison.regions.len() {
+        &comparison.outline
+    } else {
+        &comparison.regions
+    };
+    for r in regions {
         let (x1, y1) = (r.x + r.width - 1, r.y + r.height - 1);
         for x in r.x..=x1 {
             put(x, r.y);

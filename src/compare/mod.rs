@@ -17,7 +17,7 @@ pub mod heatmap;
 pub mod mistakes;
 pub mod report;
 pub mod stats;
-mod verdict;
+pub mod verdict;
 
 use std::path::{Path, PathBuf};
 
@@ -226,6 +226,26 @@ pub struct Region {
     pub z: f64,
 }
 
+/// The noise check: is the candidate no noisier than `N` samples per pixel allow? The squared
+/// differences from the golden over the pixels whose noise shows through the quantisation are
+/// summed and compared with their bound under the claim (Bernstein's inequality; false-failure
+/// bound [`NOISE_ALPHA`](verdict::NOISE_ALPHA)), so a 1-spp image does not pass as 41 spp.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NoiseCheck {
+    /// The samples per pixel claimed (`--spp`).
+    pub claimed_spp: u32,
+    /// The samples per pixel the candidate's noise suggests.
+    pub effective_spp: Option<f64>,
+    /// The pixels (and channels) the check used.
+    pub pixels: usize,
+    /// The p-value of the squared differences under the claim.
+    pub p: f64,
+    /// The threshold.
+    pub threshold: f64,
+    /// Whether `p >= threshold`.
+    pub passed: bool,
+}
+
 /// One alternative hypothesis the diagnosis tried.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HypothesisScore {
@@ -271,8 +291,18 @@ pub struct Comparison {
     pub alpha: f64,
     /// One entry per scale: pixel, tile8, tile32, global.
     pub scales: Vec<ScaleResult>,
-    /// The failing regions, worst first (at most 50).
+    /// The failing regions, worst first (at most 50; `regions_total` says how many there are).
     pub regions: Vec<Region>,
+    /// How many failing regions there are in all.
+    #[serde(default)]
+    pub regions_total: usize,
+    /// Every failing region (the heatmap outlines them all).
+    #[serde(skip)]
+    pub outline: Vec<Region>,
+    /// Whether the candidate is as noisy as its claimed samples per pixel allow (absent when
+    /// too few pixels show their noise through the quantisation).
+    #[serde(default)]
+    pub noise: Option<NoiseCheck>,
     /// Mean of (candidate - golden) per channel, linear, over all pixels (mid-points of the
     /// candidate's intervals).
     pub bias: [f64; 3],

@@ -3,9 +3,16 @@
 
 use super::stats::{bernstein_p, sidak};
 use super::{
-    CandidateImage, CompareOptions, Comparison, Diagnosis, Encoding, Golden, Region, ScaleResult,
-    Verdict,
+    CandidateImage, CompareOptions, Comparison, Diagnosis, Encoding, Golden, NoiseCheck, Region,
+    ScaleResult, Verdict,
 };
+
+/// The false-failure bound of the noise check (on top of the four scales' `alpha`).
+pub const NOISE_ALPHA: f64 = 1e-6;
+/// Fewer noisy pixels than this and neither the effective spp nor the noise check is computed.
+const NOISE_MIN_PIXELS: usize = 100;
+/// Regions the report lists (the heatmap outlines all of them).
+pub const REGIONS_LISTED: usize = 50;
 
 /// The names of the scales, in order.
 pub const SCALES: [&str; 4] = ["pixel", "tile8", "tile32", "global"];
@@ -148,8 +155,10 @@ pub struct Evaluation {
     pub passed: bool,
     /// Per scale.
     pub scales: Vec<ScaleResult>,
-    /// Failing regions, worst first.
+    /// Failing regions, worst first (all of them).
     pub regions: Vec<Region>,
+    /// Whether the candidate is as noisy as `N` samples allow.
+    pub noise: Option<NoiseCheck>,
     /// Signed z per pixel.
     pub z_map: Vec<f32>,
     /// Mean (candidate mid-point - golden) per channel.
@@ -193,11 +202,16 @@ pub fn evaluate(
     let mut bias = [0.0f64; 3];
     let (mut neff_num, mut neff_den, mut neff_count) = (0.0f64, 0.0f64, 0usize);
     let mut misfit = 0.0f64;
+    // The noise check: squared residuals against their bound under the claim of N samples.
+    let (mut sq_sum, mut sq_bound, mut sq_var, mut sq_max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
 
     for y in 0..height {
         for x in 0..width {
             let i = y * width + x;
             let mut best_z = 0.0f64;
+            // A pixel's channels come from the same samples: its terms are summed first, and
+            // the pixels (independent) enter the bound as one term each.
+            let (mut px_sq, mut px_bound, mut px_cap) = (0.0f64, 0.0f64, 0.0f64);
             for c in 0..3 {
                 let mu = golden.mean[i][c];
                 let s2 = golden.variance[i][c];
@@ -256,10 +270,26 @@ pub fn evaluate(
                         neff_num += s2;
                         neff_den += (mid - mu).powi(2) - (hi - lo).powi(2) / 12.0 - s2 / m;
                         neff_count += 1;
+                        // Under the claim, d = mid - mu = (mean - mu) + (mid - mean) with
+                        // E (mean - mu)^2 <= lambda s2_eff / n + s2 / m (the variance the tests
+                        // allow) and |mid - mean| <= w / 2, so E d^2 <= e (Minkowski), and
+                        // |d| <= b + w / 2 + slack, so d^2 <= cap and Var d^2 <= cap e.
+                        let w = hi - lo;
+                        let e = (variance.sqrt() + w / 2.0).powi(2);
+                        let cap = (b + w / 2.0 + slack).powi(2);
+                        px_sq += (mid - mu).powi(2);
+                        px_bound += e;
+                        px_cap += cap;
                     }
                 }
             }
             z_map[i] = best_z as f32;
+            if px_cap > 0.0 {
+                sq_sum += px_sq;
+                sq_bound += px_bound;
+                sq_var += px_cap * px_bound;
+                sq_max = sq_max.max(px_cap);
+            }
         }
     }
 
@@ -353,15 +383,38 @@ pub fn evaluate(
     if let (true, Some(w)) = (regions.is_empty(), g_worst) {
         regions.push(region(0, 0, width, height, w));
     }
-    let passed = scales.iter().all(|s| s.failing == 0);
+    let effective_spp =
+        (neff_count >= NOISE_MIN_PIXELS && neff_den > 0.0).then(|| neff_num / neff_den);
+    let noise = (neff_count >= NOISE_MIN_PIXELS).then(|| {
+        // Bernstein's inequality for the sum of the independent squared residuals (bounded by
+        // sq_max, variances summing to at most sq_var) above its bound under the claim.
+        let excess = sq_sum - sq_bound;
+        let p = if excess <= 0.0 {
+            1.0
+        } else {
+            (-excess * excess / (2.0 * sq_var + 2.0 * sq_max * excess / 3.0))
+                .exp()
+                .min(1.0)
+        };
+        NoiseCheck {
+            claimed_spp: options.samples_per_pixel,
+            effective_spp,
+            pixels: neff_count,
+            p,
+            threshold: NOISE_ALPHA,
+            passed: p >= NOISE_ALPHA,
+        }
+    });
+    let passed = scales.iter().all(|s| s.failing == 0) && noise.as_ref().is_none_or(|n| n.passed);
     let pixels = (width * height) as f64;
     Evaluation {
         passed,
         scales,
         regions,
+        noise,
         z_map,
         bias: bias.map(|b| b / pixels),
-        effective_spp: (neff_count >= 100 && neff_den > 0.0).then(|| neff_num / neff_den),
+        effective_spp,
         misfit,
         encoding: iv.encoding,
     }
@@ -381,7 +434,8 @@ fn region(x: usize, y: usize, width: usize, height: usize, w: Worst) -> Region {
 }
 
 /// Connected groups of failing cells (8-connected within 32x32 blocks), as pixel boxes, worst
-/// first, at most 50.
+/// first (all of them: the report lists the first [`REGIONS_LISTED`], the heatmap outlines
+/// every one, so an image wrong all over is outlined all over).
 fn regions_of(
     cells: &[Option<Worst>],
     cx: usize,
@@ -436,7 +490,6 @@ fn regions_of(
             .then(b.z.abs().total_cmp(&a.z.abs()))
             .then((a.y, a.x).cmp(&(b.y, b.x)))
     });
-    out.truncate(50);
     out
 }
 
@@ -450,6 +503,8 @@ impl Evaluation {
         diagnosis: Option<Diagnosis>,
     ) -> Comparison {
         let (width, height) = candidate.size();
+        let regions_total = self.regions.len();
+        let listed = self.regions.iter().take(REGIONS_LISTED).cloned().collect();
         Comparison {
             verdict: if self.passed {
                 Verdict::Pass
@@ -466,7 +521,10 @@ impl Evaluation {
                 .map_or_else(|| "exr".to_string(), |e| e.name().to_string()),
             alpha: options.alpha,
             scales: self.scales,
-            regions: self.regions,
+            regions: listed,
+            regions_total,
+            outline: self.regions,
+            noise: self.noise,
             bias: self.bias,
             effective_spp: self.effective_spp,
             diagnosis,

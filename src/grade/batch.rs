@@ -11,9 +11,13 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
-use super::inputs::{CodeChecker, ImageChecker};
+use super::inputs::{CodeChecker, FailureKind, ImageChecker};
 use super::rubric::Rubric;
-use super::run::{Format, GradeError, GradeReport, grade_to_dir, round2};
+use super::run::{
+    Format, GradeError, GradeReport, check_replaceable, grade_into, round2, staging_dir, swap_in,
+};
+use crate::escape::{csv_cell, markdown_inline};
+use crate::oracle::vectors::ShapeKind;
 
 /// One submission of a batch.
 #[derive(Debug)]
@@ -54,11 +58,12 @@ pub fn grade_batch(
     if !dir.is_dir() {
         return Err(GradeError::NoSubmission(dir.to_path_buf()));
     }
-    std::fs::create_dir_all(out).map_err(|e| GradeError::Output {
-        path: out.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let out = &crate::compare::report::resolve_link(out);
     let subs = submissions(dir, Some(out))?;
+    check_replaceable(out)?;
+    // Everything is written into a fresh folder beside `out` and swapped in whole at the end.
+    let (tmp, _guard) = staging_dir(out)?;
+    let staging = tmp.path().to_path_buf();
     let bar = if std::io::stderr().is_terminal() {
         let bar =
             ProgressBar::with_draw_target(Some(subs.len() as u64), ProgressDrawTarget::stderr());
@@ -77,9 +82,13 @@ pub fn grade_batch(
                 .file_name()
                 .map(|n| n.to_string_lossy().to_string())
                 .unwrap_or_default();
-            let target = out.join(&name);
+            let target = staging.join(&name);
             let result = catch_unwind(AssertUnwindSafe(|| {
-                grade_to_dir(sub, rubric, code, images, &target, formats)
+                std::fs::create_dir(&target).map_err(|e| GradeError::Output {
+                    path: out.join(&name),
+                    message: e.to_string(),
+                })?;
+                grade_into(sub, rubric, code, images, &target, formats)
             }));
             bar.inc(1);
             let result = match result {
@@ -92,23 +101,17 @@ pub fn grade_batch(
         .collect();
     bar.finish_and_clear();
     let write = |file: &str, text: String| {
-        let path = out.join(file);
-        super::run::write_public(&path, text.as_bytes()).map_err(|e| GradeError::Output {
-            path,
-            message: e.to_string(),
+        super::run::write_public(&staging.join(file), text.as_bytes()).map_err(|e| {
+            GradeError::Output {
+                path: out.join(file),
+                message: e.to_string(),
+            }
         })
     };
     write("gradebook.csv", gradebook_csv(rubric, &entries))?;
     write("summary.md", summary_md(rubric, &entries))?;
+    swap_in(tmp, out)?;
     Ok(entries)
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// `gradebook.csv`: `submission,score,max_score`, one column per rubric group, then `status`.
@@ -116,11 +119,11 @@ pub fn gradebook_csv(rubric: &Rubric, entries: &[BatchEntry]) -> String {
     let mut csv = String::from("submission,score,max_score");
     for g in &rubric.groups {
         csv.push(',');
-        csv.push_str(&csv_field(&g.id));
+        csv.push_str(&csv_cell(&g.id));
     }
     csv.push_str(",status\n");
     for e in entries {
-        csv.push_str(&csv_field(&e.name));
+        csv.push_str(&csv_cell(&e.name));
         match &e.result {
             Ok(r) => {
                 let groups: BTreeMap<String, f64> = r
@@ -128,22 +131,54 @@ pub fn gradebook_csv(rubric: &Rubric, entries: &[BatchEntry]) -> String {
                     .into_iter()
                     .map(|(g, s, _)| (g, s))
                     .collect();
-                let _ = write!(csv, ",{},{}", r.score, r.max_score);
+                let _ = write!(
+                    csv,
+                    ",{},{}",
+                    csv_cell(&r.score.to_string()),
+                    csv_cell(&r.max_score.to_string())
+                );
                 for g in &rubric.groups {
-                    let _ = write!(csv, ",{}", groups.get(&g.id).copied().unwrap_or(0.0));
+                    let points = groups.get(&g.id).copied().unwrap_or(0.0);
+                    let _ = write!(csv, ",{}", csv_cell(&points.to_string()));
                 }
                 csv.push_str(",ok\n");
             }
             Err(msg) => {
-                let _ = write!(csv, ",,{}", rubric.max_score());
+                let _ = write!(csv, ",,{}", csv_cell(&rubric.max_score().to_string()));
                 for _ in &rubric.groups {
                     csv.push(',');
                 }
-                let _ = writeln!(csv, ",{}", csv_field(&format!("error: {msg}")));
+                let _ = writeln!(csv, ",{}", csv_cell(&format!("error: {msg}")));
             }
         }
     }
     csv
+}
+
+/// How many vectors "Most common failures" lists.
+const VECTORS_SHOWN: usize = 10;
+
+/// The `n` vectors failed most often, fairly across shapes: each shape's vectors are ranked by
+/// how many submissions failed them (then by id), and the list takes them by count, then by rank
+/// within their shape, then shape by shape, so a tie never hides a shape behind another's
+/// alphabetically earlier ids.
+fn most_failed(
+    vectors: BTreeMap<String, (ShapeKind, usize, String)>,
+    n: usize,
+) -> Vec<(String, usize, String)> {
+    let mut by_shape: BTreeMap<ShapeKind, Vec<(String, usize, String)>> = BTreeMap::new();
+    for (id, (shape, count, msg)) in vectors {
+        by_shape.entry(shape).or_default().push((id, count, msg));
+    }
+    let mut ranked = Vec::new();
+    for (shape, mut rows) in by_shape {
+        rows.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        for (rank, row) in rows.into_iter().enumerate() {
+            ranked.push((row.1, rank, shape, row));
+        }
+    }
+    ranked.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    ranked.into_iter().take(n).map(|r| r.3).collect()
 }
 
 /// `summary.md`: the score distribution and the most common failures.
@@ -204,7 +239,8 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         }
         // Checks that lost points, and the vectors failed most often.
         let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
-        let mut vectors: BTreeMap<String, (usize, String)> = BTreeMap::new();
+        // Per vector: its shape, how many submissions failed it (having run it), one message.
+        let mut vectors: BTreeMap<String, (ShapeKind, usize, String)> = BTreeMap::new();
         let mut fatal = 0usize;
         for r in &graded {
             if r.code.fatal.is_some() {
@@ -215,11 +251,15 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
                     let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
                     e.1 += 1;
                 }
-                for f in c.failures.iter().filter(|f| f.definite) {
+                for f in c
+                    .failures
+                    .iter()
+                    .filter(|f| f.definite && f.kind != FailureKind::NotRun)
+                {
                     let e = vectors
                         .entry(f.id.clone())
-                        .or_insert((0, f.message.clone()));
-                    e.0 += 1;
+                        .or_insert((f.shape, 0, f.message.clone()));
+                    e.1 += 1;
                 }
             }
         }
@@ -238,11 +278,14 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
             let _ = writeln!(md, "\n{fatal} submission(s) could not be imported.");
         }
         if !vectors.is_empty() {
-            let mut rows: Vec<_> = vectors.into_iter().collect();
-            rows.sort_by(|a, b| b.1.0.cmp(&a.1.0).then(a.0.cmp(&b.0)));
             md.push_str("\n| Vector | Submissions failing it | Example |\n|---|---:|---|\n");
-            for (id, (count, msg)) in rows.into_iter().take(10) {
-                let _ = writeln!(md, "| `{id}` | {count} | {} |", msg.replace('|', "\\|"));
+            for (id, count, msg) in most_failed(vectors, VECTORS_SHOWN) {
+                let _ = writeln!(
+                    md,
+                    "| `{}` | {count} | {} |",
+                    id.replace('`', "'"),
+                    markdown_inline(&msg)
+                );
             }
         }
     }
@@ -253,10 +296,38 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
             let _ = writeln!(
                 md,
                 "- {}: {}",
-                e.name,
-                e.result.as_ref().err().map_or("", |s| s)
+                markdown_inline(&e.name),
+                markdown_inline(e.result.as_ref().err().map_or("", |s| s))
             );
         }
     }
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ties are shared between shapes: with ten sphere vectors and two quad vectors all failed
+    /// by 3 submissions, the ten listed include both quad ones (alphabetically "quad-" came
+    /// after every "a-sphere-" id and was never listed).
+    #[test]
+    fn most_failed_vectors_take_turns_between_shapes_on_ties() {
+        let mut v = BTreeMap::new();
+        for i in 0..10 {
+            v.insert(
+                format!("a-sphere-{i:02}"),
+                (ShapeKind::Sphere, 3, String::new()),
+            );
+        }
+        for i in 0..2 {
+            v.insert(format!("quad-{i:02}"), (ShapeKind::Quad, 3, String::new()));
+        }
+        v.insert("a-sphere-top".into(), (ShapeKind::Sphere, 5, String::new()));
+        let listed: Vec<String> = most_failed(v, 10).into_iter().map(|r| r.0).collect();
+        assert_eq!(listed[0], "a-sphere-top");
+        assert!(listed.contains(&"quad-00".to_string()), "{listed:?}");
+        assert!(listed.contains(&"quad-01".to_string()), "{listed:?}");
+        assert_eq!(listed.len(), 10);
+    }
 }

@@ -120,9 +120,9 @@ fn grade_failure(
     timeout: Duration,
 ) -> (FailureKind, String) {
     match (kind, outcome) {
-        // A dead interpreter is counted with the time-outs: "timed out or crashed Python".
+        // A dead interpreter is an error (counted as a crash), not a time-out.
         (CheckKind::Error, Outcome::Died { .. }) => (
-            FailureKind::Timeout,
+            FailureKind::Error,
             message.replace(
                 "the candidate died on this case",
                 "Python died on this vector",
@@ -281,6 +281,9 @@ impl CodeChecker for CourseCodeChecker {
             };
             if definite {
                 match failure_kind {
+                    FailureKind::Error if matches!(outcome, Outcome::Died { .. }) => {
+                        counts.crashes += 1
+                    }
                     FailureKind::Error => counts.errors += 1,
                     FailureKind::Timeout => counts.timeouts += 1,
                     FailureKind::NotRun => counts.not_run += 1,

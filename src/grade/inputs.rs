@@ -53,8 +53,11 @@ pub struct GroupCounts {
     pub failed: usize,
     /// Definite vectors on which the code raised an exception.
     pub errors: usize,
-    /// Definite vectors on which the code did not answer in time or crashed the interpreter.
+    /// Definite vectors on which the code did not answer in time.
     pub timeouts: usize,
+    /// Definite vectors on which the interpreter died (a crash, `os._exit`, a signal).
+    #[serde(default)]
+    pub crashes: usize,
     /// Definite vectors never run (after too many timeouts, or when the import failed).
     pub not_run: usize,
     /// Ambiguous vectors run (reported, scored only when the rubric says so).

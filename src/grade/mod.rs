@@ -29,6 +29,7 @@ pub mod batch;
 pub mod bench;
 pub mod checkers;
 pub mod inputs;
+pub mod intake;
 pub mod report;
 pub mod rubric;
 mod run;

@@ -11,7 +11,7 @@ use super::inputs::{
     ImageVerdict,
 };
 use super::report;
-use super::rubric::{Group, GroupKind, Rubric, Visibility, sha256_hex};
+use super::rubric::{Group, GroupKind, Rubric, Visibility};
 
 /// How many failing vectors of a group the reports show.
 pub const FAILURES_SHOWN: usize = 5;
@@ -191,13 +191,20 @@ pub enum GradeError {
     Format(String),
 }
 
-/// The failure a student should look at first: one that ran (not a time-out or not run when
-/// another exists), with the fewest edge-case tags, then the shortest reproduction.
+/// The failure a student should look at first: a definite vector that was run and failed (never
+/// one that was not run), an answer before a time-out, with the fewest edge-case tags, then the
+/// shortest reproduction.
 pub fn smallest_failure(failures: &[FailureSummary]) -> Option<&FailureSummary> {
     failures
         .iter()
-        .filter(|f| f.definite)
+        .filter(|f| f.definite && f.kind != FailureKind::NotRun)
         .min_by_key(|f| simplicity(f))
+}
+
+/// The sentence a code check's message ends with when a vector failed (the report writers that
+/// show the case in their own way take it off again).
+pub(crate) fn smallest_case_sentence(f: &FailureSummary) -> String {
+    format!(" Smallest failing case, {}: {}.", f.id, f.message)
 }
 
 /// What makes a failure easy to show a student, smallest first: an answer (not a timeout),
@@ -225,6 +232,8 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
         .failures
         .iter()
         .filter(|f| f.shape == shape && (f.definite || group.score_ambiguous))
+        // A vector that was not run did not fail: the counts say how many were not run.
+        .filter(|f| f.kind != FailureKind::NotRun)
         .cloned()
         .collect();
     failures.sort_by_cached_key(simplicity);
@@ -261,7 +270,8 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
         for (n, what) in [
             (counts.failed, "wrong"),
             (counts.errors, "raised an exception"),
-            (counts.timeouts, "timed out or crashed Python"),
+            (counts.crashes, "crashed Python"),
+            (counts.timeouts, "timed out"),
             (counts.not_run, "not run"),
         ] {
             if n > 0 {
@@ -277,7 +287,7 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
             message.push_str(" This group is all-or-nothing.");
         }
         if let Some(f) = smallest_failure(&failures) {
-            message.push_str(&format!(" Smallest failing case, {}: {}.", f.id, f.message));
+            message.push_str(&smallest_case_sentence(f));
         }
         if let Some(d) = outcome.diagnosis.iter().find(|d| d.shape == shape) {
             message.push_str(&format!(" Diagnosis: {}.", d.sentence()));
@@ -330,7 +340,7 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
             failures: outcome
                 .failures
                 .iter()
-                .filter(|f| f.shape == shape && !f.definite)
+                .filter(|f| f.shape == shape && !f.definite && f.kind != FailureKind::NotRun)
                 .take(FAILURES_SHOWN)
                 .cloned()
                 .collect(),
@@ -376,7 +386,11 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
         ImageVerdict::Unusable(why) => (
             0.0,
             CheckStatus::Error,
-            format!("{file} could not be compared and scores 0: {why}."),
+            if why.starts_with(file.as_str()) {
+                format!("{why}. It scores 0.")
+            } else {
+                format!("{file} could not be compared and scores 0: {why}.")
+            },
         ),
     };
     if let Some(p) = &outcome.heatmap {
@@ -412,21 +426,49 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
     }
 }
 
-fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
-    let mut out = BTreeMap::new();
-    if let Ok(entries) = std::fs::read_dir(dir) {
-        for e in entries.flatten() {
-            if e.file_type().map(|t| t.is_file()).unwrap_or(false) {
-                if let Ok(bytes) = std::fs::read(e.path()) {
-                    out.insert(
-                        e.file_name().to_string_lossy().to_string(),
-                        sha256_hex(&bytes),
-                    );
-                }
-            }
+/// The size the image of `scene` must have, when `scene` is a built-in scene.
+fn expected_size(scene: &str) -> Option<(usize, usize)> {
+    let d = crate::scene::builtin(scene).ok()?;
+    let camera = d.camera(None);
+    Some((camera.width, camera.height))
+}
+
+/// Reads the image of group `g` with care (see [`intake`](super::intake)) into a private copy
+/// and hands the copy to `images`; whatever the checker says names the file relative to the
+/// submission, never by the grader's paths.
+fn check_image(
+    submission: &Path,
+    g: &Group,
+    images: &dyn ImageChecker,
+    out_dir: &Path,
+) -> ImageOutcome {
+    let rel = g.file.as_deref().expect("validated");
+    let scene = g.scene.as_deref().expect("validated");
+    let stage = match tempfile::Builder::new()
+        .prefix(".rtoracle-image-")
+        .tempdir()
+    {
+        Ok(t) => t,
+        Err(e) => {
+            return ImageOutcome::unusable(format!(
+                "{rel} could not be staged for comparison ({})",
+                e.kind()
+            ));
         }
+    };
+    let _cleanup = crate::interrupt::remove_on_interrupt(stage.path());
+    let staged =
+        match super::intake::stage_image(submission, rel, expected_size(scene), stage.path()) {
+            Ok(p) => p,
+            Err(why) => return ImageOutcome::unusable(why),
+        };
+    let mut outcome = images.check(&staged, scene, &out_dir.join(heatmap_name(g)));
+    if let ImageVerdict::Unusable(why) = &mut outcome.verdict {
+        let shown = format!("{}: ", staged.display());
+        *why = why.replace(&shown, &format!("{rel}: "));
+        *why = why.replace(&staged.display().to_string(), rel);
     }
-    out
+    outcome
 }
 
 /// Grades the submission in folder `submission`: runs the code groups through `code` and the
@@ -461,14 +503,7 @@ pub fn grade(
         || {
             image_groups
                 .iter()
-                .map(|g| {
-                    let file = submission.join(g.file.as_deref().expect("validated"));
-                    images.check(
-                        &file,
-                        g.scene.as_deref().expect("validated"),
-                        &out_dir.join(heatmap_name(g)),
-                    )
-                })
+                .map(|g| check_image(submission, g, images, out_dir))
                 .collect::<Vec<_>>()
         },
     );
@@ -522,7 +557,7 @@ pub fn grade(
                 code.vectors_sha256()
             },
             goldens_sha256,
-            submission_sha256: submission_hashes(submission),
+            submission_sha256: super::intake::submission_hashes(submission),
             code_checker: code.describe(),
             image_checker: images.describe(),
         },
@@ -615,7 +650,99 @@ pub fn write_reports(
     Ok(())
 }
 
-/// Makes `out_dir`, grades, and writes the reports: what `rtoracle grade DIR` does.
+/// Whether `name` is a file rtoracle's reports consist of (so an old report folder may be
+/// replaced whole): a report, a heatmap, a batch's gradebook or summary.
+fn is_report_file(name: &str) -> bool {
+    matches!(
+        name,
+        "report.json"
+            | "results.json"
+            | "junit.xml"
+            | "feedback.md"
+            | "gradebook.csv"
+            | "summary.md"
+    ) || (name.starts_with("heatmap-") && name.ends_with(".png"))
+}
+
+/// Checks, before any work, that `out_dir` may be replaced by a fresh report folder: it is
+/// missing, or a folder holding only rtoracle's reports (and, for a batch, folders of them), so
+/// no file of the user's is ever removed.
+pub(crate) fn check_replaceable(out_dir: &Path) -> Result<(), GradeError> {
+    fn walk(dir: &Path, depth: usize) -> Result<(), String> {
+        let entries =
+            std::fs::read_dir(dir).map_err(|e| format!("cannot be read ({})", e.kind()))?;
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            let t = e
+                .file_type()
+                .map_err(|e| format!("cannot be read ({})", e.kind()))?;
+            if t.is_file() && is_report_file(&name) {
+                continue;
+            }
+            if t.is_dir() && depth == 0 {
+                walk(&e.path(), 1)
+                    .map_err(|_| format!("holds {name}, which is not an rtoracle report folder"))?;
+                continue;
+            }
+            return Err(format!("holds {name}, which is not an rtoracle report"));
+        }
+        Ok(())
+    }
+    let fail = |message: String| GradeError::Output {
+        path: out_dir.to_path_buf(),
+        message,
+    };
+    match std::fs::symlink_metadata(out_dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(fail(format!("cannot be read ({})", e.kind()))),
+        Ok(m) if !m.is_dir() => Err(fail("exists and is not a folder".into())),
+        Ok(_) => walk(out_dir, 0).map_err(|why| {
+            fail(format!(
+                "{why}; it is replaced whole, so choose an empty or new folder"
+            ))
+        }),
+    }
+}
+
+/// A fresh temporary folder beside `out_dir` (same file system, so it can be renamed into place),
+/// removed on Ctrl-C or SIGTERM while the guard lives and on drop.
+pub(crate) fn staging_dir(
+    out_dir: &Path,
+) -> Result<(tempfile::TempDir, crate::interrupt::CleanupGuard), GradeError> {
+    let parent = match out_dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let name = out_dir
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".{name}.rtoracle-"))
+        .tempdir_in(parent)
+        .map_err(|e| GradeError::Output {
+            path: out_dir.to_path_buf(),
+            message: format!("cannot make a temporary folder beside it: {e}"),
+        })?;
+    let guard = crate::interrupt::remove_on_interrupt(tmp.path());
+    Ok((tmp, guard))
+}
+
+/// Puts the finished folder `tmp` where `dest` is, whole (see
+/// [`crate::compare::report::swap_in`]), readable by everyone (reports are read by other users).
+/// The one place grading swaps folders, so it can later use a shared output helper.
+pub(crate) fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> Result<(), GradeError> {
+    use std::os::unix::fs::PermissionsExt;
+    let _ = std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755));
+    crate::compare::report::swap_in(tmp, dest).map_err(|e| GradeError::Output {
+        path: dest.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// Grades into a fresh temporary folder and swaps it in whole as `out_dir` (see [`swap_in`]):
+/// what `rtoracle grade DIR --out OUT` does. An existing `out_dir` must hold only rtoracle's
+/// reports (checked before any work); an interruption leaves no temporary folder behind.
 pub fn grade_to_dir(
     submission: &Path,
     rubric: &Rubric,
@@ -627,10 +754,23 @@ pub fn grade_to_dir(
     if !submission.is_dir() {
         return Err(GradeError::NoSubmission(submission.to_path_buf()));
     }
-    std::fs::create_dir_all(out_dir).map_err(|e| GradeError::Output {
-        path: out_dir.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let out_dir = &crate::compare::report::resolve_link(out_dir);
+    check_replaceable(out_dir)?;
+    let (tmp, _guard) = staging_dir(out_dir)?;
+    let report = grade_into(submission, rubric, code, images, tmp.path(), formats)?;
+    swap_in(tmp, out_dir)?;
+    Ok(report)
+}
+
+/// Grades and writes the reports into the existing, empty folder `out_dir`.
+pub(crate) fn grade_into(
+    submission: &Path,
+    rubric: &Rubric,
+    code: &dyn CodeChecker,
+    images: &dyn ImageChecker,
+    out_dir: &Path,
+    formats: &[Format],
+) -> Result<GradeReport, GradeError> {
     let report = grade(submission, rubric, code, images, out_dir)?;
     write_reports(&report, out_dir, formats)?;
     Ok(report)
@@ -719,16 +859,34 @@ pub(crate) mod fakes {
     pub fn all_pass() -> FakeImage {
         FakeImage(BTreeMap::new())
     }
+
+    /// Writes the images of the week-4 rubric into `dir` as PNG headers of the right size (the
+    /// fake checker reads no pixel; grading reads the header before handing the file over).
+    pub fn fake_images(dir: &Path) {
+        for (file, scene) in [
+            ("week04_sphere.png", "week04-sphere"),
+            ("week04_quad.png", "week04-quad"),
+        ] {
+            let (w, h) = expected_size(scene).unwrap();
+            let mut b = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
+            b.extend((w as u32).to_be_bytes());
+            b.extend((h as u32).to_be_bytes());
+            b.extend([8, 2, 0, 0, 0, 0, 0, 0, 0]);
+            std::fs::write(dir.join(file), b).unwrap();
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::fakes::*;
     use super::*;
+    use crate::grade::rubric::sha256_hex;
 
     fn run(rubric: &Rubric, code: &FakeCode, images: &FakeImage) -> GradeReport {
         let sub = tempfile::tempdir().unwrap();
         std::fs::write(sub.path().join("RT_object.py"), "x = 1\n").unwrap();
+        fake_images(sub.path());
         let out = tempfile::tempdir().unwrap();
         grade(sub.path(), rubric, code, images, out.path()).unwrap()
     }
@@ -779,7 +937,49 @@ mod tests {
         assert_eq!(score(&r, "sphere.intersect"), 7.5);
         let c = &r.checks[0];
         assert_eq!(c.status, CheckStatus::Failed);
-        assert!(c.message.contains("1 of 4 sphere test vectors answered correctly (1 raised an exception, 1 timed out or crashed Python, 1 not run)."), "{}", c.message);
+        assert!(c.message.contains("1 of 4 sphere test vectors answered correctly (1 raised an exception, 1 timed out, 1 not run)."), "{}", c.message);
+    }
+
+    fn failure(id: &str, kind: FailureKind) -> FailureSummary {
+        FailureSummary {
+            id: id.into(),
+            shape: crate::oracle::vectors::ShapeKind::Sphere,
+            tags: vec![],
+            kind,
+            definite: true,
+            expected: serde_json::Value::Null,
+            actual: serde_json::Value::Null,
+            message: format!("{kind:?}"),
+            repro: String::new(),
+        }
+    }
+
+    #[test]
+    fn the_smallest_failing_case_was_run_and_crashes_are_not_time_outs() {
+        let not_run = failure("a", FailureKind::NotRun);
+        let timeout = failure("b", FailureKind::Timeout);
+        let pair = [not_run.clone(), timeout];
+        assert_eq!(smallest_failure(&pair).unwrap().id, "b");
+        assert!(smallest_failure(&[not_run]).is_none());
+        let sphere = GroupCounts {
+            definite_total: 3,
+            passed: 1,
+            crashes: 1,
+            not_run: 1,
+            ..Default::default()
+        };
+        let r = run(
+            &Rubric::week04(),
+            &FakeCode::new(sphere, counts(1, 1)),
+            &all_pass(),
+        );
+        assert!(
+            r.checks[0].message.contains(
+                "1 of 3 sphere test vectors answered correctly (1 crashed Python, 1 not run)."
+            ),
+            "{}",
+            r.checks[0].message
+        );
     }
 
     #[test]
@@ -871,6 +1071,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for name in ["a", "b", "c"] {
             std::fs::create_dir(dir.path().join(name)).unwrap();
+            fake_images(&dir.path().join(name));
         }
         let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
         code.panic_on = Some("b".into());

@@ -532,3 +532,114 @@ fn exr_candidates_are_compared_as_linear_values() {
     assert!(!c.passed());
     assert!(c.bias.iter().all(|b| *b < 0.0), "{:?}", c.bias);
 }
+
+/// A render of fewer samples than claimed is caught by the noise check: 1 spp claimed as 41
+/// fails on both scenes, with an effective spp far below 41, while honest renders at 41 spp
+/// (and at 20, in `honest_renders_pass_at_every_seed`) pass it. The check's false-failure bound
+/// is NOISE_ALPHA = 1e-6 per image; honest renders sit far from it (p = 1 here: the squared
+/// differences stay below their bound under the claim).
+#[test]
+fn fewer_samples_than_claimed_fail_the_noise_check() {
+    for scene in COURSE_SCENES {
+        let d = rtoracle::scene::builtin(scene).unwrap();
+        let claim = |n: u32| CompareOptions {
+            samples_per_pixel: n,
+            ..Default::default()
+        };
+        let results: Vec<(u64, Comparison, Comparison)> = (1..=4u64)
+            .into_par_iter()
+            .map(|seed| {
+                let one = render_with_mistake(&d, Mistake::Honest, 1, 500 + seed);
+                let c1 = compare_image(&candidate(one), golden(scene), &claim(41)).unwrap();
+                let honest = render_with_mistake(&d, Mistake::Honest, 41, 600 + seed);
+                let c41 = compare_image(&candidate(honest), golden(scene), &claim(41)).unwrap();
+                (seed, c1, c41)
+            })
+            .collect();
+        for (seed, c1, c41) in results {
+            let n1 = c1.noise.as_ref().expect("enough noisy pixels");
+            assert!(!c1.passed() && !n1.passed, "{scene} seed {seed}: {n1:?}");
+            assert!(n1.effective_spp.unwrap() < 10.0, "{scene}: {n1:?}");
+            let n41 = c41.noise.as_ref().expect("enough noisy pixels");
+            eprintln!(
+                "{scene} seed {seed}: 1 spp as 41: effective {:.2}, p {:.1e}; 41 spp: effective {:.1}, p {:.3}",
+                n1.effective_spp.unwrap(),
+                n1.p,
+                n41.effective_spp.unwrap_or(f64::NAN),
+                n41.p
+            );
+            assert!(c41.passed() && n41.passed, "{scene} seed {seed}: {n41:?}");
+            assert!(n41.p > 1e3 * n41.threshold, "{scene}: {n41:?}");
+        }
+    }
+}
+
+/// An image wrong all over (no gamma) has its failing regions outlined all over the heatmap,
+/// not only in the top rows: the report lists the first 50 and says how many there are.
+#[test]
+fn the_heatmap_outlines_failing_regions_all_over_the_image() {
+    let d = rtoracle::scene::builtin("week04-quad").unwrap();
+    let c = compare(
+        "week04-quad",
+        render_with_mistake(&d, Mistake::NoGamma, 20, 9),
+    );
+    assert!(!c.passed());
+    assert!(c.regions_total > 50, "{}", c.regions_total);
+    assert_eq!(c.regions.len(), 50);
+    assert_eq!(c.outline.len(), c.regions_total);
+    let img = rtoracle::compare::heatmap::heatmap_image(&c);
+    // Outline pixels (pure green) in each horizontal third of the image.
+    let green = |y0: usize, y1: usize| {
+        (y0..y1).any(|y| {
+            (0..img.width).any(|x| img.data[3 * (y * img.width + x)..][..3] == [0, 170, 0])
+        })
+    };
+    let h = img.height;
+    assert!(green(0, h / 3) && green(h / 3, 2 * h / 3) && green(2 * h / 3, h));
+}
+
+/// A FAIL says how to see where (unless a picture was asked for); a reused `--report` folder
+/// keeps no stale crop; a folder holding other files is refused before any work.
+#[test]
+fn a_fail_points_to_the_pictures_and_a_reused_report_folder_keeps_nothing_stale() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    write(
+        dir.path(),
+        "bad.png",
+        &render_with_mistake(&d, Mistake::NoGamma, 20, 3),
+    );
+    let out = compare_cli(dir.path(), &["bad.png", "--scene", "week04-sphere"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("add --heatmap FILE.png"), "{stdout}");
+    assert!(stdout.contains("--report DIR"), "{stdout}");
+    // A stale file of an earlier report does not survive.
+    let report = dir.path().join("rep");
+    std::fs::create_dir(&report).unwrap();
+    std::fs::write(report.join("region-99.png"), b"stale").unwrap();
+    let out = compare_cli(
+        dir.path(),
+        &["bad.png", "--scene", "week04-sphere", "--report", "rep"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("add --heatmap"));
+    assert!(report.join("index.html").is_file() && report.join("region-1.png").is_file());
+    assert!(!report.join("region-99.png").exists());
+    // No temporary folder is left beside it.
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    // A folder with a file of the user's is refused up front, and the file stays.
+    std::fs::write(report.join("notes.txt"), b"mine").unwrap();
+    let out = compare_cli(
+        dir.path(),
+        &["bad.png", "--scene", "week04-sphere", "--report", "rep"],
+    );
+    assert_bad_input(&out, "notes.txt");
+    assert_eq!(std::fs::read(report.join("notes.txt")).unwrap(), b"mine");
+}

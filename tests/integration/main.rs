@@ -11,3 +11,4 @@ mod oracle_props;
 mod protocol;
 mod readme;
 mod render;
+mod reports;

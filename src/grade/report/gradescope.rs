@@ -4,25 +4,37 @@
 
 use serde_json::{Value, json};
 
+use super::markdown::{check_body, worth_showing};
+use crate::escape::markdown_inline;
 use crate::grade::{CheckStatus, GradeReport};
 
-/// One test's output text (Markdown): the message, then the first failure's reproduction.
-fn test_output(check: &crate::grade::CheckResult) -> String {
-    let mut out = check.message.clone();
-    if let Some(f) = crate::grade::smallest_failure(&check.failures) {
-        out.push_str(&format!(
-            "\n\nSmallest failing case to run yourself:\n\n```python\n{}```",
-            f.repro
-        ));
+/// Text the submission controls, for Gradescope's Markdown: each line escaped with
+/// [`markdown_inline`] (so `<`, `>` and `&` are entities and nothing is a link, a heading or
+/// HTML, even if Gradescope lets raw HTML through), as a quote with hard line breaks, leading
+/// spaces kept as `&nbsp;`.
+pub(crate) fn quoted(s: &str) -> String {
+    let mut out = String::new();
+    for line in s.trim_end().lines() {
+        let text = markdown_inline(line);
+        let body = text.trim_start_matches(' ');
+        let indent = text.len() - body.len();
+        out.push_str("> ");
+        out.push_str(&"&nbsp;".repeat(indent));
+        out.push_str(body);
+        out.push_str("  \n");
     }
-    if let Some(img) = &check.image {
-        if let Some(d) = &img.diagnosis {
-            if !out.contains(d.as_str()) {
-                out.push_str(&format!("\n\n{d}"));
-            }
-        }
-    }
+    out.push('\n');
     out
+}
+
+/// One test's output (Markdown): the message, the smallest failing case and its reproduction.
+/// The heatmaps are not on Gradescope, so nothing points to them, and the diagnosis of an image
+/// is said once (it is in the message).
+fn test_output(check: &crate::grade::CheckResult) -> String {
+    check_body(check, true, quoted)
+        .replace(" (outlined in the heatmap)", "")
+        .trim_end()
+        .to_string()
 }
 
 /// The Gradescope value.
@@ -30,6 +42,7 @@ pub fn value(report: &GradeReport) -> Value {
     let tests: Vec<Value> = report
         .checks
         .iter()
+        .filter(|c| worth_showing(c))
         .enumerate()
         .map(|(i, c)| {
             json!({
@@ -52,7 +65,8 @@ pub fn value(report: &GradeReport) -> Value {
     );
     if let Some(fatal) = &report.code.fatal {
         output.push_str(&format!(
-            "\n\nYour code could not be run:\n\n```\n{fatal}\n```"
+            "\n\nYour code could not be run. Python said:\n\n{}",
+            quoted(fatal)
         ));
     }
     json!({

@@ -1,0 +1,398 @@
+//! Reading what a submission holds, with care: only regular files inside the submission folder
+//! are read, size caps are checked before anything is read or hashed, and a PNG's header is
+//! checked (size, colour type, bit depth) before it is decoded.
+//!
+//! Promises:
+//! - a FIFO, a socket, a device, a folder or a symbolic link (even to a regular file) where a
+//!   file is expected is reported by name and never opened, so it cannot block or redirect the
+//!   grader. The check is made with `symlink_metadata`, the file is opened with
+//!   `O_NOFOLLOW | O_NONBLOCK` and checked again with `fstat` (same device and inode, still a
+//!   regular file), so swapping it between the check and the open does not help;
+//! - no file is read past its cap ([`MAX_IMAGE_BYTES`] for an image; [`HASH_FILE_CAP`] per file
+//!   and [`HASH_TOTAL_CAP`] in all for the hashes of `report.json`), whatever its size claims;
+//! - a PNG whose header says it is not the expected size, has more than [`MAX_IMAGE_PIXELS`]
+//!   pixels, is grey, uses a palette or has 16-bit channels is reported in plain words, naming
+//!   the file as the student knows it (relative to the submission), without being decoded.
+
+use std::collections::BTreeMap;
+use std::fs::{File, FileType, Metadata};
+use std::io::Read;
+use std::os::unix::fs::{FileTypeExt, MetadataExt, OpenOptionsExt};
+use std::path::{Component, Path, PathBuf};
+
+use super::rubric::sha256_hex;
+
+/// The largest image file read (64 MiB).
+pub const MAX_IMAGE_BYTES: u64 = 64 << 20;
+/// The most pixels an image may have (about 8192 x 8192).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+/// The largest file hashed for `report.json` (16 MiB); larger ones are listed as not hashed.
+pub const HASH_FILE_CAP: u64 = 16 << 20;
+/// The most bytes hashed for `report.json` over the whole submission (64 MiB).
+pub const HASH_TOTAL_CAP: u64 = 64 << 20;
+
+/// What a file that is not a regular file is, in words.
+fn kind_of(t: &FileType) -> &'static str {
+    if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_dir() {
+        "a folder"
+    } else if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_socket() {
+        "a socket"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// `rel` under `root`, refusing absolute paths, `..`, and folders on the way that are symbolic
+/// links or not folders. `rel` names the file in messages.
+fn inside(root: &Path, rel: &str) -> Result<PathBuf, String> {
+    let rel_path = Path::new(rel);
+    let mut path = root.to_path_buf();
+    let parts: Vec<Component> = rel_path.components().collect();
+    for (i, part) in parts.iter().enumerate() {
+        match part {
+            Component::Normal(name) => path.push(name),
+            Component::CurDir => continue,
+            _ => return Err(format!("{rel} is outside the submission")),
+        }
+        if i + 1 < parts.len() {
+            match std::fs::symlink_metadata(&path) {
+                Ok(m) if m.is_dir() => {}
+                Ok(m) => {
+                    let shown = path.strip_prefix(root).unwrap_or(&path).display();
+                    return Err(format!(
+                        "{shown} is {}, not a folder",
+                        kind_of(&m.file_type())
+                    ));
+                }
+                Err(_) => return Err(format!("{rel} is missing from the submission")),
+            }
+        }
+    }
+    Ok(path)
+}
+
+/// Opens `path` only if it is a regular file of at most `cap` bytes (see the module's
+/// promises); `shown` names it in the error.
+pub fn open_regular(path: &Path, shown: &str, cap: u64) -> Result<(File, Metadata), String> {
+    let before = std::fs::symlink_metadata(path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            format!("{shown} is missing from the submission")
+        } else {
+            format!("{shown} cannot be read ({})", e.kind())
+        }
+    })?;
+    if !before.file_type().is_file() {
+        return Err(format!(
+            "{shown} is {}, not a regular file",
+            kind_of(&before.file_type())
+        ));
+    }
+    let over = |len: u64| format!("{shown} is {len} bytes, over the limit of {cap} bytes");
+    if before.len() > cap {
+        return Err(over(before.len()));
+    }
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| {
+            if e.raw_os_error() == Some(libc::ELOOP) {
+                format!("{shown} is a symbolic link, not a regular file")
+            } else {
+                format!("{shown} cannot be read ({})", e.kind())
+            }
+        })?;
+    let after = file
+        .metadata()
+        .map_err(|e| format!("{shown} cannot be read ({})", e.kind()))?;
+    if !after.file_type().is_file() || (after.dev(), after.ino()) != (before.dev(), before.ino()) {
+        return Err(format!("{shown} changed while it was being read"));
+    }
+    if after.len() > cap {
+        return Err(over(after.len()));
+    }
+    Ok((file, after))
+}
+
+/// The bytes of the regular file `path`, at most `cap` of them (an error past it).
+pub fn read_regular(path: &Path, shown: &str, cap: u64) -> Result<Vec<u8>, String> {
+    let (file, meta) = open_regular(path, shown, cap)?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(cap + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{shown} cannot be read ({})", e.kind()))?;
+    if bytes.len() as u64 > cap {
+        return Err(format!(
+            "{shown} is more than {cap} bytes, over the limit of {cap} bytes"
+        ));
+    }
+    Ok(bytes)
+}
+
+/// What a PNG's IHDR chunk says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PngHeader {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Bits per channel.
+    pub bit_depth: u8,
+    /// 0 grey, 2 RGB, 3 palette, 4 grey and alpha, 6 RGBA.
+    pub colour_type: u8,
+}
+
+/// The header of a PNG: `None` when `bytes` is not a PNG at all, an error when its header is
+/// cut short or is not an IHDR chunk.
+pub fn png_header(bytes: &[u8]) -> Option<Result<PngHeader, &'static str>> {
+    if !bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        return None;
+    }
+    if bytes.len() < 29 || &bytes[12..16] != b"IHDR" {
+        return Some(Err("is not a readable PNG (its header is cut short)"));
+    }
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    Some(Ok(PngHeader {
+        width: be(16),
+        height: be(20),
+        bit_depth: bytes[24],
+        colour_type: bytes[25],
+    }))
+}
+
+/// Checks a PNG's header against what grading needs, in plain words naming `shown`.
+pub fn check_png(
+    shown: &str,
+    bytes: &[u8],
+    expected: Option<(usize, usize)>,
+) -> Result<(), String> {
+    let header = match png_header(bytes) {
+        None => return Ok(()),
+        Some(Err(why)) => return Err(format!("{shown} {why}")),
+        Some(Ok(h)) => h,
+    };
+    let (w, h) = (header.width as u64, header.height as u64);
+    if w * h > MAX_IMAGE_PIXELS {
+        return Err(format!(
+            "{shown} is {w}x{h} pixels, more than the {MAX_IMAGE_PIXELS} allowed"
+        ));
+    }
+    if let Some((ew, eh)) = expected {
+        if (w, h) != (ew as u64, eh as u64) {
+            return Err(format!("{shown} is {w}x{h} pixels; expected {ew}x{eh}"));
+        }
+    }
+    match header.colour_type {
+        0 | 4 => Err(format!("{shown} is greyscale; expected an RGB PNG")),
+        3 => Err(format!(
+            "{shown} uses a colour palette; expected an RGB PNG"
+        )),
+        2 | 6 if header.bit_depth != 8 => Err(format!(
+            "{shown} has {} bits per channel; expected 8",
+            header.bit_depth
+        )),
+        2 | 6 => Ok(()),
+        _ => Err(format!(
+            "{shown} is not a readable PNG (unknown colour type)"
+        )),
+    }
+}
+
+/// Reads the image `rel` of `submission` with care, checks its header, and writes its bytes to
+/// `stage_dir` under its own file name (the path returned), so whatever reads it next reads a
+/// copy the grader owns. The error is a sentence naming `rel`.
+pub fn stage_image(
+    submission: &Path,
+    rel: &str,
+    expected: Option<(usize, usize)>,
+    stage_dir: &Path,
+) -> Result<PathBuf, String> {
+    let path = inside(submission, rel)?;
+    let bytes = read_regular(&path, rel, MAX_IMAGE_BYTES)?;
+    check_png(rel, &bytes, expected)?;
+    let name = path.file_name().unwrap_or_else(|| "image".as_ref());
+    let staged = stage_dir.join(name);
+    std::fs::write(&staged, &bytes)
+        .map_err(|e| format!("{rel} could not be staged for comparison ({})", e.kind()))?;
+    Ok(staged)
+}
+
+/// SHA-256 of each regular file at the top of `dir`, by name: only regular files (never through a
+/// symbolic link), each up to [`HASH_FILE_CAP`] and [`HASH_TOTAL_CAP`] in all (in name order); a
+/// file past a cap or unreadable gets a note instead of a hash.
+pub fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return out;
+    };
+    let mut files: Vec<(String, PathBuf)> = entries
+        .flatten()
+        .filter(|e| e.file_type().map(|t| t.is_file()).unwrap_or(false))
+        .map(|e| (e.file_name().to_string_lossy().to_string(), e.path()))
+        .collect();
+    files.sort();
+    let mut total = 0u64;
+    for (name, path) in files {
+        let cap = HASH_FILE_CAP.min(HASH_TOTAL_CAP - total);
+        let value = match read_regular(&path, &name, cap) {
+            Ok(bytes) => {
+                total += bytes.len() as u64;
+                sha256_hex(&bytes)
+            }
+            Err(why) => {
+                let size = std::fs::symlink_metadata(&path).map_or(0, |m| m.len());
+                if size > cap {
+                    format!(
+                        "not hashed: {size} bytes, over the cap ({HASH_FILE_CAP} per file, {HASH_TOTAL_CAP} in all)"
+                    )
+                } else {
+                    format!("not hashed: {why}")
+                }
+            }
+        };
+        out.insert(name, value);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    fn png(width: u32, height: u32, bit_depth: u8, colour_type: u8) -> Vec<u8> {
+        let mut b = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
+        b.extend(width.to_be_bytes());
+        b.extend(height.to_be_bytes());
+        b.extend([bit_depth, colour_type, 0, 0, 0, 0, 0, 0, 0]);
+        b
+    }
+
+    #[test]
+    fn special_files_are_named_and_never_opened() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let fifo = std::ffi::CString::new(d.join("week04_sphere.png").to_str().unwrap()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o644) }, 0);
+        std::fs::write(d.join("real.png"), b"x").unwrap();
+        std::os::unix::fs::symlink(d.join("real.png"), d.join("link.png")).unwrap();
+        let _sock = std::os::unix::net::UnixListener::bind(d.join("sock.png")).unwrap();
+        std::fs::create_dir(d.join("dir.png")).unwrap();
+        let start = Instant::now();
+        let err = |name: &str| read_regular(&d.join(name), name, 100).unwrap_err();
+        assert_eq!(
+            err("week04_sphere.png"),
+            "week04_sphere.png is a FIFO, not a regular file"
+        );
+        assert_eq!(
+            err("link.png"),
+            "link.png is a symbolic link, not a regular file"
+        );
+        assert_eq!(err("sock.png"), "sock.png is a socket, not a regular file");
+        assert_eq!(err("dir.png"), "dir.png is a folder, not a regular file");
+        assert_eq!(err("none.png"), "none.png is missing from the submission");
+        // A device, where root can make one (a copy of /dev/null's numbers).
+        let dev = std::ffi::CString::new(d.join("dev.png").to_str().unwrap()).unwrap();
+        if unsafe { libc::mknod(dev.as_ptr(), libc::S_IFCHR | 0o644, libc::makedev(1, 3)) } == 0 {
+            assert_eq!(
+                err("dev.png"),
+                "dev.png is a character device, not a regular file"
+            );
+        }
+        assert!(start.elapsed() < Duration::from_secs(5));
+        assert_eq!(
+            read_regular(&d.join("real.png"), "real.png", 100).unwrap(),
+            b"x"
+        );
+    }
+
+    #[test]
+    fn caps_are_checked_before_reading_and_a_sparse_giant_is_not_hashed() {
+        let dir = tempfile::tempdir().unwrap();
+        let big = std::fs::File::create(dir.path().join("big.bin")).unwrap();
+        big.set_len(4 << 30).unwrap();
+        std::fs::write(dir.path().join("RT_object.py"), b"x = 1\n").unwrap();
+        std::os::unix::fs::symlink("/etc/hostname", dir.path().join("link.py")).unwrap();
+        let start = Instant::now();
+        let hashes = submission_hashes(dir.path());
+        // Reading 4 GiB of zeros would take far longer than this on any machine here.
+        assert!(
+            start.elapsed() < Duration::from_secs(2),
+            "{:?}",
+            start.elapsed()
+        );
+        assert!(
+            hashes["big.bin"].starts_with("not hashed: 4294967296 bytes, over the cap"),
+            "{hashes:?}"
+        );
+        assert_eq!(hashes["RT_object.py"], sha256_hex(b"x = 1\n"));
+        assert!(!hashes.contains_key("link.py"), "{hashes:?}");
+        let e = read_regular(&dir.path().join("big.bin"), "big.bin", MAX_IMAGE_BYTES).unwrap_err();
+        assert_eq!(
+            e,
+            format!("big.bin is 4294967296 bytes, over the limit of {MAX_IMAGE_BYTES} bytes")
+        );
+    }
+
+    #[test]
+    fn png_headers_are_judged_before_decoding() {
+        let ok = Some((400, 225));
+        assert_eq!(check_png("a.png", &png(400, 225, 8, 2), ok), Ok(()));
+        assert_eq!(check_png("a.png", &png(400, 225, 8, 6), ok), Ok(()));
+        assert_eq!(
+            check_png("week04_quad.png", &png(400, 225, 8, 0), ok).unwrap_err(),
+            "week04_quad.png is greyscale; expected an RGB PNG"
+        );
+        assert_eq!(
+            check_png("a.png", &png(400, 225, 8, 3), ok).unwrap_err(),
+            "a.png uses a colour palette; expected an RGB PNG"
+        );
+        assert_eq!(
+            check_png("a.png", &png(400, 225, 16, 2), ok).unwrap_err(),
+            "a.png has 16 bits per channel; expected 8"
+        );
+        assert_eq!(
+            check_png("a.png", &png(200, 100, 8, 2), ok).unwrap_err(),
+            "a.png is 200x100 pixels; expected 400x225"
+        );
+        assert!(
+            check_png("a.png", &png(100_000, 100_000, 8, 2), None)
+                .unwrap_err()
+                .contains("more than the 67108864 allowed")
+        );
+        assert_eq!(
+            check_png("a.png", &png(4, 4, 8, 2)[..20], None).unwrap_err(),
+            "a.png is not a readable PNG (its header is cut short)"
+        );
+        assert_eq!(check_png("a.png", b"not a png", None), Ok(()));
+    }
+
+    #[test]
+    fn images_are_only_read_inside_the_submission() {
+        let dir = tempfile::tempdir().unwrap();
+        let stage = tempfile::tempdir().unwrap();
+        let outside = tempfile::tempdir().unwrap();
+        std::fs::write(outside.path().join("a.png"), png(4, 4, 8, 2)).unwrap();
+        std::os::unix::fs::symlink(outside.path(), dir.path().join("imgs")).unwrap();
+        assert_eq!(
+            stage_image(dir.path(), "imgs/a.png", None, stage.path()).unwrap_err(),
+            "imgs is a symbolic link, not a folder"
+        );
+        assert_eq!(
+            stage_image(dir.path(), "../a.png", None, stage.path()).unwrap_err(),
+            "../a.png is outside the submission"
+        );
+        std::fs::write(dir.path().join("b.png"), png(4, 4, 8, 2)).unwrap();
+        let staged = stage_image(dir.path(), "b.png", Some((4, 4)), stage.path()).unwrap();
+        assert_eq!(staged, stage.path().join("b.png"));
+        assert_eq!(std::fs::read(staged).unwrap(), png(4, 4, 8, 2));
+    }
+}
