@@ -68,7 +68,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         case_timeout: Duration::from_millis(args.case_timeout_ms),
         ..Default::default()
     };
-    let images = rtoracle::compare::CompareImageChecker::default();
+    let images = rtoracle::grade::CompareImageChecker::default();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
+use super::CompareImageChecker;
 use super::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
-use crate::compare::CompareImageChecker;
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 

@@ -47,7 +47,7 @@ impl CheckStatus {
 pub struct ImageResult {
     /// The file in the submission.
     pub file: String,
-    /// The built-in scene it must show.
+    /// The scene it must show: a built-in's name or the rubric's scene file.
     pub scene: String,
     /// What the comparison said: `"verdict": "pass" | "fail" | "unusable"`, with `"reason"` for
     /// unusable input.
@@ -102,8 +102,11 @@ pub struct Reproducibility {
     pub rubric_sha256: String,
     /// SHA-256 of the vectors run.
     pub vectors_sha256: String,
-    /// SHA-256 of each scene's golden.
+    /// SHA-256 of each scene's golden (for a scene file: of the golden EXR file's bytes).
     pub goldens_sha256: BTreeMap<String, String>,
+    /// SHA-256 of each scene file's bytes, by the rubric's `scene` value (built-in scenes are
+    /// not listed: the tool version names them).
+    pub scenes_sha256: BTreeMap<String, String>,
     /// SHA-256 of each file of the submission folder (top level).
     pub submission_sha256: BTreeMap<String, String>,
     /// The code checker.
@@ -448,9 +451,9 @@ pub fn grade(
                 .iter()
                 .map(|g| {
                     let file = submission.join(g.file.as_deref().expect("validated"));
-                    images.check(
+                    images.check_scene(
                         &file,
-                        g.scene.as_deref().expect("validated"),
+                        &g.scene_source().expect("validated"),
                         &out_dir.join(heatmap_name(g)),
                     )
                 })
@@ -471,11 +474,13 @@ pub fn grade(
     }
     let goldens_sha256 = image_groups
         .iter()
-        .filter_map(|g| g.scene.clone())
-        .map(|s| {
-            let h = images.golden_sha256(&s);
-            (s, h)
-        })
+        .filter_map(|g| g.scene_source())
+        .map(|s| (s.label().to_string(), images.scene_golden_sha256(&s)))
+        .collect();
+    let scenes_sha256 = image_groups
+        .iter()
+        .filter_map(|g| g.scene_file.as_ref())
+        .map(|f| (f.label.clone(), f.sha256.clone()))
         .collect();
     let score = round2(checks.iter().map(|c| c.score).sum());
     let submission_name = submission
@@ -505,6 +510,7 @@ pub fn grade(
                 code.vectors_sha256()
             },
             goldens_sha256,
+            scenes_sha256,
             submission_sha256: submission_hashes(submission),
             code_checker: code.describe(),
             image_checker: images.describe(),

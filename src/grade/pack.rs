@@ -1,0 +1,1 @@
+//! Packing a rubric with its scene files and goldens, for the Gradescope autograder.
