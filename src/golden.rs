@@ -255,7 +255,18 @@ pub fn cached_golden(
     spp: u32,
     progress: bool,
 ) -> Result<CachedGolden, GoldenError> {
-    let Some(dir) = cache_dir() else {
+    cached_golden_in(cache_dir().as_deref(), description, name, spp, progress)
+}
+
+/// [`cached_golden`] with the cache in folder `dir` (`None`: no cache, always render).
+pub fn cached_golden_in(
+    dir: Option<&Path>,
+    description: &SceneDescription,
+    name: &str,
+    spp: u32,
+    progress: bool,
+) -> Result<CachedGolden, GoldenError> {
+    let Some(dir) = dir else {
         let bytes = golden_bytes_of(description, name, spp, GOLDEN_SEED, progress)?;
         return Ok(CachedGolden {
             bytes,
@@ -266,7 +277,7 @@ pub fn cached_golden(
             ),
         });
     };
-    let path = cache_file(&dir, description, spp);
+    let path = cache_file(dir, description, spp);
     let lock = key_lock(&path);
     let _held = lock.lock().unwrap_or_else(|e| e.into_inner());
     if let Ok(bytes) = std::fs::read(&path) {
@@ -604,6 +615,58 @@ mod tests {
             d.summary(2)
                 .contains("the size is 3x1 but 2x1 was expected")
         );
+    }
+
+    fn tiny_scene(radius: f64) -> SceneDescription {
+        let mut d = builtin("week04-sphere").unwrap();
+        d.image.width = 8;
+        if let crate::scene::ObjectEntry::Sphere { radius: r, .. } = &mut d.objects[1] {
+            *r = radius;
+        }
+        d
+    }
+
+    #[test]
+    fn the_cache_renders_each_golden_once_even_when_asked_concurrently() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = tiny_scene(0.5);
+        let results: Vec<CachedGolden> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..4)
+                .map(|_| s.spawn(|| cached_golden_in(Some(dir.path()), &d, "tiny", 4, false)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap().unwrap())
+                .collect()
+        });
+        assert_eq!(results.iter().filter(|r| r.rendered).count(), 1);
+        let path = cache_file(dir.path(), &d, 4);
+        assert!(
+            results
+                .iter()
+                .all(|r| r.path.as_deref() == Some(path.as_path()))
+        );
+        let on_disk = std::fs::read(&path).unwrap();
+        assert!(results.iter().all(|r| r.bytes == on_disk));
+        // The file is the golden of this scene and of no other.
+        assert!(golden_fits(&on_disk, &path, &d).is_ok());
+        let other = tiny_scene(0.3);
+        let e = golden_fits(&on_disk, &path, &other).unwrap_err();
+        assert!(e.contains("another scene"), "{e}");
+        let mut wider = d.clone();
+        wider.image.width = 9;
+        assert!(
+            golden_fits(&on_disk, &path, &wider)
+                .unwrap_err()
+                .contains("is 8x")
+        );
+        // Another scene has another key; a corrupt cache file is rendered again.
+        assert_ne!(cache_file(dir.path(), &other, 4), path);
+        std::fs::write(&path, b"junk").unwrap();
+        let again = cached_golden_in(Some(dir.path()), &d, "tiny", 4, false).unwrap();
+        assert!(again.rendered);
+        assert_eq!(again.bytes, on_disk);
+        assert_eq!(std::fs::read(&path).unwrap(), on_disk);
     }
 
     #[test]

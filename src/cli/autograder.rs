@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::grade::{Rubric, autograder};
+use rtoracle::grade::{Rubric, autograder, pack};
 
 /// `rtoracle autograder --out autograder.zip [--rubric FILE.toml] [--binary PATH]`
 #[derive(Debug, clap::Args)]
@@ -10,7 +10,9 @@ pub struct Args {
     /// The package to write.
     #[arg(long, value_name = "ZIP", default_value = "autograder.zip")]
     out: PathBuf,
-    /// The rubric to grade with (default: the built-in week-4 rubric).
+    /// The rubric to grade with (default: the built-in week-4 rubric). Its scene files and
+    /// their goldens are packed too (missing goldens are rendered now), so Gradescope never
+    /// renders.
     #[arg(long, value_name = "FILE.toml")]
     rubric: Option<PathBuf>,
     /// The rtoracle binary to pack (default: this one). It must be an x86_64 Linux executable,
@@ -20,22 +22,38 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let rubric_text = match &args.rubric {
-        Some(path) => {
-            // Validate it now, so a bad rubric fails here and not on Gradescope.
-            Rubric::from_file(path)?;
-            std::fs::read_to_string(path)
-                .with_context(|| format!("{}: cannot read the rubric", path.display()))?
-        }
-        None => rtoracle::grade::rubric::WEEK04_RUBRIC.to_string(),
-    };
     let binary = match args.binary {
         Some(b) => b,
         None => std::env::current_exe().context("cannot find the running rtoracle binary")?,
     };
-    autograder::build_package(&binary, &rubric_text, &args.out)?;
+    // Refuse a wrong binary before rendering any golden.
+    autograder::check_binary(&binary)?;
+    let packed = match &args.rubric {
+        Some(path) => {
+            // Validate it now, so a bad rubric fails here and not on Gradescope.
+            let rubric = Rubric::from_file(path)?;
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("{}: cannot read the rubric", path.display()))?;
+            pack::pack_rubric(&rubric, &text)?
+        }
+        None => pack::PackedRubric {
+            rubric_toml: rtoracle::grade::rubric::WEEK04_RUBRIC.to_string(),
+            files: vec![],
+            rendered: 0,
+        },
+    };
+    autograder::build_package_with(&binary, &packed.rubric_toml, &packed.files, &args.out)?;
+    let scenes = if packed.files.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ", {} scene files and goldens in {}/",
+            packed.files.len() / 2,
+            pack::PACKED_SCENES
+        )
+    };
     eprintln!(
-        "wrote {} (setup.sh, run_autograder, rubric.toml, rtoracle from {}); upload it as the assignment's autograder",
+        "wrote {} (setup.sh, run_autograder, rubric.toml, rtoracle from {}{scenes}); upload it as the assignment's autograder",
         args.out.display(),
         binary.display()
     );

@@ -4,14 +4,23 @@ use std::time::Instant;
 
 use anyhow::Context;
 use rtoracle::golden::{
-    GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_file_name,
+    GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_bytes_of,
+    golden_file_name,
 };
 use rtoracle::image_io::{decode_exr, write_atomically};
-use rtoracle::scene::{builtin, builtin_names};
+use rtoracle::scene::{SceneDescription, builtin, builtin_names};
 
-/// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`
+/// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`, or
+/// `rtoracle golden FILE.toml -o FILE.exr [--spp N]` for a scene file.
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    /// A scene file (TOML) to make the golden of, instead of the built-in scenes; a rubric's
+    /// image group names it with `golden = "FILE.exr"`.
+    #[arg(value_name = "FILE.toml", requires = "out", conflicts_with_all = ["check", "scenes", "dir"])]
+    scene_file: Option<PathBuf>,
+    /// Where to write the scene file's golden (EXR).
+    #[arg(short, long, value_name = "FILE.exr", requires = "scene_file")]
+    out: Option<PathBuf>,
     /// Verify instead of writing: regenerate each golden in memory and compare it with the file,
     /// pixel by pixel within a small tolerance. Exit 0 when all are equal, 1 when one differs,
     /// 2 when a file cannot be read.
@@ -33,6 +42,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         n if n <= 0 => anyhow::bail!("--spp {n}: samples per pixel must be at least 1"),
         n => u32::try_from(n).map_err(|_| anyhow::anyhow!("--spp {n}: too large"))?,
     };
+    if let (Some(file), Some(out)) = (&args.scene_file, &args.out) {
+        return write_scene_file(file, out, spp);
+    }
     let scenes: Vec<String> = if args.scenes.is_empty() {
         builtin_names().into_iter().map(String::from).collect()
     } else {
@@ -46,6 +58,30 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         write(&args.dir, &scenes, spp)
     }
+}
+
+fn write_scene_file(file: &Path, out: &Path, spp: u32) -> anyhow::Result<ExitCode> {
+    let description = SceneDescription::from_file(file)?;
+    if out.extension().and_then(|e| e.to_str()) != Some("exr") {
+        anyhow::bail!("{}: the golden must be an .exr file", out.display());
+    }
+    if out.is_dir() {
+        anyhow::bail!("{}: is a folder, not a file to write", out.display());
+    }
+    let name = file
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| file.display().to_string());
+    let start = Instant::now();
+    let bytes = golden_bytes_of(&description, &name, spp, GOLDEN_SEED, true)?;
+    write_atomically(out, &bytes)?;
+    println!(
+        "wrote {} ({spp} spp, seed {GOLDEN_SEED}, {} bytes) in {:.1} s",
+        out.display(),
+        bytes.len(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
