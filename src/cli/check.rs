@@ -8,9 +8,10 @@ use anyhow::Context;
 use rtoracle::candidate::{CandidateCommand, RunOptions, check_command};
 use rtoracle::oracle::{default_suite, vectors::read_vectors};
 
-/// Which candidate to run (shared by `check` and `fuzz`).
+/// Which candidate to run (shared by `check` and `fuzz`; `check` without either checks the
+/// course submission in the current folder).
 #[derive(Debug, clap::Args)]
-#[group(required = true, multiple = false)]
+#[group(required = false, multiple = false)]
 pub struct Target {
     /// A submission folder in the course's Python layout (RT_utility.py, RT_ray.py,
     /// RT_object.py), run through the bundled adapter.
@@ -28,7 +29,7 @@ impl Target {
         Ok(match (&self.python_course, &self.adapter) {
             (Some(dir), _) => CandidateCommand::python_course(dir)?,
             (_, Some(cmd)) => CandidateCommand::adapter(cmd)?,
-            _ => unreachable!("clap requires one"),
+            _ => anyhow::bail!("give the candidate: --python-course DIR or --adapter 'CMD ARGS'"),
         })
     }
 }
@@ -58,6 +59,20 @@ pub struct Args {
     show: usize,
 }
 
+/// `rtoracle check` with no candidate: the course submission in the current folder, as
+/// `--python-course .`, announced on stderr (stdout stays the report, JSON with `--json`).
+fn current_submission() -> anyhow::Result<CandidateCommand> {
+    let here = std::env::current_dir().context("cannot read the current folder")?;
+    let shown = rtoracle::escape::terminal_line(&here.display().to_string());
+    if !here.join("RT_object.py").is_file() {
+        anyhow::bail!(
+            "no RT_object.py in {shown}: run `rtoracle check` in a course submission folder (RT_utility.py, RT_ray.py, RT_object.py), or give --python-course DIR or --adapter 'CMD ARGS'"
+        );
+    }
+    eprintln!("checking the course submission in {shown} (as --python-course .)");
+    Ok(CandidateCommand::python_course(&here)?)
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let cases = match &args.vectors {
         Some(path) => read_vectors(path)?,
@@ -71,7 +86,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         hello_timeout: Duration::from_millis(args.hello_timeout_ms),
         ..RunOptions::default()
     };
-    let command = args.target.command()?;
+    let command = if args.target.python_course.is_none() && args.target.adapter.is_none() {
+        current_submission()?
+    } else {
+        args.target.command()?
+    };
     let report = check_command(command, &cases, options).context("check")?;
     let text = if args.json {
         report.to_json()
