@@ -486,19 +486,18 @@ impl Rubric {
                                 g.id
                             )));
                         }
-                        None => {}
-                        Some(file) => {
+                        Some(file)
                             if file.is_empty()
                                 || file.contains('/')
                                 || file.contains('\\')
-                                || file.starts_with('.')
-                            {
-                                return Err(invalid(format!(
-                                    "image group {:?}: file {file:?} must be a plain file name",
-                                    g.id
-                                )));
-                            }
+                                || file.starts_with('.') =>
+                        {
+                            return Err(invalid(format!(
+                                "image group {:?}: file {file:?} must be a plain file name",
+                                g.id
+                            )));
                         }
+                        _ => {}
                     }
                     if !builtin {
                         let stem = Path::new(scene)
