@@ -1,6 +1,10 @@
 //! The fixture submissions of this repository, made into real submissions, and the grading
-//! benchmark (`cargo bench --bench grade`): one submission, and a batch of 30 on 2 threads,
-//! against a baseline measured in the same run (starting Python once).
+//! benchmark (`cargo bench --bench grade`, `rtoracle bench grade`): one submission, and a batch
+//! of 30 on 2 threads, against a baseline measured in the same run (starting Python once); and a
+//! batch of 10 triangle submissions against the 160x160 scene file of
+//! `examples/rubrics/triangles.toml` with a cold golden cache, against the same batch with the
+//! built-in `triangles` scene (embedded golden) in the same run: the golden is rendered once
+//! per cache, not once per submission.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -201,6 +205,7 @@ pub fn run() -> (f64, f64) {
         assert_eq!(entries.len(), 30);
         secs(t.elapsed())
     });
+    let (builtin, scene_file) = pool.install(|| scene_file_batches(work.path()));
     println!(
         "grade benchmark (2 threads; fixtures: {})",
         names.join(", ")
@@ -220,5 +225,92 @@ pub fn run() -> (f64, f64) {
         batch_time / baseline,
         batch_time / 30.0
     );
+    println!(
+        "  batch of 10, built-in scene 'triangles'  {:8.3} s  (embedded golden)",
+        builtin
+    );
+    println!(
+        "  batch of 10, 160x160 scene file          {:8.3} s  = {:6.2} x built-in  (cold golden cache; target < 2 x)",
+        scene_file,
+        scene_file / builtin
+    );
     (one, batch_time)
+}
+
+/// Grades 10 honest triangle submissions twice, with the triangle rubric of `examples/rubrics`
+/// (code and image groups): once with its image group on the built-in `triangles` scene, once
+/// on its scene file with an empty golden cache. Returns both times in seconds.
+pub fn scene_file_batches(work: &Path) -> (f64, f64) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let rubric_path = root.join("examples/rubrics/triangles.toml");
+    let text = std::fs::read_to_string(&rubric_path).expect("examples/rubrics/triangles.toml");
+    let file_rubric = Rubric::from_file(&rubric_path).expect("the example rubric is valid");
+    let builtin_rubric = Rubric::from_toml(
+        &text.replace(
+            "scene = \"triangles-scene.toml\"",
+            "scene = \"triangles\"\nfile = \"triangles.png\"",
+        ),
+        "triangles (built-in scene)",
+    )
+    .expect("the built-in variant is valid");
+    let scene_file = file_rubric.groups[1]
+        .scene_file
+        .clone()
+        .expect("a scene-file group");
+    let subs = work.join("triangle-subs");
+    let python = root.join("tests/fixtures/python");
+    for i in 0..10u64 {
+        let dest = subs.join(format!("{i:02}"));
+        std::fs::create_dir_all(&dest).expect("a submission folder");
+        for from in std::fs::read_dir(python.join("common"))
+            .expect("tests/fixtures/python/common")
+            .flatten()
+            .map(|e| e.path())
+            .chain([python.join("triangle_assignment/RT_object.py")])
+        {
+            std::fs::copy(&from, dest.join(from.file_name().expect("a file")))
+                .expect("copy a course module");
+        }
+        let builtin = crate::scene::builtin("triangles").expect("the built-in scene");
+        for (d, name) in [
+            (&scene_file.description, "triangles-scene.png"),
+            (&builtin, "triangles.png"),
+        ] {
+            let options = RenderOptions {
+                samples_per_pixel: 20,
+                seed: 100 + i,
+                ..Default::default()
+            };
+            let film = render(&d.scene(), &d.camera(None), &options).expect("a render");
+            write_png(
+                &dest.join(name),
+                &Rgb8Image {
+                    width: film.width,
+                    height: film.height,
+                    data: film.to_course_rgb8(),
+                },
+            )
+            .expect("write the image");
+        }
+    }
+    let time = |rubric: &Rubric, out: &str| {
+        let mut images = CompareImageChecker::default();
+        images.cache_dir = Some(work.join(format!("{out}-cache")));
+        let t = Instant::now();
+        let entries = batch::grade_batch(
+            &subs,
+            rubric,
+            &CourseCodeChecker::default(),
+            &images,
+            &work.join(out),
+            &Format::ALL,
+        )
+        .expect("batch grading works");
+        assert_eq!(entries.len(), 10);
+        secs(t.elapsed())
+    };
+    (
+        time(&builtin_rubric, "builtin"),
+        time(&file_rubric, "scene-file"),
+    )
 }

@@ -9,7 +9,7 @@
 //! stderr says so, and indicatif's bar shows the progress when stderr is a terminal).
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use sha2::{Digest, Sha256};
@@ -28,6 +28,8 @@ use crate::image_io::decode_exr;
 pub struct CompareImageChecker {
     /// How to compare (samples per pixel, encoding, false-failure rate).
     pub options: CompareOptions,
+    /// The golden cache folder for scene files; `None`: [`crate::golden::cache_dir`].
+    pub cache_dir: Option<PathBuf>,
     goldens: Mutex<HashMap<String, (Arc<Golden>, String)>>,
 }
 
@@ -36,6 +38,7 @@ impl CompareImageChecker {
     pub fn new(options: CompareOptions) -> Self {
         CompareImageChecker {
             options,
+            cache_dir: None,
             goldens: Mutex::new(HashMap::new()),
         }
     }
@@ -74,8 +77,10 @@ impl CompareImageChecker {
             None => {
                 let spp = golden_spp(self.options.samples_per_pixel);
                 let camera = f.description.camera(None);
-                let cache_file = crate::golden::cache_dir()
-                    .map(|d| crate::golden::cache_file(&d, &f.description, spp));
+                let dir = self.cache_dir.clone().or_else(crate::golden::cache_dir);
+                let cache_file = dir
+                    .as_ref()
+                    .map(|d| crate::golden::cache_file(d, &f.description, spp));
                 if !cache_file.as_ref().is_some_and(|p| p.is_file()) {
                     eprintln!(
                         "rendering the golden of {} ({}x{}, {spp} spp), once per cache{}",
@@ -88,8 +93,14 @@ impl CompareImageChecker {
                         ))
                     );
                 }
-                let made = crate::golden::cached_golden(&f.description, &f.label, spp, true)
-                    .map_err(|e| CompareError::Golden(e.to_string()))?;
+                let made = crate::golden::cached_golden_in(
+                    dir.as_deref(),
+                    &f.description,
+                    &f.label,
+                    spp,
+                    true,
+                )
+                .map_err(|e| CompareError::Golden(e.to_string()))?;
                 if let Some(why) = &made.warning {
                     eprintln!(
                         "warning: the golden of {} is not cached ({}); it is rendered again next time",

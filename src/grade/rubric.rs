@@ -563,6 +563,38 @@ mod tests {
     }
 
     #[test]
+    fn a_scene_file_group_reads_its_scene_relative_to_the_rubric_and_names_the_image_after_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = crate::scene::builtin("week04-quad").unwrap().to_toml();
+        std::fs::create_dir(dir.path().join("scenes")).unwrap();
+        std::fs::write(dir.path().join("scenes/tri.toml"), &scene).unwrap();
+        let text = "name = \"t\"\n[[group]]\nid = \"image.tri\"\nname = \"T\"\nkind = \"image\"\nscene = \"scenes/tri.toml\"\npoints = 5\n";
+        std::fs::write(dir.path().join("r.toml"), text).unwrap();
+        let r = Rubric::from_file(&dir.path().join("r.toml")).unwrap();
+        let g = &r.groups[0];
+        assert_eq!(g.file.as_deref(), Some("tri.png"));
+        let Some(SceneSource::File(f)) = g.scene_source() else {
+            panic!("a scene file: {:?}", g.scene_source());
+        };
+        assert_eq!(f.label, "scenes/tri.toml");
+        assert_eq!(f.path, dir.path().join("scenes/tri.toml"));
+        assert_eq!(f.sha256, sha256_hex(scene.as_bytes()));
+        assert_eq!(f.description, crate::scene::builtin("week04-quad").unwrap());
+        assert!(f.golden.is_none());
+        // An explicit file wins; a built-in scene stays a built-in.
+        let named = text.replace("points = 5", "file = \"mine.png\"\npoints = 5");
+        let r = Rubric::from_toml_in(&named, "r.toml", dir.path()).unwrap();
+        assert_eq!(r.groups[0].file.as_deref(), Some("mine.png"));
+        assert_eq!(
+            Rubric::week04().groups[2].scene_source(),
+            Some(SceneSource::Builtin("week04-sphere".into()))
+        );
+        // Relative to the rubric, not to the current folder.
+        let e = Rubric::from_toml(text, "r.toml").unwrap_err().to_string();
+        assert!(e.contains("scenes/tri.toml: no such file"), "{e}");
+    }
+
+    #[test]
     fn overrides_parse_and_nonsense_is_refused_with_the_file_named() {
         let custom = WEEK04_RUBRIC
             .replace("points = 30\nvisibility = \"visible\"\n\n[[group]]\nid = \"quad\"", "points = 40\nall_or_nothing = true\nvisibility = \"hidden\"\n\n[[group]]\nid = \"quad\"");
