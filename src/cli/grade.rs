@@ -3,7 +3,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::grade::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
+use rtoracle::grade::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
 use rtoracle::oracle::vectors::read_vectors;
 
 /// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--vectors FILE.jsonl] [--out DIR] [--format all|json,gradescope,junit,markdown]`
@@ -73,6 +73,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .num_threads(args.threads.unwrap_or(0))
         .build()
         .context("cannot start the worker threads")?;
+
+    // The goldens first (a scene file's is rendered once, on every thread), so one that
+    // cannot be made stops the grading before it starts.
+    pool.install(|| images.prepare(&rubric.image_scenes()))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", rubric.source))?;
 
     if let Some(dir) = &args.batch {
         let entries =

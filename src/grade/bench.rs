@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use serde::Deserialize;
 
 use super::CompareImageChecker;
-use super::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
+use super::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 
@@ -297,6 +297,9 @@ pub fn scene_file_batches(work: &Path) -> (f64, f64) {
         let mut images = CompareImageChecker::default();
         images.cache_dir = Some(work.join(format!("{out}-cache")));
         let t = Instant::now();
+        images
+            .prepare(&rubric.image_scenes())
+            .expect("the goldens can be made");
         let entries = batch::grade_batch(
             &subs,
             rubric,

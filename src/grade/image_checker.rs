@@ -146,6 +146,14 @@ impl ImageChecker for CompareImageChecker {
         self.scene_golden_sha256(&SceneSource::Builtin(scene.to_string()))
     }
 
+    fn prepare(&self, scenes: &[SceneSource]) -> Result<(), String> {
+        for scene in scenes {
+            self.golden(scene)
+                .map_err(|e| format!("no golden for {}: {e}", scene.label()))?;
+        }
+        Ok(())
+    }
+
     fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
         self.golden(scene).map(|(_, h)| h).unwrap_or_default()
     }

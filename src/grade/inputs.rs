@@ -56,6 +56,14 @@ pub trait ImageChecker: Sync {
         self.check(candidate_png, scene.label(), heatmap_out)
     }
 
+    /// Makes ready what comparing with `scenes` needs (a golden to render, say) before any
+    /// submission is graded, so a batch does it once with every core of the pool it runs on;
+    /// the error says which scene could not be made ready. The default does nothing.
+    fn prepare(&self, scenes: &[SceneSource]) -> Result<(), String> {
+        let _ = scenes;
+        Ok(())
+    }
+
     /// The SHA-256 (hex) of the golden it compares `scene` with; the default asks
     /// [`golden_sha256`](Self::golden_sha256) with the scene's label.
     fn scene_golden_sha256(&self, scene: &SceneSource) -> String {

@@ -528,6 +528,11 @@ impl Rubric {
         self.groups.iter().map(|g| g.points).sum()
     }
 
+    /// The scenes of the image groups, in order.
+    pub fn image_scenes(&self) -> Vec<SceneSource> {
+        self.groups.iter().filter_map(Group::scene_source).collect()
+    }
+
     /// The shape kinds the code groups need, without repeats, in order.
     pub fn code_shapes(&self) -> Vec<ShapeKind> {
         let set: BTreeSet<ShapeKind> = self.groups.iter().filter_map(|g| g.shape).collect();
