@@ -46,9 +46,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let scenes = if packed.files.is_empty() {
         String::new()
     } else {
+        let n = packed.files.len() / 2;
+        let s = if n == 1 { "" } else { "s" };
         format!(
-            ", {} scene files and goldens in {}/",
-            packed.files.len() / 2,
+            ", {n} scene file{s} and golden{s} in {}/",
             pack::PACKED_SCENES
         )
     };
