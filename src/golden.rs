@@ -128,7 +128,16 @@ pub fn render_golden(
     seed: u64,
     progress: bool,
 ) -> Result<Film, GoldenError> {
-    let description = builtin(scene)?;
+    render_golden_of(&builtin(scene)?, spp, seed, progress)
+}
+
+/// [`render_golden`] of any scene (a built-in or a scene file). Counted by [`golden_renders`].
+pub fn render_golden_of(
+    description: &SceneDescription,
+    spp: u32,
+    seed: u64,
+    progress: bool,
+) -> Result<Film, GoldenError> {
     let options = RenderOptions {
         samples_per_pixel: spp,
         seed,
@@ -136,6 +145,7 @@ pub fn render_golden(
         jitter: PixelJitter::Uniform,
         progress,
     };
+    RENDERS.fetch_add(1, Ordering::Relaxed);
     Ok(render(
         &description.scene(),
         &description.camera(None),
@@ -157,7 +167,7 @@ pub fn golden_bytes(
 
 /// The bytes of the golden file of any scene (a built-in or a scene file), named `name` in its
 /// `rtoracle.scene` attribute: rendered at the scene's own size with `spp` samples per pixel,
-/// `seed`, uniform jitter and the per-sample variance. Counted by [`golden_renders`].
+/// `seed`, uniform jitter and the per-sample variance ([`render_golden_of`]).
 pub fn golden_bytes_of(
     description: &SceneDescription,
     name: &str,
@@ -165,15 +175,7 @@ pub fn golden_bytes_of(
     seed: u64,
     progress: bool,
 ) -> Result<Vec<u8>, GoldenError> {
-    let options = RenderOptions {
-        samples_per_pixel: spp,
-        seed,
-        variance: true,
-        jitter: PixelJitter::Uniform,
-        progress,
-    };
-    RENDERS.fetch_add(1, Ordering::Relaxed);
-    let film = render(&description.scene(), &description.camera(None), &options)?;
+    let film = render_golden_of(description, spp, seed, progress)?;
     let attributes = golden_attributes(name, description, spp, seed);
     Ok(encode_exr(
         &film,
@@ -184,8 +186,8 @@ pub fn golden_bytes_of(
 
 static RENDERS: AtomicUsize = AtomicUsize::new(0);
 
-/// How many goldens [`golden_bytes_of`] (and so [`golden_bytes`] and [`cached_golden`]) has
-/// rendered in this process: a cache hit renders none.
+/// How many goldens [`render_golden_of`] (and so [`render_golden`], [`golden_bytes`] and
+/// [`cached_golden`]) has rendered in this process: a cache hit renders none.
 pub fn golden_renders() -> usize {
     RENDERS.load(Ordering::Relaxed)
 }
