@@ -36,6 +36,9 @@ impl Target {
 
 /// `rtoracle check`.
 #[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Without --python-course or --adapter, checks the course submission in the current folder (as --python-course .)."
+)]
 pub struct Args {
     #[command(flatten)]
     target: Target,
