@@ -23,7 +23,7 @@ fn embed_fixtures() {
     let root = std::path::PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").unwrap());
     let base = root.join("tests/fixtures");
     let mut files = Vec::new();
-    for top in ["submissions", "python/common"] {
+    for top in ["submissions", "python/common", "python/triangle_assignment"] {
         println!("cargo::rerun-if-changed=tests/fixtures/{top}");
         collect(&base.join(top), &mut files);
     }

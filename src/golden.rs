@@ -11,12 +11,20 @@
 //! ([`embedded_golden`]), so an installed `rtoracle` has them without the source tree.
 //! [`compare_goldens`] compares two goldens pixel by pixel within a [`Tolerance`]; `rtoracle
 //! golden --check` and the test suite's insta snapshots use it.
+//!
+//! Goldens of instructors' own scene files ([`golden_bytes_of`]) are the same kind of file,
+//! rendered the first time they are needed and kept in a cache ([`cached_golden`]) keyed by the
+//! scene's content hash, the sample count and the tool version: a batch renders each one once,
+//! and a golden is never used for a scene it was not made from ([`golden_fits`]).
 
-use std::path::Path;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use sha2::{Digest, Sha256};
 
-use crate::image_io::{ExrImage, ImageError, decode_exr, encode_exr, read_exr};
+use crate::image_io::{ExrImage, ImageError, decode_exr, encode_exr, read_exr, write_atomically};
 use crate::render::{Film, PixelJitter, RenderError, RenderOptions, render};
 use crate::scene::{SceneDescription, SceneError, builtin};
 
@@ -120,7 +128,16 @@ pub fn render_golden(
     seed: u64,
     progress: bool,
 ) -> Result<Film, GoldenError> {
-    let description = builtin(scene)?;
+    render_golden_of(&builtin(scene)?, spp, seed, progress)
+}
+
+/// [`render_golden`] of any scene (a built-in or a scene file). Counted by [`golden_renders`].
+pub fn render_golden_of(
+    description: &SceneDescription,
+    spp: u32,
+    seed: u64,
+    progress: bool,
+) -> Result<Film, GoldenError> {
     let options = RenderOptions {
         samples_per_pixel: spp,
         seed,
@@ -128,6 +145,7 @@ pub fn render_golden(
         jitter: PixelJitter::Uniform,
         progress,
     };
+    RENDERS.fetch_add(1, Ordering::Relaxed);
     Ok(render(
         &description.scene(),
         &description.camera(None),
@@ -144,13 +162,190 @@ pub fn golden_bytes(
     progress: bool,
 ) -> Result<Vec<u8>, GoldenError> {
     let description = builtin(scene)?;
-    let film = render_golden(scene, spp, seed, progress)?;
-    let attributes = golden_attributes(scene, &description, spp, seed);
+    golden_bytes_of(&description, scene, spp, seed, progress)
+}
+
+/// The bytes of the golden file of any scene (a built-in or a scene file), named `name` in its
+/// `rtoracle.scene` attribute: rendered at the scene's own size with `spp` samples per pixel,
+/// `seed`, uniform jitter and the per-sample variance ([`render_golden_of`]).
+pub fn golden_bytes_of(
+    description: &SceneDescription,
+    name: &str,
+    spp: u32,
+    seed: u64,
+    progress: bool,
+) -> Result<Vec<u8>, GoldenError> {
+    let film = render_golden_of(description, spp, seed, progress)?;
+    let attributes = golden_attributes(name, description, spp, seed);
     Ok(encode_exr(
         &film,
         &attributes,
-        Path::new(&golden_file_name(scene)),
+        Path::new(&golden_file_name(name)),
     )?)
+}
+
+static RENDERS: AtomicUsize = AtomicUsize::new(0);
+
+/// How many goldens [`render_golden_of`] (and so [`render_golden`], [`golden_bytes`] and
+/// [`cached_golden`]) has rendered in this process: a cache hit renders none.
+pub fn golden_renders() -> usize {
+    RENDERS.load(Ordering::Relaxed)
+}
+
+/// The folder rtoracle caches in: `$RTORACLE_CACHE_DIR`, else `$XDG_CACHE_HOME/rtoracle`, else
+/// `$HOME/.cache/rtoracle` (empty variables count as unset); `None` when none is set.
+pub fn cache_dir() -> Option<PathBuf> {
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    env("RTORACLE_CACHE_DIR")
+        .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("rtoracle")))
+        .or_else(|| env("HOME").map(|d| d.join(".cache").join("rtoracle")))
+}
+
+/// Where [`cached_golden`] keeps the golden of a scene in cache folder `dir`:
+/// `goldens/<scene sha256>-<spp>spp-<version>.exr`, keyed by the scene's content
+/// ([`scene_sha256`]), the sample count and the tool version (the seed is always
+/// [`GOLDEN_SEED`]), so editing the scene or upgrading rtoracle renders a new one.
+pub fn cache_file(dir: &Path, description: &SceneDescription, spp: u32) -> PathBuf {
+    dir.join("goldens").join(format!(
+        "{}-{spp}spp-{}.exr",
+        scene_sha256(description),
+        env!("CARGO_PKG_VERSION")
+    ))
+}
+
+/// A golden [`cached_golden`] found or made.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CachedGolden {
+    /// The EXR's bytes.
+    pub bytes: Vec<u8>,
+    /// The cache file holding them, or `None` when there is no cache folder or it could not be
+    /// written (the golden was rendered for this process only; [`CachedGolden::warning`] says
+    /// why).
+    pub path: Option<PathBuf>,
+    /// Whether this call rendered it (false: read from the cache).
+    pub rendered: bool,
+    /// Why the golden could not be cached, when it could not.
+    pub warning: Option<String>,
+}
+
+/// One lock per cache key, so the members of a batch render each golden once.
+fn key_lock(key: &Path) -> Arc<Mutex<()>> {
+    static LOCKS: OnceLock<Mutex<HashMap<PathBuf, Arc<Mutex<()>>>>> = OnceLock::new();
+    let mut locks = LOCKS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    Arc::clone(locks.entry(key.to_path_buf()).or_default())
+}
+
+/// The golden of `description` (named `name` in the file) with `spp` samples per pixel and
+/// [`GOLDEN_SEED`], from the cache ([`cache_dir`], [`cache_file`]) or, the first time, rendered
+/// (`progress`: a bar on stderr when it is a terminal) and written there atomically (a
+/// temporary file renamed into place, so another process never reads half a golden).
+///
+/// Within a process, callers asking for the same key wait for the first one's render instead
+/// of rendering again; across processes, two may render the same golden at the same time, and
+/// both write the same bytes. A cache file that is not a golden of this scene (corrupt, or
+/// made by another tool) is rendered again and replaced.
+pub fn cached_golden(
+    description: &SceneDescription,
+    name: &str,
+    spp: u32,
+    progress: bool,
+) -> Result<CachedGolden, GoldenError> {
+    cached_golden_in(cache_dir().as_deref(), description, name, spp, progress)
+}
+
+/// [`cached_golden`] with the cache in folder `dir` (`None`: no cache, always render).
+pub fn cached_golden_in(
+    dir: Option<&Path>,
+    description: &SceneDescription,
+    name: &str,
+    spp: u32,
+    progress: bool,
+) -> Result<CachedGolden, GoldenError> {
+    let Some(dir) = dir else {
+        let bytes = golden_bytes_of(description, name, spp, GOLDEN_SEED, progress)?;
+        return Ok(CachedGolden {
+            bytes,
+            path: None,
+            rendered: true,
+            warning: Some(
+                "no cache folder (set RTORACLE_CACHE_DIR, XDG_CACHE_HOME or HOME)".to_string(),
+            ),
+        });
+    };
+    let path = cache_file(dir, description, spp);
+    let lock = key_lock(&path);
+    let _held = lock.lock().unwrap_or_else(|e| e.into_inner());
+    if let Ok(bytes) = std::fs::read(&path) {
+        if golden_fits(&bytes, &path, description).is_ok() {
+            return Ok(CachedGolden {
+                bytes,
+                path: Some(path),
+                rendered: false,
+                warning: None,
+            });
+        }
+    }
+    let bytes = golden_bytes_of(description, name, spp, GOLDEN_SEED, progress)?;
+    let written = std::fs::create_dir_all(path.parent().expect("a file in goldens/"))
+        .map_err(|e| format!("{}: cannot create the cache folder: {e}", dir.display()))
+        .and_then(|()| write_atomically(&path, &bytes).map_err(|e| e.to_string()));
+    Ok(match written {
+        Ok(()) => CachedGolden {
+            bytes,
+            path: Some(path),
+            rendered: true,
+            warning: None,
+        },
+        Err(why) => CachedGolden {
+            bytes,
+            path: None,
+            rendered: true,
+            warning: Some(why),
+        },
+    })
+}
+
+/// Checks that EXR `bytes` (read from `source`) are a golden of `description`: an EXR with a
+/// `variance` layer, the scene's size and its content hash in `rtoracle.sceneSha256`. The error
+/// is one line without the file name.
+pub fn golden_fits(
+    bytes: &[u8],
+    source: &Path,
+    description: &SceneDescription,
+) -> Result<ExrImage, String> {
+    let image = decode_exr(bytes, source).map_err(|e| {
+        let text = e.to_string();
+        let prefix = format!("{}: ", source.display());
+        text.strip_prefix(&prefix).map(String::from).unwrap_or(text)
+    })?;
+    let camera = description.camera(None);
+    if (image.width, image.height) != (camera.width, camera.height) {
+        return Err(format!(
+            "is {}x{} but the scene is {}x{}",
+            image.width, image.height, camera.width, camera.height
+        ));
+    }
+    let want = scene_sha256(description);
+    match image.attribute(ATTR_SCENE_SHA256) {
+        Some(h) if h == want => {}
+        Some(h) => {
+            return Err(format!(
+                "was made from another scene ({ATTR_SCENE_SHA256} {h}, but the scene's is {want})"
+            ));
+        }
+        None => return Err(format!("has no {ATTR_SCENE_SHA256} attribute")),
+    }
+    if image.variance.is_none() {
+        return Err("has no 'variance' layer".to_string());
+    }
+    Ok(image)
 }
 
 /// Reads a golden (or any EXR [`read_exr`] reads).
@@ -422,6 +617,58 @@ mod tests {
             d.summary(2)
                 .contains("the size is 3x1 but 2x1 was expected")
         );
+    }
+
+    fn tiny_scene(radius: f64) -> SceneDescription {
+        let mut d = builtin("week04-sphere").unwrap();
+        d.image.width = 8;
+        if let crate::scene::ObjectEntry::Sphere { radius: r, .. } = &mut d.objects[1] {
+            *r = radius;
+        }
+        d
+    }
+
+    #[test]
+    fn the_cache_renders_each_golden_once_even_when_asked_concurrently() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = tiny_scene(0.5);
+        let results: Vec<CachedGolden> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..4)
+                .map(|_| s.spawn(|| cached_golden_in(Some(dir.path()), &d, "tiny", 4, false)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap().unwrap())
+                .collect()
+        });
+        assert_eq!(results.iter().filter(|r| r.rendered).count(), 1);
+        let path = cache_file(dir.path(), &d, 4);
+        assert!(
+            results
+                .iter()
+                .all(|r| r.path.as_deref() == Some(path.as_path()))
+        );
+        let on_disk = std::fs::read(&path).unwrap();
+        assert!(results.iter().all(|r| r.bytes == on_disk));
+        // The file is the golden of this scene and of no other.
+        assert!(golden_fits(&on_disk, &path, &d).is_ok());
+        let other = tiny_scene(0.3);
+        let e = golden_fits(&on_disk, &path, &other).unwrap_err();
+        assert!(e.contains("another scene"), "{e}");
+        let mut wider = d.clone();
+        wider.image.width = 9;
+        assert!(
+            golden_fits(&on_disk, &path, &wider)
+                .unwrap_err()
+                .contains("is 8x")
+        );
+        // Another scene has another key; a corrupt cache file is rendered again.
+        assert_ne!(cache_file(dir.path(), &other, 4), path);
+        std::fs::write(&path, b"junk").unwrap();
+        let again = cached_golden_in(Some(dir.path()), &d, "tiny", 4, false).unwrap();
+        assert!(again.rendered);
+        assert_eq!(again.bytes, on_disk);
+        assert_eq!(std::fs::read(&path).unwrap(), on_disk);
     }
 
     #[test]

@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::grade::{Rubric, autograder};
+use rtoracle::grade::{Rubric, autograder, pack};
 
 /// `rtoracle autograder --out autograder.zip [--rubric FILE.toml] [--binary PATH]`
 #[derive(Debug, clap::Args)]
@@ -10,7 +10,9 @@ pub struct Args {
     /// The package to write.
     #[arg(long, value_name = "ZIP", default_value = "autograder.zip")]
     out: PathBuf,
-    /// The rubric to grade with (default: the built-in week-4 rubric).
+    /// The rubric to grade with (default: the built-in week-4 rubric). Its scene files and
+    /// their goldens are packed too (missing goldens are rendered now), so Gradescope never
+    /// renders.
     #[arg(long, value_name = "FILE.toml")]
     rubric: Option<PathBuf>,
     /// The rtoracle binary to pack (default: this one). It must be an x86_64 Linux executable,
@@ -28,19 +30,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(binary) = &args.binary {
         check_is_rtoracle(binary)?;
     }
-    let (rubric_text, rubric_seed) = match &args.rubric {
-        Some(path) => {
-            // Validate it now, so a bad rubric fails here and not on Gradescope.
-            let rubric = Rubric::from_file(path)?;
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("{}: cannot read the rubric", path.display()))?;
-            (text, rubric.seed)
-        }
-        None => (
-            rtoracle::grade::rubric::WEEK04_RUBRIC.to_string(),
-            Rubric::week04().seed,
-        ),
-    };
     if args.seed.is_some_and(|s| s > i64::MAX as u64) {
         anyhow::bail!(
             "--seed {}: at most {} (a TOML integer)",
@@ -48,6 +37,29 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             i64::MAX
         );
     }
+    let binary = match args.binary {
+        Some(b) => b,
+        None => std::env::current_exe().context("cannot find the running rtoracle binary")?,
+    };
+    // Refuse a wrong binary before rendering any golden.
+    autograder::check_binary(&binary)?;
+    let (packed, rubric_seed) = match &args.rubric {
+        Some(path) => {
+            // Validate it now, so a bad rubric fails here and not on Gradescope.
+            let rubric = Rubric::from_file(path)?;
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("{}: cannot read the rubric", path.display()))?;
+            (pack::pack_rubric(&rubric, &text)?, rubric.seed)
+        }
+        None => (
+            pack::PackedRubric {
+                rubric_toml: rtoracle::grade::rubric::WEEK04_RUBRIC.to_string(),
+                files: vec![],
+                rendered: 0,
+            },
+            Rubric::week04().seed,
+        ),
+    };
     let (seed, how) = match (args.seed, rubric_seed) {
         (Some(s), _) => (s, "from --seed"),
         (None, s) if s != 0 => (s, "the rubric's"),
@@ -56,14 +68,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "secret, drawn now",
         ),
     };
-    let rubric_text = autograder::with_seed(&rubric_text, seed);
-    let binary = match args.binary {
-        Some(b) => b,
-        None => std::env::current_exe().context("cannot find the running rtoracle binary")?,
+    let rubric_text = autograder::with_seed(&packed.rubric_toml, seed);
+    autograder::build_package_with(&binary, &rubric_text, &packed.files, &args.out)?;
+    let scenes = if packed.files.is_empty() {
+        String::new()
+    } else {
+        let n = packed.files.len() / 2;
+        let s = if n == 1 { "" } else { "s" };
+        format!(
+            ", {n} scene file{s} and golden{s} in {}/",
+            pack::PACKED_SCENES
+        )
     };
-    autograder::build_package(&binary, &rubric_text, &args.out)?;
     errln!(
-        "wrote {} (setup.sh, run_autograder, rubric.toml with seed {seed} ({how}), rtoracle from {}); upload it as the assignment's autograder",
+        "wrote {} (setup.sh, run_autograder, rubric.toml with seed {seed} ({how}), rtoracle from {}{scenes}); upload it as the assignment's autograder",
         args.out.display(),
         binary.display()
     );

@@ -11,9 +11,10 @@ use rtoracle::oracle::{
     Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
 };
 
-/// Which candidate to run (shared by `check` and `fuzz`).
+/// Which candidate to run (shared by `check` and `fuzz`; `check` without either checks the
+/// course submission in the current folder).
 #[derive(Debug, clap::Args)]
-#[group(required = true, multiple = false)]
+#[group(required = false, multiple = false)]
 pub struct Target {
     /// A submission folder in the course's Python layout (RT_utility.py, RT_ray.py,
     /// RT_object.py), run through the bundled adapter.
@@ -77,7 +78,7 @@ impl Target {
     /// The profile a candidate is judged by when `--profile` is not given: `course` for the
     /// course adapter, `robust` for an `--adapter` (another renderer).
     pub fn default_profile(&self) -> Profile {
-        if self.python_course.is_some() {
+        if self.adapter.is_none() {
             Profile::Course
         } else {
             Profile::Robust
@@ -90,7 +91,7 @@ impl Target {
         Ok(match (&self.python_course, &self.adapter) {
             (Some(dir), _) => CandidateCommand::python_course(dir)?,
             (_, Some(cmd)) => CandidateCommand::adapter(cmd)?,
-            _ => unreachable!("clap requires one"),
+            _ => anyhow::bail!("give the candidate: --python-course DIR or --adapter 'CMD ARGS'"),
         })
     }
 }
@@ -121,6 +122,9 @@ impl Target {
 
 /// `rtoracle check`.
 #[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Without --python-course or --adapter, checks the course submission in the current folder (as --python-course .)."
+)]
 pub struct Args {
     #[command(flatten)]
     target: Target,
@@ -147,6 +151,20 @@ pub struct Args {
     show: usize,
 }
 
+/// `rtoracle check` with no candidate: the course submission in the current folder, as
+/// `--python-course .`, announced on stderr (stdout stays the report, JSON with `--json`).
+fn current_submission() -> anyhow::Result<CandidateCommand> {
+    let here = std::env::current_dir().context("cannot read the current folder")?;
+    let shown = rtoracle::escape::terminal_line(&here.display().to_string());
+    if !here.join("RT_object.py").is_file() {
+        anyhow::bail!(
+            "no RT_object.py in {shown}: run `rtoracle check` in a course submission folder (RT_utility.py, RT_ray.py, RT_object.py), or give --python-course DIR or --adapter 'CMD ARGS'"
+        );
+    }
+    errln!("checking the course submission in {shown} (as --python-course .)");
+    Ok(CandidateCommand::python_course(&here)?)
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.target.check()?;
     let judging = args.judging.judging(args.target.default_profile());
@@ -169,7 +187,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         hello_timeout: Duration::from_millis(args.hello_timeout_ms),
         ..RunOptions::default()
     };
-    let command = args.target.command()?;
+    let command = if args.target.python_course.is_none() && args.target.adapter.is_none() {
+        current_submission()?
+    } else {
+        args.target.command()?
+    };
     let mut report = check_command(command, &cases, options).context("check")?;
     report.judged_by = Some(judged_by);
     let text = if args.json {

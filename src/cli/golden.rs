@@ -3,14 +3,23 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use rtoracle::golden::{
-    GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_file_name,
+    GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_bytes_of,
+    golden_file_name,
 };
 use rtoracle::image_io::{decode_exr, write_atomically};
-use rtoracle::scene::{builtin, builtin_names};
+use rtoracle::scene::{SceneDescription, builtin, builtin_names};
 
-/// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`
+/// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`, or
+/// `rtoracle golden FILE.toml -o FILE.exr [--spp N]` for a scene file.
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    /// A scene file (TOML) to make the golden of, instead of the built-in scenes; a rubric's
+    /// image group names it with `golden = "FILE.exr"`.
+    #[arg(value_name = "FILE.toml", requires = "out", conflicts_with_all = ["check", "scenes", "dir"])]
+    scene_file: Option<PathBuf>,
+    /// Where to write the scene file's golden (EXR).
+    #[arg(short, long, value_name = "FILE.exr", requires = "scene_file")]
+    out: Option<PathBuf>,
     /// Verify instead of writing: regenerate each golden in memory and compare it with the file,
     /// pixel by pixel within a small tolerance. Exit 0 when all are equal, 1 when one differs,
     /// 2 when a file cannot be read.
@@ -29,6 +38,9 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let spp = args.spp;
+    if let (Some(file), Some(out)) = (&args.scene_file, &args.out) {
+        return write_scene_file(file, out, spp);
+    }
     let scenes: Vec<String> = if args.scenes.is_empty() {
         builtin_names().into_iter().map(String::from).collect()
     } else {
@@ -59,6 +71,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         write(&args.dir, &scenes, spp)
     }
+}
+
+fn write_scene_file(file: &Path, out: &Path, spp: u32) -> anyhow::Result<ExitCode> {
+    let description = SceneDescription::from_file(file)?;
+    if out.extension().and_then(|e| e.to_str()) != Some("exr") {
+        anyhow::bail!("-o {}: the golden must be an .exr file", out.display());
+    }
+    rtoracle::output::check_output_file(out, "-o")?;
+    let name = file
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| file.display().to_string());
+    let start = Instant::now();
+    let bytes = golden_bytes_of(&description, &name, spp, GOLDEN_SEED, true)?;
+    write_atomically(out, &bytes)?;
+    outln!(
+        "wrote {} ({spp} spp, seed {GOLDEN_SEED}, {} bytes) in {:.1} s",
+        out.display(),
+        bytes.len(),
+        start.elapsed().as_secs_f64()
+    )?;
+    Ok(ExitCode::SUCCESS)
 }
 
 fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::escape::terminal_line;
-use rtoracle::grade::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
+use rtoracle::grade::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
 use rtoracle::oracle::vectors::read_vectors;
 
 /// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--vectors FILE.jsonl] [--out DIR] [--format all|json,gradescope,junit,markdown]`
@@ -124,11 +124,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let public_seed = (code.vectors.is_none() && rubric.seed == 0).then_some(
         "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
     );
-    let images = rtoracle::compare::CompareImageChecker::default();
+    let images = rtoracle::grade::CompareImageChecker::default();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()
         .context("cannot start the worker threads")?;
+
+    // The goldens first (a scene file's is rendered once, on every thread), so one that
+    // cannot be made stops the grading before it starts.
+    pool.install(|| images.prepare(&rubric.image_scenes()))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", rubric.source))?;
 
     if let Some(dir) = &args.batch {
         let entries =

@@ -288,14 +288,7 @@ const CACHE_MAGIC: &[u8] = b"rtoracle golden cache v1\n";
 /// The folder goldens are cached in: `$RTORACLE_CACHE_DIR`, else `$XDG_CACHE_HOME/rtoracle`,
 /// else `~/.cache/rtoracle`.
 pub fn cache_dir() -> Option<PathBuf> {
-    let env = |k: &str| {
-        std::env::var_os(k)
-            .filter(|v| !v.is_empty())
-            .map(PathBuf::from)
-    };
-    env("RTORACLE_CACHE_DIR")
-        .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("rtoracle")))
-        .or_else(|| env("HOME").map(|d| d.join(".cache").join("rtoracle")))
+    crate::golden::cache_dir()
 }
 
 /// The cache file of a scene's golden: keyed by the scene's content, `M`, the seed and the tool

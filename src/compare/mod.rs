@@ -9,7 +9,6 @@
 //! common mistakes as alternative hypotheses. See `docs/sections/compare.md`.
 
 pub mod bench;
-pub mod checker;
 pub mod diagnose;
 pub mod encoding;
 pub mod golden;
@@ -23,7 +22,6 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-pub use checker::CompareImageChecker;
 pub use encoding::{ENCODINGS, Encoding};
 pub use golden::{Golden, golden_for_scene, golden_spp};
 pub use heatmap::write_heatmap;

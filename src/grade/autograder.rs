@@ -39,6 +39,11 @@ mkdir -p "$prefix/bin" "$prefix/share"
 install -m 0755 rtoracle "$prefix/bin/rtoracle"
 # The rubric holds the secret seed of the suite: readable by root (the grader) only.
 install -m 0600 rubric.toml "$prefix/share/rtoracle-rubric.toml"
+# The rubric's own scene files and their goldens (rubric.toml names them relative to itself).
+if [ -d rtoracle-scenes ]; then
+    mkdir -p "$prefix/share/rtoracle-scenes"
+    install -m 0644 rtoracle-scenes/* "$prefix/share/rtoracle-scenes/"
+fi
 has_modules() { [ -n "$1" ] && [ -x "$1" ] && "$1" -I -c "import numpy, PIL" >/dev/null 2>&1; }
 python=""
 for p in /usr/bin/python3 /usr/local/bin/python3 "$(command -v python3 || true)"; do
@@ -178,12 +183,38 @@ pub fn is_linux_x86_64_elf(bytes: &[u8]) -> bool {
         && u16::from_le_bytes([bytes[18], bytes[19]]) == 0x3e // EM_X86_64
 }
 
+/// Checks that `binary` can be read and is an x86_64 Linux executable, as the package needs.
+pub fn check_binary(binary: &Path) -> Result<(), AutograderError> {
+    let bin = std::fs::read(binary).map_err(|e| AutograderError::Binary {
+        path: binary.display().to_string(),
+        message: e.to_string(),
+    })?;
+    if is_linux_x86_64_elf(&bin) {
+        Ok(())
+    } else {
+        Err(AutograderError::NotLinuxX86_64 {
+            path: binary.display().to_string(),
+        })
+    }
+}
+
 /// Writes the package to `out_zip` (atomically): `setup.sh`, `run_autograder`, `rtoracle` (the
 /// file `binary`) and `rubric.toml` (`rubric_toml`). Entries have fixed times, so the same inputs
 /// give the same bytes.
 pub fn build_package(
     binary: &Path,
     rubric_toml: &str,
+    out_zip: &Path,
+) -> Result<(), AutograderError> {
+    build_package_with(binary, rubric_toml, &[], out_zip)
+}
+
+/// [`build_package`] with `extra` files (path in the package, bytes) after the others: the
+/// rubric's scene files and goldens ([`super::pack::pack_rubric`]).
+pub fn build_package_with(
+    binary: &Path,
+    rubric_toml: &str,
+    extra: &[(String, Vec<u8>)],
     out_zip: &Path,
 ) -> Result<(), AutograderError> {
     let bin = std::fs::read(binary).map_err(|e| AutograderError::Binary {
@@ -215,6 +246,11 @@ pub fn build_package(
     ];
     for (name, bytes, mode) in files {
         zip.start_file(name, options(mode))
+            .map_err(|e| write_err(&e))?;
+        zip.write_all(bytes).map_err(|e| write_err(&e))?;
+    }
+    for (name, bytes) in extra {
+        zip.start_file(name.as_str(), options(0o644))
             .map_err(|e| write_err(&e))?;
         zip.write_all(bytes).map_err(|e| write_err(&e))?;
     }

@@ -1,14 +1,18 @@
 //! The fixture submissions of this repository, made into real submissions, and the grading
-//! benchmark (`cargo bench --bench grade`): one submission, and a batch of 30 on 2 threads,
-//! against a baseline measured in the same run (starting Python once).
+//! benchmark (`cargo bench --bench grade`, `rtoracle bench grade`): one submission, and a batch
+//! of 30 on 2 threads, against a baseline measured in the same run (starting Python once); and a
+//! batch of 10 triangle submissions against the 160x160 scene file of
+//! `examples/rubrics/triangles.toml` with a cold golden cache, against the same batch with the
+//! built-in `triangles` scene (embedded golden) in the same run: the golden is rendered once
+//! per cache, not once per submission.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
-use super::{CourseCodeChecker, Format, Rubric, batch, grade_to_dir};
-use crate::compare::CompareImageChecker;
+use super::CompareImageChecker;
+use super::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 
@@ -212,6 +216,7 @@ pub fn run() -> String {
         assert_eq!(entries.len(), 30);
         secs(t.elapsed())
     });
+    let (builtin, scene_file) = pool.install(|| scene_file_batches(work.path()));
     let mut report = String::new();
     report.push_str(&format!(
         "grade benchmark (2 threads; fixtures: {})",
@@ -236,5 +241,103 @@ pub fn run() -> String {
         batch_time / 30.0
     ));
     report.push('\n');
+    report.push_str(&format!(
+        "  batch of 10, built-in scene 'triangles'  {:8.3} s  (embedded golden)",
+        builtin
+    ));
+    report.push('\n');
+    report.push_str(&format!(
+        "  batch of 10, 160x160 scene file          {:8.3} s  = {:6.2} x built-in  (cold golden cache; target < 2 x)",
+        scene_file,
+        scene_file / builtin
+    ));
+    report.push('\n');
     report
+}
+
+/// Grades 10 honest triangle submissions twice, with the triangle rubric of `examples/rubrics`
+/// (code and image groups): once with its image group on the built-in `triangles` scene, once
+/// on its scene file with an empty golden cache. Returns both times in seconds.
+pub fn scene_file_batches(work: &Path) -> (f64, f64) {
+    // The example rubric and its scene file, embedded so an installed binary can run this too.
+    let rubrics = work.join("rubrics");
+    std::fs::create_dir_all(&rubrics).expect("a rubric folder");
+    let text = include_str!("../../examples/rubrics/triangles.toml");
+    let rubric_path = rubrics.join("triangles.toml");
+    std::fs::write(&rubric_path, text).expect("write the example rubric");
+    std::fs::write(
+        rubrics.join("triangles-scene.toml"),
+        include_str!("../../examples/rubrics/triangles-scene.toml"),
+    )
+    .expect("write the example scene");
+    let file_rubric = Rubric::from_file(&rubric_path).expect("the example rubric is valid");
+    let builtin_rubric = Rubric::from_toml(
+        &text.replace(
+            "scene = \"triangles-scene.toml\"",
+            "scene = \"triangles\"\nfile = \"triangles.png\"",
+        ),
+        "triangles (built-in scene)",
+    )
+    .expect("the built-in variant is valid");
+    let scene_file = file_rubric.groups[1]
+        .scene_file
+        .clone()
+        .expect("a scene-file group");
+    let subs = work.join("triangle-subs");
+    for i in 0..10u64 {
+        let dest = subs.join(format!("{i:02}"));
+        std::fs::create_dir_all(&dest).expect("a submission folder");
+        for (path, bytes) in FIXTURE_FILES {
+            let name = path
+                .strip_prefix("python/common/")
+                .or_else(|| path.strip_prefix("python/triangle_assignment/"));
+            if let Some(name) = name.filter(|n| n.ends_with(".py") && !n.contains('/')) {
+                std::fs::write(dest.join(name), bytes).expect("write a course module");
+            }
+        }
+        let builtin = crate::scene::builtin("triangles").expect("the built-in scene");
+        for (d, name) in [
+            (&scene_file.description, "triangles-scene.png"),
+            (&builtin, "triangles.png"),
+        ] {
+            let options = RenderOptions {
+                samples_per_pixel: 20,
+                seed: 100 + i,
+                ..Default::default()
+            };
+            let film = render(&d.scene(), &d.camera(None), &options).expect("a render");
+            write_png(
+                &dest.join(name),
+                &Rgb8Image {
+                    width: film.width,
+                    height: film.height,
+                    data: film.to_course_rgb8(),
+                },
+            )
+            .expect("write the image");
+        }
+    }
+    let time = |rubric: &Rubric, out: &str| {
+        let mut images = CompareImageChecker::default();
+        images.cache_dir = Some(work.join(format!("{out}-cache")));
+        let t = Instant::now();
+        images
+            .prepare(&rubric.image_scenes())
+            .expect("the goldens can be made");
+        let entries = batch::grade_batch(
+            &subs,
+            rubric,
+            &CourseCodeChecker::default(),
+            &images,
+            &work.join(out),
+            &Format::ALL,
+        )
+        .expect("batch grading works");
+        assert_eq!(entries.len(), 10);
+        secs(t.elapsed())
+    };
+    (
+        time(&builtin_rubric, "builtin"),
+        time(&file_rubric, "scene-file"),
+    )
 }

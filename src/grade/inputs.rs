@@ -3,8 +3,8 @@
 //!
 //! [`grade`](super::grade) only ever talks to a [`CodeChecker`] and an [`ImageChecker`]: the
 //! `check` harness ([`CourseCodeChecker`](super::CourseCodeChecker)), the noise-aware comparison
-//! ([`CompareImageChecker`](crate::compare::CompareImageChecker)) and the fakes of the tests
-//! implement them.
+//! ([`CompareImageChecker`](super::CompareImageChecker)) and the fakes of the tests implement
+//! them.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::oracle::vectors::ShapeKind;
+
+pub use super::rubric::{SceneFile, SceneSource};
 
 /// Checks the intersection code of a submission.
 pub trait CodeChecker: Sync {
@@ -40,6 +42,33 @@ pub trait ImageChecker: Sync {
 
     /// The SHA-256 (hex) of the golden/reference it compares `scene` with.
     fn golden_sha256(&self, scene: &str) -> String;
+
+    /// Compares `candidate_png` with the reference of any scene: a built-in one or an
+    /// instructor's scene file. Grading calls this one. The default hands the scene's
+    /// [label](SceneSource::label) to [`check`](Self::check), which is enough for checkers that
+    /// only know built-in scenes (and for fakes).
+    fn check_scene(
+        &self,
+        candidate_png: &Path,
+        scene: &SceneSource,
+        heatmap_out: &Path,
+    ) -> ImageOutcome {
+        self.check(candidate_png, scene.label(), heatmap_out)
+    }
+
+    /// Makes ready what comparing with `scenes` needs (a golden to render, say) before any
+    /// submission is graded, so a batch does it once with every core of the pool it runs on;
+    /// the error says which scene could not be made ready. The default does nothing.
+    fn prepare(&self, scenes: &[SceneSource]) -> Result<(), String> {
+        let _ = scenes;
+        Ok(())
+    }
+
+    /// The SHA-256 (hex) of the golden it compares `scene` with; the default asks
+    /// [`golden_sha256`](Self::golden_sha256) with the scene's label.
+    fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
+        self.golden_sha256(scene.label())
+    }
 }
 
 /// Counts of one shape kind's vectors.

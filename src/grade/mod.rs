@@ -6,12 +6,12 @@
 //! Grading sees the code under test only through [`CodeChecker`] and the images only through
 //! [`ImageChecker`] ([`inputs`]). The code checker is [`CourseCodeChecker`] ([`checkers`]): the
 //! `check` harness running the course adapter in the [sandbox](crate::sandbox); the image
-//! checker is [`CompareImageChecker`](crate::compare::CompareImageChecker), the noise-aware
-//! comparison against the embedded goldens.
+//! checker is [`CompareImageChecker`] ([`image_checker`]), the noise-aware comparison against
+//! the golden of a built-in scene (embedded) or of an instructor's scene file (the rubric's, or
+//! rendered once and cached).
 //!
 //! ```no_run
-//! use rtoracle::compare::CompareImageChecker;
-//! use rtoracle::grade::{CourseCodeChecker, Format, Rubric, grade_to_dir};
+//! use rtoracle::grade::{CompareImageChecker, CourseCodeChecker, Format, Rubric, grade_to_dir};
 //! let report = grade_to_dir(
 //!     "submission".as_ref(),
 //!     &Rubric::week04(),
@@ -28,18 +28,21 @@ pub mod autograder;
 pub mod batch;
 pub mod bench;
 pub mod checkers;
+pub mod image_checker;
 pub mod inputs;
 pub mod intake;
+pub mod pack;
 pub mod report;
 pub mod rubric;
 mod run;
 
 pub use checkers::CourseCodeChecker;
+pub use image_checker::CompareImageChecker;
 pub use inputs::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
-    ImageVerdict,
+    ImageVerdict, SceneFile, SceneSource,
 };
-pub use rubric::{Group, GroupKind, Rubric, RubricError, Visibility};
+pub use rubric::{GoldenFile, Group, GroupKind, Rubric, RubricError, Visibility};
 pub use run::{
     CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, Format, GradeError, GradeReport,
     ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,

@@ -23,10 +23,30 @@
 //! file = "week04_sphere.png"     # for image groups: the file in the submission
 //! scene = "week04-sphere"        # and the built-in scene it must show
 //! points = 20
+//!
+//! [[group]]
+//! id = "image.tri"
+//! name = "Triangle scene image"
+//! kind = "image"
+//! scene = "tri.toml"             # or a scene file, relative to the rubric file
+//! golden = "tri.exr"             # optional: its golden (else rendered once and cached)
+//! file = "tri.png"               # optional for scene files: default the scene's stem + ".png"
+//! points = 20
 //! ```
+//!
+//! An image group's `scene` is a built-in scene when it names one, and otherwise a scene file
+//! (`.toml`) relative to the folder of the rubric file (of the current folder for a rubric
+//! given as text). Loading the rubric reads and validates each scene file and each `golden`
+//! (an EXR with a `variance` layer, the scene's size, and the scene's content hash in its
+//! `rtoracle.sceneSha256` attribute, as `rtoracle golden FILE.toml -o FILE.exr` writes), so a
+//! missing file, an unparsable scene or a golden of another scene stops the grading before it
+//! starts, with one line naming the rubric. Without a `golden`, the image checker renders the
+//! golden the first time it is needed and keeps it in the cache
+//! ([`crate::golden::cached_golden`]).
 
 use std::collections::BTreeSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -127,9 +147,17 @@ pub struct Group {
     /// For image groups: the file name in the submission folder.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub file: Option<String>,
-    /// For image groups: the built-in scene the image must show.
+    /// For image groups: the built-in scene the image must show, or a scene file (`.toml`)
+    /// relative to the rubric's folder.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scene: Option<String>,
+    /// For image groups on a scene file: its golden (EXR) relative to the rubric's folder;
+    /// without it the golden is rendered once and cached.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub golden: Option<String>,
+    /// For image groups on a scene file: the scene file and golden as read at load time.
+    #[serde(skip)]
+    pub scene_file: Option<Arc<SceneFile>>,
     /// The group's points.
     pub points: f64,
     /// Everything or nothing, instead of points in proportion to the vectors passed.
@@ -141,6 +169,64 @@ pub struct Group {
     /// Who sees the group's tests on Gradescope.
     #[serde(default)]
     pub visibility: Visibility,
+}
+
+/// A scene file an image group names, read and validated when the rubric was loaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneFile {
+    /// The `scene` value as the rubric wrote it (the label in reports).
+    pub label: String,
+    /// The file, resolved against the rubric's folder.
+    pub path: PathBuf,
+    /// The scene it describes.
+    pub description: crate::scene::SceneDescription,
+    /// SHA-256 (hex) of the file's bytes.
+    pub sha256: String,
+    /// The golden the rubric names, if it names one.
+    pub golden: Option<GoldenFile>,
+}
+
+/// A golden EXR an image group names, read and validated when the rubric was loaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoldenFile {
+    /// The `golden` value as the rubric wrote it.
+    pub label: String,
+    /// The file, resolved against the rubric's folder.
+    pub path: PathBuf,
+    /// The file's bytes (an EXR golden of the scene).
+    pub bytes: Vec<u8>,
+    /// SHA-256 (hex) of the bytes.
+    pub sha256: String,
+}
+
+/// The scene an image group's image must show.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    /// A built-in scene, by name (`week04-sphere`).
+    Builtin(String),
+    /// An instructor's scene file.
+    File(Arc<SceneFile>),
+}
+
+impl SceneSource {
+    /// The name reports use: the built-in's name, or the `scene` value of the rubric.
+    pub fn label(&self) -> &str {
+        match self {
+            SceneSource::Builtin(name) => name,
+            SceneSource::File(f) => &f.label,
+        }
+    }
+}
+
+impl Group {
+    /// For an image group of a validated rubric: the scene its image must show.
+    pub fn scene_source(&self) -> Option<SceneSource> {
+        match (&self.scene_file, &self.scene) {
+            (Some(f), _) => Some(SceneSource::File(Arc::clone(f))),
+            (None, Some(name)) => Some(SceneSource::Builtin(name.clone())),
+            (None, None) => None,
+        }
+    }
 }
 
 /// A whole rubric.
@@ -200,6 +286,16 @@ pub enum RubricError {
     },
 }
 
+/// An I/O error in a few words ("no such file" rather than "No such file or directory (os
+/// error 2)").
+fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        std::io::ErrorKind::IsADirectory => "is a folder".to_string(),
+        _ => e.to_string(),
+    }
+}
+
 /// SHA-256 of `bytes` as lowercase hex.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
@@ -220,11 +316,18 @@ impl Rubric {
             path: path.display().to_string(),
             message: e.to_string(),
         })?;
-        Rubric::from_toml(&text, &path.display().to_string())
+        let base = path.parent().unwrap_or(Path::new(""));
+        Rubric::from_toml_in(&text, &path.display().to_string(), base)
     }
 
-    /// Parses and validates a rubric; `source` labels errors and the report.
+    /// Parses and validates a rubric; `source` labels errors and the report; scene files are
+    /// relative to the current folder.
     pub fn from_toml(text: &str, source: &str) -> Result<Rubric, RubricError> {
+        Rubric::from_toml_in(text, source, Path::new(""))
+    }
+
+    /// Parses and validates a rubric whose scene and golden files are relative to `base`.
+    pub fn from_toml_in(text: &str, source: &str, base: &Path) -> Result<Rubric, RubricError> {
         let mut rubric: Rubric = toml::from_str(text).map_err(|e| RubricError::Parse {
             path: source.to_string(),
             message: e
@@ -237,7 +340,95 @@ impl Rubric {
         rubric.source = source.to_string();
         rubric.sha256 = sha256_hex(text.as_bytes());
         rubric.validate()?;
+        rubric.read_scene_files(base)?;
         Ok(rubric)
+    }
+
+    /// Reads and checks the scene files and goldens of the image groups, and gives scene-file
+    /// groups without a `file` their default (the scene's stem + `.png`).
+    fn read_scene_files(&mut self, base: &Path) -> Result<(), RubricError> {
+        let source = self.source.clone();
+        let invalid = |message: String| RubricError::Invalid {
+            path: source.clone(),
+            message,
+        };
+        for g in &mut self.groups {
+            let Some(scene) = g.scene.clone() else {
+                continue;
+            };
+            if crate::scene::builtin(&scene).is_ok() {
+                if g.golden.is_some() {
+                    return Err(invalid(format!(
+                        "image group {:?}: the built-in scene {scene:?} has its golden already; golden is for scene files",
+                        g.id
+                    )));
+                }
+                continue;
+            }
+            let path = base.join(&scene);
+            let bytes = std::fs::read(&path).map_err(|e| {
+                invalid(format!(
+                    "image group {:?}: cannot read the scene file {}: {}",
+                    g.id,
+                    path.display(),
+                    io_reason(&e)
+                ))
+            })?;
+            let text = String::from_utf8(bytes.clone()).map_err(|_| {
+                invalid(format!(
+                    "image group {:?}: the scene file {} is not UTF-8 text",
+                    g.id,
+                    path.display()
+                ))
+            })?;
+            let description =
+                crate::scene::SceneDescription::from_toml(&text, &path.display().to_string())
+                    .map_err(|e| invalid(format!("image group {:?}: {e}", g.id)))?;
+            let golden = match &g.golden {
+                None => None,
+                Some(label) => {
+                    let gpath = base.join(label);
+                    let gbytes = std::fs::read(&gpath).map_err(|e| {
+                        invalid(format!(
+                            "image group {:?}: cannot read the golden {}: {}",
+                            g.id,
+                            gpath.display(),
+                            io_reason(&e)
+                        ))
+                    })?;
+                    crate::golden::golden_fits(&gbytes, &gpath, &description).map_err(|why| {
+                        invalid(format!(
+                            "image group {:?}: the golden {} {why}; make it with `rtoracle golden {} -o {}`",
+                            g.id,
+                            gpath.display(),
+                            path.display(),
+                            gpath.display()
+                        ))
+                    })?;
+                    Some(GoldenFile {
+                        label: label.clone(),
+                        path: gpath,
+                        sha256: sha256_hex(&gbytes),
+                        bytes: gbytes,
+                    })
+                }
+            };
+            if g.file.is_none() {
+                let stem = Path::new(&scene)
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().to_string())
+                    .unwrap_or_default();
+                g.file = Some(format!("{stem}.png"));
+            }
+            g.scene_file = Some(Arc::new(SceneFile {
+                label: scene,
+                path,
+                description,
+                sha256: sha256_hex(&bytes),
+                golden,
+            }));
+        }
+        Ok(())
     }
 
     fn validate(&self) -> Result<(), RubricError> {
@@ -279,9 +470,9 @@ impl Rubric {
                             g.id
                         )));
                     }
-                    if g.file.is_some() || g.scene.is_some() {
+                    if g.file.is_some() || g.scene.is_some() || g.golden.is_some() {
                         return Err(invalid(format!(
-                            "code group {:?} takes no file or scene",
+                            "code group {:?} takes no file, scene or golden",
                             g.id
                         )));
                     }
@@ -293,24 +484,48 @@ impl Rubric {
                             g.id
                         )));
                     }
-                    let (Some(file), Some(scene)) = (&g.file, &g.scene) else {
-                        return Err(invalid(format!(
-                            "image group {:?} needs a file and a scene",
-                            g.id
-                        )));
+                    let Some(scene) = &g.scene else {
+                        return Err(invalid(format!("image group {:?} needs a scene", g.id)));
                     };
-                    if file.contains('/') || file.contains('\\') || file.starts_with('.') {
+                    let builtin = crate::scene::builtin(scene).is_ok();
+                    if !builtin && !scene.ends_with(".toml") {
                         return Err(invalid(format!(
-                            "image group {:?}: file {file:?} must be a plain file name",
-                            g.id
-                        )));
-                    }
-                    if crate::scene::builtin(scene).is_err() {
-                        return Err(invalid(format!(
-                            "image group {:?}: unknown scene {scene:?} (known: {})",
+                            "image group {:?}: unknown scene {scene:?} (known: {}; or a scene file FILE.toml relative to the rubric)",
                             g.id,
                             crate::scene::builtin_names().join(", ")
                         )));
+                    }
+                    match &g.file {
+                        None if builtin => {
+                            return Err(invalid(format!(
+                                "image group {:?} needs a file (the image in the submission)",
+                                g.id
+                            )));
+                        }
+                        Some(file)
+                            if file.is_empty()
+                                || file.contains('/')
+                                || file.contains('\\')
+                                || file.starts_with('.') =>
+                        {
+                            return Err(invalid(format!(
+                                "image group {:?}: file {file:?} must be a plain file name",
+                                g.id
+                            )));
+                        }
+                        _ => {}
+                    }
+                    if !builtin {
+                        let stem = Path::new(scene)
+                            .file_stem()
+                            .map(|s| s.to_string_lossy().to_string())
+                            .unwrap_or_default();
+                        if g.file.is_none() && (stem.is_empty() || stem.starts_with('.')) {
+                            return Err(invalid(format!(
+                                "image group {:?}: give a file, the scene file's name {scene:?} makes no image name",
+                                g.id
+                            )));
+                        }
                     }
                     if g.score_ambiguous || g.shape.is_some() {
                         return Err(invalid(format!(
@@ -327,6 +542,11 @@ impl Rubric {
     /// The sum of the groups' points.
     pub fn max_score(&self) -> f64 {
         self.groups.iter().map(|g| g.points).sum()
+    }
+
+    /// The scenes of the image groups, in order.
+    pub fn image_scenes(&self) -> Vec<SceneSource> {
+        self.groups.iter().filter_map(Group::scene_source).collect()
     }
 
     /// The shape kinds the code groups need, without repeats, in order.
@@ -361,6 +581,38 @@ mod tests {
                 .all(|g| !g.all_or_nothing && !g.score_ambiguous)
         );
         assert_eq!(r.sha256, sha256_hex(WEEK04_RUBRIC.as_bytes()));
+    }
+
+    #[test]
+    fn a_scene_file_group_reads_its_scene_relative_to_the_rubric_and_names_the_image_after_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = crate::scene::builtin("week04-quad").unwrap().to_toml();
+        std::fs::create_dir(dir.path().join("scenes")).unwrap();
+        std::fs::write(dir.path().join("scenes/tri.toml"), &scene).unwrap();
+        let text = "name = \"t\"\n[[group]]\nid = \"image.tri\"\nname = \"T\"\nkind = \"image\"\nscene = \"scenes/tri.toml\"\npoints = 5\n";
+        std::fs::write(dir.path().join("r.toml"), text).unwrap();
+        let r = Rubric::from_file(&dir.path().join("r.toml")).unwrap();
+        let g = &r.groups[0];
+        assert_eq!(g.file.as_deref(), Some("tri.png"));
+        let Some(SceneSource::File(f)) = g.scene_source() else {
+            panic!("a scene file: {:?}", g.scene_source());
+        };
+        assert_eq!(f.label, "scenes/tri.toml");
+        assert_eq!(f.path, dir.path().join("scenes/tri.toml"));
+        assert_eq!(f.sha256, sha256_hex(scene.as_bytes()));
+        assert_eq!(f.description, crate::scene::builtin("week04-quad").unwrap());
+        assert!(f.golden.is_none());
+        // An explicit file wins; a built-in scene stays a built-in.
+        let named = text.replace("points = 5", "file = \"mine.png\"\npoints = 5");
+        let r = Rubric::from_toml_in(&named, "r.toml", dir.path()).unwrap();
+        assert_eq!(r.groups[0].file.as_deref(), Some("mine.png"));
+        assert_eq!(
+            Rubric::week04().groups[2].scene_source(),
+            Some(SceneSource::Builtin("week04-sphere".into()))
+        );
+        // Relative to the rubric, not to the current folder.
+        let e = Rubric::from_toml(text, "r.toml").unwrap_err().to_string();
+        assert!(e.contains("scenes/tri.toml: no such file"), "{e}");
     }
 
     #[test]

@@ -11,7 +11,7 @@ use super::inputs::{
     ImageVerdict,
 };
 use super::report;
-use super::rubric::{Group, GroupKind, Rubric, Visibility};
+use super::rubric::{Group, GroupKind, Rubric, SceneSource, Visibility};
 
 /// How many failing vectors of a group the reports show.
 pub const FAILURES_SHOWN: usize = 5;
@@ -47,7 +47,7 @@ impl CheckStatus {
 pub struct ImageResult {
     /// The file in the submission.
     pub file: String,
-    /// The built-in scene it must show.
+    /// The scene it must show: a built-in's name or the rubric's scene file.
     pub scene: String,
     /// What the comparison said: `"verdict": "pass" | "fail" | "unusable"`, with `"reason"` for
     /// unusable input.
@@ -102,8 +102,11 @@ pub struct Reproducibility {
     pub rubric_sha256: String,
     /// SHA-256 of the vectors run.
     pub vectors_sha256: String,
-    /// SHA-256 of each scene's golden.
+    /// SHA-256 of each scene's golden (for a scene file: of the golden EXR file's bytes).
     pub goldens_sha256: BTreeMap<String, String>,
+    /// SHA-256 of each scene file's bytes, by the rubric's `scene` value (built-in scenes are
+    /// not listed: the tool version names them).
+    pub scenes_sha256: BTreeMap<String, String>,
     /// SHA-256 of each file of the submission folder (top level).
     pub submission_sha256: BTreeMap<String, String>,
     /// The code checker.
@@ -427,9 +430,11 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
 }
 
 /// The size the image of `scene` must have, when `scene` is a built-in scene.
-fn expected_size(scene: &str) -> Option<(usize, usize)> {
-    let d = crate::scene::builtin(scene).ok()?;
-    let camera = d.camera(None);
+fn expected_size(scene: &SceneSource) -> Option<(usize, usize)> {
+    let camera = match scene {
+        SceneSource::Builtin(name) => crate::scene::builtin(name).ok()?.camera(None),
+        SceneSource::File(f) => f.description.camera(None),
+    };
     Some((camera.width, camera.height))
 }
 
@@ -443,7 +448,7 @@ fn check_image(
     out_dir: &Path,
 ) -> ImageOutcome {
     let rel = g.file.as_deref().expect("validated");
-    let scene = g.scene.as_deref().expect("validated");
+    let scene = g.scene_source().expect("validated");
     let stage = match tempfile::Builder::new()
         .prefix(".rtoracle-image-")
         .tempdir()
@@ -458,11 +463,11 @@ fn check_image(
     };
     let _cleanup = crate::interrupt::remove_on_interrupt(stage.path());
     let staged =
-        match super::intake::stage_image(submission, rel, expected_size(scene), stage.path()) {
+        match super::intake::stage_image(submission, rel, expected_size(&scene), stage.path()) {
             Ok(p) => p,
             Err(why) => return ImageOutcome::unusable(why),
         };
-    let mut outcome = images.check(&staged, scene, &out_dir.join(heatmap_name(g)));
+    let mut outcome = images.check_scene(&staged, &scene, &out_dir.join(heatmap_name(g)));
     if let ImageVerdict::Unusable(why) = &mut outcome.verdict {
         let shown = format!("{}: ", staged.display());
         *why = why.replace(&shown, &format!("{rel}: "));
@@ -521,11 +526,13 @@ pub fn grade(
     }
     let goldens_sha256 = image_groups
         .iter()
-        .filter_map(|g| g.scene.clone())
-        .map(|s| {
-            let h = images.golden_sha256(&s);
-            (s, h)
-        })
+        .filter_map(|g| g.scene_source())
+        .map(|s| (s.label().to_string(), images.scene_golden_sha256(&s)))
+        .collect();
+    let scenes_sha256 = image_groups
+        .iter()
+        .filter_map(|g| g.scene_file.as_ref())
+        .map(|f| (f.label.clone(), f.sha256.clone()))
         .collect();
     let score = round2(checks.iter().map(|c| c.score).sum());
     let submission_name = submission
@@ -557,6 +564,7 @@ pub fn grade(
                 code.vectors_sha256()
             },
             goldens_sha256,
+            scenes_sha256,
             submission_sha256: super::intake::submission_hashes(submission),
             code_checker: code.describe(),
             image_checker: images.describe(),
@@ -867,7 +875,7 @@ pub(crate) mod fakes {
             ("week04_sphere.png", "week04-sphere"),
             ("week04_quad.png", "week04-quad"),
         ] {
-            let (w, h) = expected_size(scene).unwrap();
+            let (w, h) = expected_size(&SceneSource::Builtin(scene.into())).unwrap();
             let mut b = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
             b.extend((w as u32).to_be_bytes());
             b.extend((h as u32).to_be_bytes());

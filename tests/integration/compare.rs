@@ -454,7 +454,7 @@ fn bad_candidates_exit_2_naming_the_file() {
 /// diagnosis and a heatmap, missing and wrong-size files are unusable.
 #[test]
 fn the_grading_image_checker_uses_the_comparison() {
-    use rtoracle::compare::CompareImageChecker;
+    use rtoracle::grade::CompareImageChecker;
     use rtoracle::grade::inputs::{ImageChecker, ImageVerdict};
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path();

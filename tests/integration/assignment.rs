@@ -1,0 +1,490 @@
+//! An instructor's own assignment end to end: the triangle rubric of `examples/rubrics`
+//! (a triangle code group and an image group on the scene file beside it), the golden cache,
+//! `rtoracle golden FILE.toml`, the autograder package with the scene and its golden, rubric
+//! validation, and `rtoracle check` with no argument in a submission folder.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use std::sync::OnceLock;
+use std::time::SystemTime;
+
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+
+use crate::common::*;
+use rtoracle::image_io::{Rgb8Image, write_png};
+use rtoracle::render::{RenderOptions, render};
+use rtoracle::scene::SceneDescription;
+
+const RENDER_NOTE: &str = "rendering the golden of";
+
+fn crate_dir() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn rubric_path() -> PathBuf {
+    crate_dir().join("examples/rubrics/triangles.toml")
+}
+
+fn scene_path() -> PathBuf {
+    crate_dir().join("examples/rubrics/triangles-scene.toml")
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+fn read_json(path: &Path) -> Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).to_string()
+}
+
+/// A course submission in `dest`: the shared course modules, the `RT_object.py` of
+/// `tests/fixtures/python/triangle_assignment/<variant>` and, when given, the image.
+fn submission(dest: &Path, variant: &str, image: Option<&Rgb8Image>) {
+    std::fs::create_dir_all(dest).unwrap();
+    let python = crate_dir().join("tests/fixtures/python");
+    for e in std::fs::read_dir(python.join("common")).unwrap().flatten() {
+        std::fs::copy(e.path(), dest.join(e.file_name())).unwrap();
+    }
+    std::fs::copy(
+        python
+            .join("triangle_assignment")
+            .join(variant)
+            .join("RT_object.py"),
+        dest.join("RT_object.py"),
+    )
+    .unwrap();
+    if let Some(image) = image {
+        write_png(&dest.join("triangles-scene.png"), image).unwrap();
+    }
+}
+
+/// An honest student's image: the reference's render of the scene file at the assignment's
+/// 20 spp with a seed of the student's (not the golden's).
+fn honest_image(seed: u64) -> Rgb8Image {
+    let d = SceneDescription::from_file(&scene_path()).unwrap();
+    let film = render(
+        &d.scene(),
+        &d.camera(None),
+        &RenderOptions {
+            samples_per_pixel: 20,
+            seed,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    Rgb8Image {
+        width: film.width,
+        height: film.height,
+        data: film.to_course_rgb8(),
+    }
+}
+
+/// The same image upside down (rows in reverse order).
+fn flipped(image: &Rgb8Image) -> Rgb8Image {
+    let row = 3 * image.width;
+    let data = image.data.chunks(row).rev().flatten().copied().collect();
+    Rgb8Image {
+        data,
+        ..image.clone()
+    }
+}
+
+fn cache_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.join("goldens"))
+        .map(|rd| rd.flatten().map(|e| e.path()).collect())
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
+struct Graded {
+    root: PathBuf,
+    cache: PathBuf,
+    subs: PathBuf,
+    out: PathBuf,
+    output: Output,
+}
+
+/// Three submissions graded as one batch with the triangle rubric and a cold cache.
+fn graded() -> &'static Graded {
+    static GRADED: OnceLock<Graded> = OnceLock::new();
+    GRADED.get_or_init(|| {
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("triangle-assignment");
+        let _ = std::fs::remove_dir_all(&root);
+        let subs = root.join("subs");
+        let honest = honest_image(11);
+        submission(&subs.join("honest"), "", Some(&honest));
+        submission(&subs.join("flipped"), "", Some(&flipped(&honest)));
+        submission(
+            &subs.join("parallelogram"),
+            "bug_parallelogram",
+            Some(&honest_image(12)),
+        );
+        let cache = root.join("cache");
+        let out = root.join("out");
+        let output = rtoracle()
+            .current_dir(&root)
+            .env("RTORACLE_CACHE_DIR", &cache)
+            .args(["grade", "--batch", "subs", "--out", "out", "--rubric"])
+            .arg(rubric_path())
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", stderr(&output));
+        Graded {
+            root,
+            cache,
+            subs,
+            out,
+            output,
+        }
+    })
+}
+
+fn scores(report: &Value) -> Vec<(String, f64, f64)> {
+    report["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["max_score"].as_f64().unwrap() > 0.0)
+        .map(|c| {
+            (
+                c["id"].as_str().unwrap().to_string(),
+                c["score"].as_f64().unwrap(),
+                c["max_score"].as_f64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn honest_gets_full_marks_a_flipped_image_zero_and_a_triangle_bug_loses_triangle_points() {
+    let g = graded();
+    let honest = read_json(&g.out.join("honest/report.json"));
+    assert_eq!(honest["score"], 100.0, "{:?}", scores(&honest));
+    assert_eq!(honest["max_score"], 100.0);
+
+    let flipped = read_json(&g.out.join("flipped/report.json"));
+    let s = scores(&flipped);
+    assert_eq!(
+        s,
+        [
+            ("triangle.intersect".to_string(), 60.0, 60.0),
+            ("image.triangles-scene".to_string(), 0.0, 40.0)
+        ],
+        "{s:?}"
+    );
+    let image = flipped["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"] == "image.triangles-scene")
+        .unwrap();
+    assert_eq!(image["status"], "failed");
+    assert_eq!(image["image"]["file"], "triangles-scene.png");
+    assert_eq!(image["image"]["scene"], "triangles-scene.toml");
+
+    let bug = read_json(&g.out.join("parallelogram/report.json"));
+    let s = scores(&bug);
+    assert_eq!(s[1], ("image.triangles-scene".to_string(), 40.0, 40.0));
+    assert_eq!(s[0].0, "triangle.intersect");
+    assert!(s[0].1 < 60.0, "{s:?}");
+}
+
+#[test]
+fn a_batch_renders_the_golden_once_and_a_warm_cache_renders_nothing() {
+    let g = graded();
+    // Three submissions, one golden rendered and cached.
+    assert_eq!(
+        stderr(&g.output).matches(RENDER_NOTE).count(),
+        1,
+        "{}",
+        stderr(&g.output)
+    );
+    let files = cache_files(&g.cache);
+    assert_eq!(files.len(), 1, "{files:?}");
+    let name = files[0].file_name().unwrap().to_string_lossy().to_string();
+    let d = SceneDescription::from_file(&scene_path()).unwrap();
+    assert!(
+        name.starts_with(&rtoracle::golden::scene_sha256(&d))
+            && name.ends_with(&format!("-{}.exr", env!("CARGO_PKG_VERSION"))),
+        "{name}"
+    );
+    let mtime = |p: &Path| -> SystemTime { std::fs::metadata(p).unwrap().modified().unwrap() };
+    let before = (mtime(&files[0]), std::fs::read(&files[0]).unwrap());
+    let again = rtoracle()
+        .current_dir(&g.root)
+        .env("RTORACLE_CACHE_DIR", &g.cache)
+        .args(["grade", "subs/honest", "--out", "again", "--rubric"])
+        .arg(rubric_path())
+        .output()
+        .unwrap();
+    assert!(again.status.success(), "{}", stderr(&again));
+    assert!(!stderr(&again).contains(RENDER_NOTE), "{}", stderr(&again));
+    assert_eq!(
+        (mtime(&files[0]), std::fs::read(&files[0]).unwrap()),
+        before
+    );
+    assert_eq!(read_json(&g.root.join("again/report.json"))["score"], 100.0);
+}
+
+#[test]
+fn report_json_records_the_sha256_of_the_scene_file_and_of_the_golden() {
+    let g = graded();
+    let report = read_json(&g.out.join("honest/report.json"));
+    let r = &report["reproducibility"];
+    let scene = std::fs::read(scene_path()).unwrap();
+    assert_eq!(
+        r["scenes_sha256"]["triangles-scene.toml"],
+        sha256_hex(&scene)
+    );
+    let golden = std::fs::read(&cache_files(&g.cache)[0]).unwrap();
+    assert_eq!(
+        r["goldens_sha256"]["triangles-scene.toml"],
+        sha256_hex(&golden)
+    );
+    assert_eq!(
+        r["submission_sha256"]["triangles-scene.png"],
+        sha256_hex(&std::fs::read(g.subs.join("honest/triangles-scene.png")).unwrap())
+    );
+}
+
+#[test]
+fn the_golden_command_writes_the_bytes_the_cache_holds_and_a_rubric_accepts_them() {
+    let g = graded();
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(scene_path(), dir.path().join("triangles-scene.toml")).unwrap();
+    let out = run_in(
+        dir.path(),
+        &["golden", "triangles-scene.toml", "-o", "tri.exr"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    // Same scene, samples, seed and version: the same bytes as the golden the grader rendered.
+    let made = std::fs::read(dir.path().join("tri.exr")).unwrap();
+    assert_eq!(made, std::fs::read(&cache_files(&g.cache)[0]).unwrap());
+    // A rubric naming it grades without any cache and without rendering.
+    let rubric = std::fs::read_to_string(rubric_path()).unwrap().replace(
+        "scene = \"triangles-scene.toml\"",
+        "scene = \"triangles-scene.toml\"\ngolden = \"tri.exr\"",
+    );
+    std::fs::write(dir.path().join("r.toml"), rubric).unwrap();
+    let empty = dir.path().join("empty-cache");
+    std::fs::create_dir(&empty).unwrap();
+    let graded = rtoracle()
+        .current_dir(dir.path())
+        .env("RTORACLE_CACHE_DIR", &empty)
+        .args(["grade", "--rubric", "r.toml", "--out", "out"])
+        .arg(g.subs.join("honest"))
+        .output()
+        .unwrap();
+    assert!(graded.status.success(), "{}", stderr(&graded));
+    assert!(!stderr(&graded).contains(RENDER_NOTE));
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
+    let report = read_json(&dir.path().join("out/report.json"));
+    assert_eq!(report["score"], 100.0);
+    assert_eq!(
+        report["reproducibility"]["goldens_sha256"]["triangles-scene.toml"],
+        sha256_hex(&made)
+    );
+}
+
+#[test]
+fn the_autograder_package_carries_the_scene_and_its_golden_so_gradescope_never_renders() {
+    let g = graded();
+    let dir = tempfile::tempdir().unwrap();
+    // Packing with the warm cache renders nothing either.
+    let out = rtoracle()
+        .current_dir(dir.path())
+        .env("RTORACLE_CACHE_DIR", &g.cache)
+        .args(["autograder", "--out", "autograder.zip", "--rubric"])
+        .arg(rubric_path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let root = dir.path().join("autograder");
+    let source = root.join("source");
+    let file = std::fs::File::open(dir.path().join("autograder.zip")).unwrap();
+    let mut archive = zip::ZipArchive::new(file).unwrap();
+    let mut names: Vec<String> = archive.file_names().map(String::from).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "rtoracle",
+            "rtoracle-scenes/triangles-scene.exr",
+            "rtoracle-scenes/triangles-scene.toml",
+            "rubric.toml",
+            "run_autograder",
+            "setup.sh"
+        ]
+    );
+    archive.extract(&source).unwrap();
+    assert_eq!(
+        std::fs::read(source.join("rtoracle-scenes/triangles-scene.toml")).unwrap(),
+        std::fs::read(scene_path()).unwrap()
+    );
+    assert_eq!(
+        std::fs::read(source.join("rtoracle-scenes/triangles-scene.exr")).unwrap(),
+        std::fs::read(&cache_files(&g.cache)[0]).unwrap()
+    );
+    // Install and run it as Gradescope would, with an empty cache.
+    let prefix = dir.path().join("prefix");
+    let empty = dir.path().join("empty-cache");
+    std::fs::create_dir(&empty).unwrap();
+    let setup = std::process::Command::new("bash")
+        .arg(source.join("setup.sh"))
+        .env("PREFIX", &prefix)
+        .output()
+        .unwrap();
+    assert!(setup.status.success(), "{}", stderr(&setup));
+    copy_dir(&g.subs.join("honest"), &root.join("submission"));
+    let run = std::process::Command::new("bash")
+        .arg(source.join("run_autograder"))
+        .env("PREFIX", &prefix)
+        .env("AUTOGRADER", &root)
+        .env("RTORACLE_CACHE_DIR", &empty)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(!stderr(&run).contains(RENDER_NOTE), "{}", stderr(&run));
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
+    let results = read_json(&root.join("results/results.json"));
+    assert_eq!(results["score"], 100.0, "{results}");
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+#[test]
+fn rubric_scene_file_errors_exit_2_with_one_line_naming_the_rubric() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    let scene = std::fs::read_to_string(scene_path()).unwrap();
+    std::fs::write(p.join("tri.toml"), &scene).unwrap();
+    std::fs::write(p.join("broken.toml"), "[image]\nwidth = \"wide\"\n").unwrap();
+    // Goldens of other scenes, cheaply (4 spp): a narrower one and one with the sphere moved.
+    std::fs::write(
+        p.join("narrow.toml"),
+        scene.replace("width = 160", "width = 80"),
+    )
+    .unwrap();
+    std::fs::write(
+        p.join("moved.toml"),
+        scene.replace("center = [0.55, -0.2, -1.2]", "center = [0.5, -0.2, -1.2]"),
+    )
+    .unwrap();
+    for name in ["narrow", "moved"] {
+        let out = run_in(
+            p,
+            &[
+                "golden",
+                &format!("{name}.toml"),
+                "-o",
+                &format!("{name}.exr"),
+                "--spp",
+                "4",
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    std::fs::write(p.join("notexr.exr"), b"not an exr").unwrap();
+    let rubric = |scene_line: &str| {
+        format!(
+            "name = \"t\"\n[[group]]\nid = \"image.t\"\nname = \"T\"\nkind = \"image\"\n{scene_line}\npoints = 10\n"
+        )
+    };
+    let cases = [
+        ("scene = \"missing.toml\"", "missing.toml: no such file"),
+        ("scene = \"broken.toml\"", "malformed scene file"),
+        ("scene = \"tri\"", "unknown scene \"tri\""),
+        (
+            "scene = \"tri.toml\"\ngolden = \"narrow.exr\"",
+            "is 80x80 but the scene is 160x160",
+        ),
+        (
+            "scene = \"tri.toml\"\ngolden = \"moved.exr\"",
+            "was made from another scene",
+        ),
+        (
+            "scene = \"tri.toml\"\ngolden = \"nope.exr\"",
+            "nope.exr: no such file",
+        ),
+        (
+            "scene = \"tri.toml\"\ngolden = \"notexr.exr\"",
+            "notexr.exr",
+        ),
+        (
+            "scene = \"week04-quad\"\nfile = \"q.png\"\ngolden = \"moved.exr\"",
+            "golden is for scene files",
+        ),
+    ];
+    std::fs::create_dir(p.join("sub")).unwrap();
+    for (line, needle) in cases {
+        std::fs::write(p.join("r.toml"), rubric(line)).unwrap();
+        let out = run_in(p, &["grade", "sub", "--rubric", "r.toml", "--out", "o"]);
+        assert_bad_input(&out, needle);
+        assert!(stderr(&out).contains("r.toml: "), "{}", stderr(&out));
+        assert!(!p.join("o").exists(), "{line}");
+        // The package is refused the same way, before anything is written.
+        let out = run_in(p, &["autograder", "--rubric", "r.toml", "--out", "a.zip"]);
+        assert_bad_input(&out, needle);
+        assert!(!p.join("a.zip").exists());
+    }
+    // Paths are relative to the rubric, not to the current folder.
+    std::fs::write(p.join("r.toml"), rubric("scene = \"tri.toml\"")).unwrap();
+    let elsewhere = tempfile::tempdir().unwrap();
+    let r = p.join("r.toml");
+    let out = run_in(
+        elsewhere.path(),
+        &["grade", "--print-rubric", "--rubric", r.to_str().unwrap()],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn check_with_no_argument_checks_the_submission_in_the_current_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    submission(dir.path(), "", None);
+    let out = run_in(dir.path(), &["check"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let here = dir.path().canonicalize().unwrap();
+    assert!(
+        err.lines().next().unwrap().starts_with(&format!(
+            "checking the course submission in {}",
+            here.display()
+        )),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("verdict: PASS"));
+
+    // The triangle bug fails the same way `--python-course .` does.
+    submission(dir.path(), "bug_parallelogram", None);
+    let bare = run_in(dir.path(), &["check", "--json"]);
+    let explicit = run_in(dir.path(), &["check", "--json", "--python-course", "."]);
+    assert_eq!(bare.status.code(), Some(1));
+    assert_eq!(explicit.status.code(), Some(1));
+    let failed = |o: &Output| -> (Value, Value) {
+        let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+        (v["by_shape"].clone(), v["failed"].clone())
+    };
+    assert_eq!(failed(&bare), failed(&explicit));
+
+    // Outside a submission folder: what it looked for, exit 2.
+    let empty = tempfile::tempdir().unwrap();
+    let out = run_in(empty.path(), &["check"]);
+    assert_bad_input(&out, "no RT_object.py in");
+    assert!(stderr(&out).contains("--python-course DIR"));
+}
