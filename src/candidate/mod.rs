@@ -6,6 +6,8 @@
 //! - [`process`]: [`Session`] runs a [`CandidateCommand`] (an `--adapter` command line or the
 //!   course adapter on a submission folder) in the [sandbox](crate::sandbox) with pipelined
 //!   requests, per-case timeouts, restarts after crashes and the process group killed on drop.
+//! - [`python`]: choosing the interpreter of the course adapter (the assignment's modules,
+//!   runnable in the sandbox).
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and its text.
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
 //! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
@@ -18,6 +20,7 @@ pub mod fuzz;
 pub mod generate;
 pub mod process;
 pub mod protocol;
+pub mod python;
 pub mod report;
 pub mod rust;
 pub mod shrink;

@@ -5,8 +5,9 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::candidate::{CandidateCommand, RunOptions, check_command};
+use rtoracle::candidate::{CandidateCommand, RunOptions, SandboxPolicy, check_command, python};
 use rtoracle::oracle::{default_suite, vectors::read_vectors};
+use rtoracle::sandbox::SandboxError;
 
 /// Which candidate to run (shared by `check` and `fuzz`).
 #[derive(Debug, clap::Args)]
@@ -22,12 +23,68 @@ pub struct Target {
     pub adapter: Option<String>,
 }
 
+/// How the candidate is sandboxed and which Python runs the course adapter (shared by `check`
+/// and `fuzz`).
+#[derive(Debug, clap::Args)]
+pub struct SandboxArgs {
+    /// The Python 3 that runs the course adapter (it must have numpy and PIL); default:
+    /// $RTORACLE_PYTHON, else the first of /usr/bin/python3, /usr/local/bin/python3, python3
+    /// on PATH, ... that has them.
+    #[arg(long, value_name = "PATH")]
+    pub python: Option<PathBuf>,
+    /// Run the candidate without a sandbox, as the current user (root included), for one's own
+    /// code where no sandbox can be made; the output says so.
+    #[arg(long)]
+    pub unsandboxed: bool,
+}
+
+impl SandboxArgs {
+    /// The sandbox policy of `check` and `fuzz`.
+    pub fn policy(&self) -> SandboxPolicy {
+        SandboxPolicy {
+            unsandboxed: self.unsandboxed,
+            ..SandboxPolicy::default()
+        }
+    }
+}
+
+/// A sandbox error with the way out that `check` and `fuzz` offer.
+fn with_hint(e: SandboxError) -> anyhow::Error {
+    match e {
+        SandboxError::Unavailable(_) => {
+            anyhow::anyhow!("{e} (pass --unsandboxed to run your own code without a sandbox)")
+        }
+        other => other.into(),
+    }
+}
+
 impl Target {
-    /// The command to run.
-    pub fn command(&self) -> anyhow::Result<CandidateCommand> {
+    /// The command to run, after checking that a sandbox can be made (fail closed) and, for the
+    /// course adapter, choosing the interpreter: both before any work.
+    pub fn command(&self, sandbox: &SandboxArgs) -> anyhow::Result<CandidateCommand> {
+        let policy = sandbox.policy();
+        rtoracle::sandbox::isolation_for(&policy).map_err(with_hint)?;
         Ok(match (&self.python_course, &self.adapter) {
-            (Some(dir), _) => CandidateCommand::python_course(dir)?,
-            (_, Some(cmd)) => CandidateCommand::adapter(cmd)?,
+            (Some(dir), _) => {
+                let python = python::choose(
+                    sandbox.python.as_deref(),
+                    &python::default_requires(),
+                    &policy,
+                )
+                .map_err(|e| match e {
+                    python::PythonError::Sandbox(e) => with_hint(e),
+                    other => other.into(),
+                })?;
+                CandidateCommand::python_course_with(dir, Some(&python), false)?
+            }
+            (_, Some(cmd)) => {
+                if sandbox.python.is_some() {
+                    anyhow::bail!(
+                        "--python is for --python-course; put the interpreter in the --adapter command"
+                    );
+                }
+                CandidateCommand::adapter(cmd)?
+            }
             _ => unreachable!("clap requires one"),
         })
     }
@@ -38,6 +95,8 @@ impl Target {
 pub struct Args {
     #[command(flatten)]
     target: Target,
+    #[command(flatten)]
+    sandbox: SandboxArgs,
     /// A vector file (JSON lines); the built-in suite when absent.
     #[arg(long, value_name = "FILE")]
     vectors: Option<PathBuf>,
@@ -69,9 +128,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
         hello_timeout: Duration::from_millis(args.hello_timeout_ms),
+        limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
-    let command = args.target.command()?;
+    rtoracle::sandbox::announce_on_stderr();
+    let command = args.target.command(&args.sandbox)?;
     let report = check_command(command, &cases, options).context("check")?;
     let text = if args.json {
         report.to_json()

@@ -15,6 +15,8 @@ use rtoracle::oracle::vectors::ShapeKind;
 pub struct Args {
     #[command(flatten)]
     target: super::check::Target,
+    #[command(flatten)]
+    sandbox: super::check::SandboxArgs,
     /// How many random cases to run.
     #[arg(long, value_name = "N", default_value_t = 10_000)]
     cases: usize,
@@ -47,9 +49,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
+        limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
-    let mut session = Session::start(args.target.command()?, options).context("fuzz")?;
+    rtoracle::sandbox::announce_on_stderr();
+    let command = args.target.command(&args.sandbox)?;
+    let mut session = Session::start(command, options).context("fuzz")?;
     if let Some(e) = &session.hello().error {
         eprintln!("rtoracle: the submission cannot be imported: {e}");
     }

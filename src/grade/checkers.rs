@@ -8,6 +8,7 @@ use std::time::Duration;
 use serde_json::Value;
 
 use crate::candidate::check::{FailureKind as CheckKind, Verdict, judge, judge_exact};
+use crate::candidate::python;
 use crate::candidate::report::python_repro;
 use crate::candidate::{
     CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
@@ -38,9 +39,11 @@ pub struct CourseCodeChecker {
     pub max_timeouts_per_group: u32,
     /// The sandbox's limits.
     pub policy: SandboxPolicy,
-    /// The interpreter (default: `$RTORACLE_PYTHON`, else `/usr/bin/python3` or
-    /// `/usr/local/bin/python3`, which a drop user can run, else `python3` on `PATH`).
+    /// The interpreter (`--python`; default: [`python::choose`]'s, which probes
+    /// `$RTORACLE_PYTHON` or the usual places, in the sandbox, for [`Self::python_requires`]).
     pub python: Option<PathBuf>,
+    /// The modules the interpreter must have (the rubric's `python_requires`).
+    pub python_requires: Vec<String>,
 }
 
 impl Default for CourseCodeChecker {
@@ -53,22 +56,9 @@ impl Default for CourseCodeChecker {
             max_timeouts_per_group: 3,
             policy: SandboxPolicy::grading(),
             python: None,
+            python_requires: python::default_requires(),
         }
     }
-}
-
-/// The interpreter to use: `None` lets the harness resolve `python3` on `PATH`.
-fn find_python(explicit: Option<&Path>) -> Option<PathBuf> {
-    if let Some(p) = explicit {
-        return Some(p.to_path_buf());
-    }
-    if let Some(p) = std::env::var_os("RTORACLE_PYTHON") {
-        return Some(PathBuf::from(p));
-    }
-    ["/usr/bin/python3", "/usr/local/bin/python3"]
-        .into_iter()
-        .map(PathBuf::from)
-        .find(|p| p.is_file())
 }
 
 /// Removes the sandbox folder, and the submission folder the harness names in its place, from
@@ -188,12 +178,17 @@ impl CodeChecker for CourseCodeChecker {
             fatal(&mut out, "RT_object.py is not in the submission".into());
             return out;
         }
-        let started = CandidateCommand::python_course_with(
-            submission,
-            find_python(self.python.as_deref()).as_deref(),
-            true,
-        )
-        .and_then(|command| Session::start(command, self.options()));
+        // Probed once per process (cached): a batch pays for it once.
+        let python =
+            match python::choose(self.python.as_deref(), &self.python_requires, &self.policy) {
+                Ok(p) => p,
+                Err(e) => {
+                    fatal(&mut out, e.to_string());
+                    return out;
+                }
+            };
+        let started = CandidateCommand::python_course_with(submission, Some(&python), true)
+            .and_then(|command| Session::start(command, self.options()));
         let mut session = match started {
             Ok(s) => s,
             Err(HarnessError::Python(e)) => {
@@ -206,9 +201,10 @@ impl CodeChecker for CourseCodeChecker {
             }
         };
         let sandbox_dir = session.sandbox_dir().to_path_buf();
+        let inside_dir = session.sandbox_inside_dir();
         let submission_dir =
             std::path::absolute(submission).unwrap_or_else(|_| submission.to_path_buf());
-        let strip = |text: &str| strip_dirs(text, &[&sandbox_dir, &submission_dir]);
+        let strip = |text: &str| strip_dirs(text, &[&sandbox_dir, &inside_dir, &submission_dir]);
         out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
         let finish = |out: &mut CodeOutcome, session: &Session| {
             out.stderr_tail = strip(&session.stderr_tail());
@@ -344,9 +340,10 @@ mod tests {
             .map(|f| &f.id)
             .collect();
         assert!(definite.is_empty(), "{definite:?}");
-        // Never root when the drop user exists and can run Python.
-        if crate::sandbox::running_as_root() && out.sandbox["note"].is_null() {
-            assert_ne!(out.sandbox["uid"], 0, "{}", out.sandbox);
+        // Never root: a root harness gives the submission a uid of its own.
+        if crate::sandbox::running_as_root() {
+            let uid = out.sandbox["uid"].as_u64().unwrap();
+            assert!(uid >= 1 << 30, "{}", out.sandbox);
         }
     }
 
@@ -410,14 +407,11 @@ mod tests {
     }
 
     #[test]
-    fn an_interpreter_the_drop_user_cannot_run_falls_back_and_says_so() {
-        // Python under /root (mode 0700) cannot be run by `nobody`.
+    fn an_interpreter_the_sandbox_user_cannot_run_is_refused_never_run_as_root() {
+        // Python under /root (mode 0700) cannot be run by a sandbox user.
         let private = Path::new("/root/.pyenv/versions/3.11.7/bin/python3");
-        if !crate::sandbox::running_as_root()
-            || !private.exists()
-            || crate::sandbox::lookup_user("nobody").is_none()
-        {
-            eprintln!("skipped: needs root, nobody and a Python under /root");
+        if !crate::sandbox::running_as_root() || !private.exists() {
+            eprintln!("skipped: needs root and a Python under /root");
             return;
         }
         let checker = CourseCodeChecker {
@@ -426,11 +420,16 @@ mod tests {
         };
         let sub = fixture("honest");
         let out = checker.check(sub.path(), &[ShapeKind::Sphere]);
-        assert_eq!(out.fatal, None);
+        let fatal = out.fatal.expect("refused");
+        assert!(
+            fatal.starts_with(&format!(
+                "--python {}: cannot be run by the sandbox user",
+                private.display()
+            )),
+            "{fatal}"
+        );
         let s = &out.per_group[&ShapeKind::Sphere];
-        assert_eq!(s.passed, s.definite_total);
-        let note = out.sandbox["note"].as_str().unwrap_or("");
-        assert!(note.contains("cannot run"), "{}", out.sandbox);
-        assert_eq!(out.sandbox["uid"], 0);
+        assert_eq!(s.not_run, s.definite_total);
+        assert!(out.sandbox.is_null(), "nothing ran: {}", out.sandbox);
     }
 }

@@ -4,6 +4,7 @@
 //! ```toml
 //! name = "week04"
 //! seed = 0                       # seed of the vector suite
+//! python_requires = ["numpy", "PIL"]  # modules the grader's Python must have (the default)
 //!
 //! [[group]]
 //! id = "sphere"                  # check ids start with the group id
@@ -150,6 +151,10 @@ pub struct Rubric {
     /// The seed of the vector suite.
     #[serde(default)]
     pub seed: u64,
+    /// The modules the Python that runs the submissions must have (default numpy and PIL, which
+    /// the course's `RT_utility.py` imports); `grade` exits 2 when no interpreter has them.
+    #[serde(default = "crate::candidate::python::default_requires")]
+    pub python_requires: Vec<String>,
     /// The groups, in report order.
     #[serde(rename = "group")]
     pub groups: Vec<Group>,
