@@ -151,13 +151,12 @@ pub fn args(
     for e in ETC {
         push(&[&"--ro-bind-try", &e, &e]);
     }
+    push(&[&"--proc", &"/proc", &"--dev", &"/dev", &"--tmpfs", &"/tmp"]);
+    // After the private /tmp, so an exposed path under /tmp is not hidden by it.
     for p in exposed {
         push(&[&"--ro-bind-try", p, p]);
     }
-    push(&[
-        &"--proc", &"/proc", &"--dev", &"/dev", &"--tmpfs", &"/tmp", &"--bind", &dir, &INSIDE,
-        &"--chdir", &INSIDE,
-    ]);
+    push(&[&"--bind", &dir, &INSIDE, &"--chdir", &INSIDE]);
     // The harness's binary, when the view shows it.
     if let Ok(exe) = std::env::current_exe()
         && (in_system_view(&exe) || exposed.iter().any(|e| exe.starts_with(e)))

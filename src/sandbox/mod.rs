@@ -248,7 +248,11 @@ impl SandboxFacts {
                 self.uid
             ),
         };
-        if let Some(note) = &self.note {
+        if let Some(note) = self
+            .note
+            .as_ref()
+            .filter(|_| self.isolation != Isolation::Unsandboxed)
+        {
             line.push_str("; ");
             line.push_str(note);
         }

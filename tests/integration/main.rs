@@ -9,3 +9,4 @@ mod oracle;
 mod oracle_props;
 mod readme;
 mod render;
+mod sandbox;
