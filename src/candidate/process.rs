@@ -367,6 +367,23 @@ impl CandidateCommand {
                 .add_file(ADAPTER_NAME, PYTHON_COURSE_ADAPTER.as_bytes())
                 .map_err(io)?;
         } else {
+            let found = if self.program.components().count() > 1 {
+                self.program.exists()
+            } else {
+                std::env::split_paths(crate::sandbox::SANDBOX_PATH)
+                    .chain(
+                        std::env::var_os("PATH")
+                            .iter()
+                            .flat_map(std::env::split_paths),
+                    )
+                    .any(|d| d.join(&self.program).is_file())
+            };
+            if !found {
+                return Err(HarnessError::Spawn {
+                    program: self.program.display().to_string(),
+                    reason: std::io::Error::from_raw_os_error(libc::ENOENT),
+                });
+            }
             for a in &self.args {
                 let p = Path::new(a);
                 if p.is_absolute() && p.exists() {
@@ -446,6 +463,9 @@ struct Proc {
     pid: i32,
     /// Ends every process the candidate started (its PID namespace or its uid).
     reaper: Reaper,
+    /// Whether the child is bubblewrap, which exits `128 + N` when the candidate dies of signal
+    /// `N`: such statuses are read back as the signal.
+    bwrap: bool,
     writer: Option<Sender<Vec<u8>>>,
     lines: Receiver<Line>,
     stderr_done: std::thread::JoinHandle<()>,
@@ -503,6 +523,7 @@ impl Proc {
             child,
             pid,
             reaper,
+            bwrap: sandbox.isolation() == crate::sandbox::Isolation::Bubblewrap,
             writer: Some(wtx),
             lines: lrx,
             stderr_done,
@@ -523,7 +544,7 @@ impl Proc {
             libc::killpg(self.pid, libc::SIGKILL);
         }
         self.reaper.reap();
-        let status = self.child.wait().ok();
+        let status = self.child.wait().ok().map(|s| self.through_bwrap(s));
         let until = Instant::now() + Duration::from_millis(200);
         while !self.stderr_done.is_finished() && Instant::now() < until {
             std::thread::sleep(Duration::from_millis(2));
@@ -531,12 +552,22 @@ impl Proc {
         status
     }
 
+    /// The candidate's status from bubblewrap's: `128 + N` is death by signal `N`.
+    fn through_bwrap(&self, status: ExitStatus) -> ExitStatus {
+        match status.code() {
+            Some(code) if self.bwrap && (129..160).contains(&code) => {
+                ExitStatus::from_raw(code - 128)
+            }
+            _ => status,
+        }
+    }
+
     /// The exit status if the process has exited (after its stdout closed).
     fn exit_status(&mut self) -> Option<ExitStatus> {
         let until = Instant::now() + Duration::from_millis(500);
         loop {
             if let Ok(Some(status)) = self.child.try_wait() {
-                return Some(status);
+                return Some(self.through_bwrap(status));
             }
             if Instant::now() >= until {
                 return None;
@@ -762,7 +793,14 @@ impl Session {
             return;
         };
         let dir = self.sandbox.dir();
-        let mut seen = vec![dir.to_path_buf(), self.sandbox.inside_dir()];
+        let inside = self.sandbox.inside_dir();
+        if inside != dir {
+            let to = submission.display().to_string();
+            for text in [&mut error.message, &mut error.traceback] {
+                *text = crate::sandbox::replace_path(text, &inside, &to);
+            }
+        }
+        let mut seen = vec![dir.to_path_buf()];
         if let Ok(real) = dir.canonicalize() {
             seen.push(real);
         }

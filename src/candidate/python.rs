@@ -185,7 +185,7 @@ fn usual_places() -> Vec<PathBuf> {
                 Some((minor, e.path()))
             })
             .collect();
-        versioned.sort_by(|a, b| b.0.cmp(&a.0));
+        versioned.sort_by_key(|v| std::cmp::Reverse(v.0));
         places.extend(versioned.into_iter().map(|(_, p)| p));
     }
     let mut seen = Vec::new();

@@ -204,7 +204,15 @@ impl CodeChecker for CourseCodeChecker {
         let inside_dir = session.sandbox_inside_dir();
         let submission_dir =
             std::path::absolute(submission).unwrap_or_else(|_| submission.to_path_buf());
-        let strip = |text: &str| strip_dirs(text, &[&sandbox_dir, &inside_dir, &submission_dir]);
+        let strip = |text: &str| {
+            let text = if inside_dir != sandbox_dir {
+                let to = submission_dir.display().to_string();
+                crate::sandbox::replace_path(text, &inside_dir, &to)
+            } else {
+                text.to_string()
+            };
+            strip_dirs(&text, &[&sandbox_dir, &submission_dir])
+        };
         out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
         let finish = |out: &mut CodeOutcome, session: &Session| {
             out.stderr_tail = strip(&session.stderr_tail());

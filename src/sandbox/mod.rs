@@ -762,7 +762,7 @@ impl Sandbox {
                     libc::SYS_close_range,
                     3u32,
                     u32::MAX,
-                    libc::CLOSE_RANGE_CLOEXEC as u32,
+                    libc::CLOSE_RANGE_CLOEXEC,
                 );
                 for fd in [info_child, args_child].into_iter().flatten() {
                     libc::fcntl(fd, libc::F_SETFD, 0);
@@ -988,6 +988,26 @@ impl Drop for Sandbox {
             }
         }
     }
+}
+
+/// `text` with the path `from` replaced by `to` where it starts a path (not inside a longer
+/// one: `/sandbox/x.py` is replaced, `/work/sandbox/x.py` and `/sandboxes` are not).
+pub fn replace_path(text: &str, from: &Path, to: &str) -> String {
+    let from = from.display().to_string();
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find(&from) {
+        let before = rest[..i].chars().next_back();
+        let after = rest[i + from.len()..].chars().next();
+        let path_char = |c: char| c.is_alphanumeric() || "._-/~".contains(c);
+        let starts = before.is_none_or(|c| !path_char(c));
+        let ends = after.is_none_or(|c| c == '/' || !path_char(c));
+        out.push_str(&rest[..i]);
+        out.push_str(if starts && ends { to } else { &from });
+        rest = &rest[i + from.len()..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Kills a child spawned from [`Sandbox::command`] and everything in its process group, and

@@ -259,3 +259,16 @@ fn an_adapter_the_sandbox_user_cannot_reach_is_refused_not_run_as_root() {
         assert!(err.contains("adapter.sh"), "{err}");
     }
 }
+
+#[test]
+fn the_inside_folder_is_replaced_only_where_it_starts_a_path() {
+    let from = Path::new("/sandbox");
+    assert_eq!(
+        replace_path(
+            "File \"/sandbox/RT_object.py\", /work/wt/sandbox/x /sandboxes /sandbox",
+            from,
+            "/sub"
+        ),
+        "File \"/sub/RT_object.py\", /work/wt/sandbox/x /sandboxes /sub"
+    );
+}
