@@ -399,3 +399,56 @@ fn only_python_modules_of_regular_files_are_copied_and_the_rest_is_named() {
     assert!(skipped.iter().all(|s| !s.contains('\u{1b}')), "{skipped:?}");
     assert_eq!(skipped.len(), 4, "{skipped:?}");
 }
+
+#[test]
+fn sigterm_mid_check_leaves_no_process_and_no_folder() {
+    if !root("sigterm_mid_check_leaves_no_process_and_no_folder") {
+        return;
+    }
+    let marker = format!("rtoracle-test-sigterm-{}", std::process::id());
+    // Its import starts a setsid daemon and then hangs.
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s, time as _t
+if _o.fork() == 0:
+    _o.setsid()
+    _o.execv(_s.executable, [_s.executable, "-c", "import time; time.sleep(600)", {marker:?}])
+_t.sleep(600)
+"#
+    ));
+    let tmp = tempfile::tempdir().unwrap();
+    open_up(tmp.path());
+    let mut child = rtoracle()
+        .current_dir(sub.path())
+        .env("TMPDIR", tmp.path())
+        .args(["check", "--python-course", sub.path().to_str().unwrap()])
+        .args(["--hello-timeout-ms", "60000"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while processes_with(&marker).is_empty() && std::time::Instant::now() < deadline {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(
+        !processes_with(&marker).is_empty(),
+        "the daemon did not start"
+    );
+    let folders = || std::fs::read_dir(tmp.path()).unwrap().count();
+    assert!(folders() > 0, "no sandbox folder in TMPDIR");
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(143));
+    let mut left = processes_with(&marker);
+    for _ in 0..100 {
+        if left.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        left = processes_with(&marker);
+    }
+    assert!(left.is_empty(), "still running: {left:?}");
+    assert_eq!(folders(), 0, "a folder was left in TMPDIR");
+}
