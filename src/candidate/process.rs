@@ -766,7 +766,7 @@ impl Session {
         &self.command
     }
 
-    /// What the sandbox did: limits, the user the candidate ran as (and why not the drop user,
+    /// What the sandbox did: limits, the isolation, the uid the candidate ran as (and a note on
     /// if so), and whether its first process was seen in a network namespace of its own.
     pub fn sandbox_facts(&self) -> SandboxFacts {
         self.facts
@@ -1079,7 +1079,7 @@ mod tests {
     #[test]
     fn the_course_adapter_runs_on_a_copy_in_the_sandbox_as_the_sandbox_user() {
         let sub = nosy_submission();
-        // /usr/bin/python3 can be run by `nobody`; elsewhere the default interpreter.
+        // /usr/bin/python3 can be run by a sandbox user; elsewhere the chosen interpreter.
         let system = Path::new("/usr/bin/python3");
         let python = system.is_file().then_some(system);
         let command = CandidateCommand::python_course_with(sub.path(), python, true).unwrap();
