@@ -767,7 +767,7 @@ impl Session {
     }
 
     /// What the sandbox did: limits, the isolation, the uid the candidate ran as (and a note on
-    /// if so), and whether its first process was seen in a network namespace of its own.
+    /// why not a stronger isolation), and the namespaces its first process was seen in.
     pub fn sandbox_facts(&self) -> SandboxFacts {
         self.facts
             .clone()
