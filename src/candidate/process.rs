@@ -545,6 +545,7 @@ impl Proc {
         }
         self.reaper.reap();
         let status = self.child.wait().ok().map(|s| self.through_bwrap(s));
+        self.reaper.untrack(self.pid as u32);
         let until = Instant::now() + Duration::from_millis(200);
         while !self.stderr_done.is_finished() && Instant::now() < until {
             std::thread::sleep(Duration::from_millis(2));
@@ -567,6 +568,7 @@ impl Proc {
         let until = Instant::now() + Duration::from_millis(500);
         loop {
             if let Ok(Some(status)) = self.child.try_wait() {
+                self.reaper.untrack(self.pid as u32);
                 return Some(self.through_bwrap(status));
             }
             if Instant::now() >= until {
@@ -585,6 +587,7 @@ impl Drop for Proc {
         }
         self.reaper.reap();
         let _ = self.child.wait();
+        self.reaper.untrack(self.pid as u32);
     }
 }
 

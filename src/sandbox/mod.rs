@@ -423,6 +423,13 @@ impl Reaper {
             g.push(pid as i32);
         }
     }
+
+    /// Forgets a child once it is reaped (its pid may be reused: never signal it again).
+    pub fn untrack(&self, pid: u32) {
+        if let Ok(mut g) = self.groups.lock() {
+            g.retain(|&p| p != pid as i32);
+        }
+    }
 }
 
 /// A prepared sandbox: a temporary folder holding copies of the files, the policy, the
@@ -855,14 +862,16 @@ impl Sandbox {
             }
         };
         let Some(status) = status else {
-            kill_group(&mut child);
             self.reaper.reap();
+            kill_group(&mut child);
+            self.reaper.untrack(child.id());
             return Err(format!(
                 "{} did not finish within {:.0} s",
                 program.display(),
                 timeout.as_secs_f64()
             ));
         };
+        self.reaper.untrack(child.id());
         self.reaper.reap();
         let out = out.join().unwrap_or_default();
         let err = err.join().unwrap_or_default();

@@ -197,7 +197,9 @@ fn a_double_forked_setsid_sleeper_does_not_outlive_the_sandbox() {
             identity::processes_of(uid).len() >= 2,
             "{isolation:?}: the sleepers did not start"
         );
+        sandbox.reaper().reap();
         kill_group(&mut child);
+        sandbox.reaper().untrack(child.id());
         drop(sandbox);
         // Everything of that uid is gone, the setsid sleeper included, and the folder too.
         let mut left = identity::processes_of(uid);
