@@ -6,6 +6,8 @@
 //! - [`process`]: [`Session`] runs a [`CandidateCommand`] (an `--adapter` command line or the
 //!   course adapter on a submission folder) in the [sandbox](crate::sandbox) with pipelined
 //!   requests, per-case timeouts, restarts after crashes and the process group killed on drop.
+//! - [`python`]: choosing the interpreter of the course adapter (the assignment's modules,
+//!   runnable in the sandbox).
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and its text.
 //! - [`diagnose`]: the known mistake (a buggy variant of the oracle) that explains the failures.
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
@@ -20,6 +22,7 @@ pub mod fuzz;
 pub mod generate;
 pub mod process;
 pub mod protocol;
+pub mod python;
 pub mod report;
 pub mod rust;
 pub mod shrink;

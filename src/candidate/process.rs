@@ -2,11 +2,15 @@
 //! pipelined requests, per-case timeouts, restart after a crash, kill the whole process group on
 //! drop.
 //!
-//! A [`Session`] makes one [`Sandbox`] (a fresh temporary folder, a cleared environment,
-//! limits, its own process group, no network where allowed, never root when a drop user exists;
-//! see [`crate::sandbox`] for what is done where) and starts every process of the candidate,
-//! restarts included, through it. The course adapter's submission files are copied into that
-//! folder, so the candidate never runs in (or writes to) the submission itself.
+//! A [`Session`] makes one [`Sandbox`] (bubblewrap where it works, else limits, its own session
+//! and a uid of its own; never root; see [`crate::sandbox`]) and starts every process of the
+//! candidate, restarts included, through it; when a process is killed or the session ends,
+//! every process the candidate started ends too ([`crate::sandbox::Reaper`]). The course
+//! adapter's submission files (its top-level Python modules, regular files up to
+//! [`MAX_STAGED_FILE_BYTES`] each and [`MAX_STAGED_TOTAL_BYTES`] in all) are copied into that
+//! folder, so the candidate never runs in (or writes to) the submission itself, and the adapter
+//! is told a neutral name, never the submission's path. The interpreter is chosen by
+//! [`python`](super::python).
 //!
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
 //! takes them while the session reads answers. Candidates may batch their answers; after the
@@ -31,11 +35,11 @@
 //!   with the reason, and the candidate is killed.
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
-use std::ffi::{OsStr, OsString};
+use std::ffi::OsString;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
+use std::process::{Child, ChildStdout, ExitStatus, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -45,10 +49,23 @@ use super::protocol::{
     quote_line,
 };
 use crate::oracle::vectors::{Case, ShapeKind};
-use crate::sandbox::{Sandbox, SandboxFacts, SandboxPolicy};
+use crate::sandbox::{Reaper, Sandbox, SandboxError, SandboxFacts, SandboxPolicy};
 
 /// The name the course adapter has in the sandbox folder.
-const ADAPTER_NAME: &str = "rtoracle_python_course.py";
+const ADAPTER_NAME: &str = "course_adapter.py";
+
+/// The name the course adapter is given (`--name`): neutral, so the code inside learns nothing
+/// of where the grader keeps the submission; reports use the harness's own label.
+const NEUTRAL_NAME: &str = "python-course";
+
+/// Largest submission file copied into the sandbox.
+pub const MAX_STAGED_FILE_BYTES: u64 = crate::sandbox::MAX_COPIED_FILE_BYTES;
+
+/// Most bytes of submission files copied into the sandbox in all.
+pub const MAX_STAGED_TOTAL_BYTES: u64 = 8 << 20;
+
+/// Most submission files copied into the sandbox.
+pub const MAX_STAGED_FILES: usize = 200;
 
 /// How many bytes of the candidate's stderr are kept for the report.
 pub const STDERR_TAIL_BYTES: usize = 4096;
@@ -188,9 +205,12 @@ pub enum HarnessError {
         /// What is wrong.
         problem: String,
     },
-    /// No usable Python interpreter.
-    #[error("cannot find python3 to run the course adapter ({0}); set RTORACLE_PYTHON")]
+    /// No usable Python interpreter (the message says which were tried and how to fix it).
+    #[error("{0}")]
     Python(String),
+    /// No sandbox may be made here: untrusted code is not run (fail closed).
+    #[error("{0}")]
+    Sandbox(#[from] SandboxError),
     /// An I/O error of the harness (temporary files, pipes).
     #[error("{context}: {reason}")]
     Io {
@@ -253,15 +273,16 @@ impl CandidateCommand {
     }
 
     /// The bundled adapter for the course's Python API run on the submission folder `dir`. The
-    /// interpreter is `$RTORACLE_PYTHON` or `python3`, resolved once to its real path. The
-    /// top-level `.py` files of `dir` are copied into the sandbox folder when the session starts,
-    /// and the adapter imports them from there. Anything the submission prints is a protocol
-    /// error of its case.
+    /// interpreter is [`python::choose`](super::python::choose)'s (with numpy and Pillow, runnable
+    /// in the sandbox). The top-level `.py` files of `dir` are copied into the sandbox folder when
+    /// the session starts, and the adapter imports them from there. Anything the submission
+    /// prints is a protocol error of its case.
     pub fn python_course(dir: &Path) -> Result<Self, HarnessError> {
         Self::python_course_with(dir, None, false)
     }
 
-    /// [`CandidateCommand::python_course`] with a chosen interpreter (`None`: as there), and with
+    /// [`CandidateCommand::python_course`] with a chosen interpreter (`None`: as there; a given one
+    /// is used as it is, so probe it first with [`python::choose`](super::python::choose)), and with
     /// the submission's prints sent to stderr instead (`prints_to_stderr`: what grading wants,
     /// since nothing a student prints may change a grade but the answers).
     pub fn python_course_with(
@@ -282,7 +303,15 @@ impl CandidateCommand {
         })?;
         let python = match python {
             Some(p) => p.to_path_buf(),
-            None => resolve_python()?,
+            None => super::python::choose(
+                None,
+                &super::python::default_requires(),
+                &SandboxPolicy::default(),
+            )
+            .map_err(|e| match e {
+                super::python::PythonError::Sandbox(e) => HarnessError::Sandbox(e),
+                other => HarnessError::Python(other.to_string()),
+            })?,
         };
         let label = format!("python-course {}", dir.display());
         let mut args: Vec<OsString> = vec![
@@ -291,7 +320,7 @@ impl CandidateCommand {
             ADAPTER_NAME.into(),
             ".".into(),
             "--name".into(),
-            label.clone().into(),
+            NEUTRAL_NAME.into(),
         ];
         if prints_to_stderr {
             args.push("--prints-to-stderr".into());
@@ -311,48 +340,117 @@ impl CandidateCommand {
         self.course_adapter
     }
 
-    /// The files to copy into the sandbox: the submission's top-level `.py` files (regular
-    /// files only: links are not followed out of the folder).
-    fn staged_files(&self) -> Result<Vec<(PathBuf, String)>, HarnessError> {
+    /// The files to copy into the sandbox: the submission's top-level Python modules (a name
+    /// that is a Python identifier plus `.py`; regular files only, never a link, FIFO or
+    /// device; up to [`MAX_STAGED_FILE_BYTES`] each, [`MAX_STAGED_TOTAL_BYTES`] and
+    /// [`MAX_STAGED_FILES`] in all), and the ones left out, each named (escaped) with why.
+    #[allow(clippy::type_complexity)]
+    fn staged_files(&self) -> Result<(Vec<(PathBuf, String)>, Vec<String>), HarnessError> {
         let Some(dir) = &self.submission else {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), Vec::new()));
         };
         let entries = std::fs::read_dir(dir).map_err(|reason| HarnessError::Io {
             context: dir.display().to_string(),
             reason,
         })?;
-        let mut files = Vec::new();
+        let mut candidates = Vec::new();
         for entry in entries.flatten() {
-            let name = entry.file_name().to_string_lossy().to_string();
-            let is_file = entry.file_type().map(|t| t.is_file()).unwrap_or(false);
-            if is_file && name.ends_with(".py") && name != ADAPTER_NAME {
-                files.push((entry.path(), name));
+            let raw = entry.file_name();
+            let name = raw.to_string_lossy().to_string();
+            if !name.ends_with(".py") || name == ADAPTER_NAME {
+                continue;
+            }
+            candidates.push((name, entry));
+        }
+        candidates.sort_by(|a, b| a.0.cmp(&b.0));
+        let mut files = Vec::new();
+        let mut skipped = Vec::new();
+        let mut total = 0u64;
+        for (name, entry) in candidates {
+            let shown = crate::escape::terminal_line(&name);
+            let stem = &name[..name.len() - 3];
+            let identifier = !stem.is_empty()
+                && !stem.starts_with(|c: char| c.is_ascii_digit())
+                && stem.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            // Not followed: a link stays a link.
+            let meta = std::fs::symlink_metadata(entry.path());
+            let why = match &meta {
+                _ if !identifier => Some("not a Python module name".to_string()),
+                Err(e) => Some(e.to_string()),
+                Ok(m) if m.file_type().is_symlink() => Some("a symbolic link".into()),
+                Ok(m) if !m.is_file() => Some("not a regular file".into()),
+                Ok(m) if m.len() > MAX_STAGED_FILE_BYTES => Some(format!(
+                    "{} bytes, over the {} bytes a file may have",
+                    m.len(),
+                    MAX_STAGED_FILE_BYTES
+                )),
+                Ok(m) if total + m.len() > MAX_STAGED_TOTAL_BYTES => Some(format!(
+                    "over the {MAX_STAGED_TOTAL_BYTES} bytes all files may have"
+                )),
+                Ok(_) if files.len() >= MAX_STAGED_FILES => {
+                    Some(format!("over the {MAX_STAGED_FILES} files that are copied"))
+                }
+                Ok(m) => {
+                    total += m.len();
+                    None
+                }
+            };
+            match why {
+                Some(why) => skipped.push(format!("{shown} ({why})")),
+                None => files.push((entry.path(), name)),
             }
         }
-        files.sort();
-        Ok(files)
+        Ok((files, skipped))
     }
 
-    /// Makes the sandbox for this command: the staged files, the adapter, and the drop user
-    /// checked before any untrusted code runs.
+    /// Makes the sandbox for this command: the staged files, the adapter, the program's and its
+    /// files' folders shown read-only, and (for an adapter) a check, inside the sandbox, that
+    /// its user can run the program and read its files, before any untrusted code runs.
     fn sandbox(&self, policy: SandboxPolicy) -> Result<Sandbox, HarnessError> {
         let io = |reason| HarnessError::Io {
             context: "preparing the candidate's sandbox folder".into(),
             reason,
         };
-        let mut sandbox = Sandbox::new(policy, &self.staged_files()?).map_err(io)?;
+        let (files, skipped) = self.staged_files()?;
+        let mut sandbox = Sandbox::new(policy, &files)?;
+        sandbox.set_skipped(skipped);
+        sandbox.expose(&self.program);
         if self.course_adapter {
             sandbox
                 .add_file(ADAPTER_NAME, PYTHON_COURSE_ADAPTER.as_bytes())
                 .map_err(io)?;
-            if sandbox.drops_user() {
-                let args = [OsStr::new("-I"), OsStr::new("-S"), OsStr::new("-c")];
-                let mut args = args.to_vec();
-                args.push(OsStr::new("pass"));
-                sandbox.probe(&self.program, &args);
-            }
         } else {
-            sandbox.probe_access(&self.program, &self.args);
+            let found = if self.program.components().count() > 1 {
+                self.program.exists()
+            } else {
+                std::env::split_paths(crate::sandbox::SANDBOX_PATH)
+                    .chain(
+                        std::env::var_os("PATH")
+                            .iter()
+                            .flat_map(std::env::split_paths),
+                    )
+                    .any(|d| d.join(&self.program).is_file())
+            };
+            if !found {
+                return Err(HarnessError::Spawn {
+                    program: self.program.display().to_string(),
+                    reason: std::io::Error::from_raw_os_error(libc::ENOENT),
+                });
+            }
+            for a in &self.args {
+                let p = Path::new(a);
+                if p.is_absolute() && p.exists() {
+                    sandbox.expose(p);
+                }
+            }
+            if sandbox.isolation() != crate::sandbox::Isolation::Unsandboxed {
+                sandbox
+                    .probe_access(&self.program, &self.args)
+                    .map_err(|problem| HarnessError::Command {
+                        command: self.label.clone(),
+                        problem,
+                    })?;
+            }
         }
         Ok(sandbox)
     }
@@ -394,24 +492,6 @@ fn split_words(line: &str) -> Option<Vec<String>> {
     Some(words)
 }
 
-fn resolve_python() -> Result<PathBuf, HarnessError> {
-    let python = std::env::var_os("RTORACLE_PYTHON").unwrap_or_else(|| "python3".into());
-    let out = Command::new(&python)
-        .args(["-I", "-c", "import sys; print(sys.executable)"])
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|e| HarnessError::Python(format!("{}: {e}", python.to_string_lossy())))?;
-    let path = String::from_utf8_lossy(&out.stdout).trim().to_string();
-    if !out.status.success() || path.is_empty() {
-        return Err(HarnessError::Python(format!(
-            "{} exited with {}",
-            python.to_string_lossy(),
-            out.status
-        )));
-    }
-    Ok(PathBuf::from(path))
-}
-
 /// The last bytes of a stream.
 #[derive(Debug, Default)]
 struct Tail(VecDeque<u8>);
@@ -437,6 +517,11 @@ enum Line {
 struct Proc {
     child: Child,
     pid: i32,
+    /// Ends every process the candidate started (its PID namespace or its uid).
+    reaper: Reaper,
+    /// Whether the child is bubblewrap, which exits `128 + N` when the candidate dies of signal
+    /// `N`: such statuses are read back as the signal.
+    bwrap: bool,
     writer: Option<Sender<Vec<u8>>>,
     lines: Receiver<Line>,
     stderr_done: std::thread::JoinHandle<()>,
@@ -458,6 +543,8 @@ impl Proc {
             reason,
         })?;
         let pid = child.id() as i32;
+        let reaper = sandbox.reaper();
+        reaper.track(child.id());
         let stdin = child.stdin.take().expect("piped stdin");
         let stdout = child.stdout.take().expect("piped stdout");
         let mut err = child.stderr.take().expect("piped stderr");
@@ -491,6 +578,8 @@ impl Proc {
         Ok(Proc {
             child,
             pid,
+            reaper,
+            bwrap: sandbox.isolation() == crate::sandbox::Isolation::Bubblewrap,
             writer: Some(wtx),
             lines: lrx,
             stderr_done,
@@ -510,7 +599,9 @@ impl Proc {
         unsafe {
             libc::killpg(self.pid, libc::SIGKILL);
         }
-        let status = self.child.wait().ok();
+        self.reaper.reap();
+        let status = self.child.wait().ok().map(|s| self.through_bwrap(s));
+        self.reaper.untrack(self.pid as u32);
         let until = Instant::now() + Duration::from_millis(200);
         while !self.stderr_done.is_finished() && Instant::now() < until {
             std::thread::sleep(Duration::from_millis(2));
@@ -518,12 +609,23 @@ impl Proc {
         status
     }
 
+    /// The candidate's status from bubblewrap's: `128 + N` is death by signal `N`.
+    fn through_bwrap(&self, status: ExitStatus) -> ExitStatus {
+        match status.code() {
+            Some(code) if self.bwrap && (129..160).contains(&code) => {
+                ExitStatus::from_raw(code - 128)
+            }
+            _ => status,
+        }
+    }
+
     /// The exit status if the process has exited (after its stdout closed).
     fn exit_status(&mut self) -> Option<ExitStatus> {
         let until = Instant::now() + Duration::from_millis(500);
         loop {
             if let Ok(Some(status)) = self.child.try_wait() {
-                return Some(status);
+                self.reaper.untrack(self.pid as u32);
+                return Some(self.through_bwrap(status));
             }
             if Instant::now() >= until {
                 return None;
@@ -539,7 +641,9 @@ impl Drop for Proc {
         unsafe {
             libc::killpg(self.pid, libc::SIGKILL);
         }
+        self.reaper.reap();
         let _ = self.child.wait();
+        self.reaper.untrack(self.pid as u32);
     }
 }
 
@@ -727,9 +831,11 @@ impl Session {
                 session.broken = Some(message);
             }
         }
-        if session.hello.name.is_empty() {
+        if session.hello.name.is_empty() || session.command.course_adapter {
+            // The course adapter was told a neutral name; reports use the real label.
             session.hello.name = session.command.label.clone();
         }
+        crate::sandbox::announce(&session.sandbox_facts());
         Ok(session)
     }
 
@@ -760,17 +866,23 @@ impl Session {
         &self.command
     }
 
-    /// What the sandbox did: limits, the user the candidate ran as (and why not the drop user,
-    /// if so), and whether its first process was seen in a network namespace of its own.
+    /// What the sandbox did: limits, the isolation, the uid the candidate ran as (and a note on
+    /// why not a stronger isolation), and the namespaces its first process was seen in.
     pub fn sandbox_facts(&self) -> SandboxFacts {
         self.facts
             .clone()
             .unwrap_or_else(|| self.sandbox.facts(None))
     }
 
-    /// The sandbox's folder (where the candidate runs; file names in its tracebacks start here).
+    /// The sandbox's folder as the harness sees it.
     pub fn sandbox_dir(&self) -> &Path {
         self.sandbox.dir()
+    }
+
+    /// The sandbox's folder as the candidate sees it (`/sandbox` under bubblewrap; file names
+    /// in its tracebacks start here).
+    pub fn sandbox_inside_dir(&self) -> PathBuf {
+        self.sandbox.inside_dir()
     }
 
     /// Names the submission's own files in a candidate's error: the course adapter runs a copy
@@ -781,6 +893,13 @@ impl Session {
             return;
         };
         let dir = self.sandbox.dir();
+        let inside = self.sandbox.inside_dir();
+        if inside != dir {
+            let to = submission.display().to_string();
+            for text in [&mut error.message, &mut error.traceback] {
+                *text = crate::sandbox::replace_path(text, &inside, &to);
+            }
+        }
         let mut seen = vec![dir.to_path_buf()];
         if let Ok(real) = dir.canonicalize() {
             seen.push(real);
@@ -1243,7 +1362,7 @@ mod tests {
     #[test]
     fn the_course_adapter_runs_on_a_copy_in_the_sandbox_as_the_sandbox_user() {
         let sub = nosy_submission();
-        // /usr/bin/python3 can be run by `nobody`; elsewhere the default interpreter.
+        // /usr/bin/python3 can be run by a sandbox user; elsewhere the chosen interpreter.
         let system = Path::new("/usr/bin/python3");
         let python = system.is_file().then_some(system);
         let command = CandidateCommand::python_course_with(sub.path(), python, true).unwrap();
@@ -1255,10 +1374,16 @@ mod tests {
         let report = super::super::check_session(&mut session, &cases).unwrap();
         assert!(report.passed(), "{}", report.to_text(3));
         let dir = session.sandbox_dir().canonicalize().unwrap();
+        let inside = session.sandbox_inside_dir();
+        let inside = inside.canonicalize().unwrap_or(inside);
         let tail = session.stderr_tail();
         // It ran in the sandbox folder, with HOME there, and wrote there, not in the submission.
         assert!(
-            tail.contains(&format!("cwd {} home {}", dir.display(), dir.display())),
+            tail.contains(&format!(
+                "cwd {} home {}",
+                inside.display(),
+                inside.display()
+            )),
             "{tail}"
         );
         assert!(dir.join("written-by-import").is_file());
@@ -1266,14 +1391,15 @@ mod tests {
         let facts = session.sandbox_facts();
         assert_eq!(report.sandbox.as_ref(), Some(&facts));
         assert!(tail.contains(&format!("uid {} ", facts.uid)), "{tail}");
-        if crate::sandbox::running_as_root()
-            && python.is_some()
-            && crate::sandbox::lookup_user("nobody").is_some()
-        {
-            assert_ne!(facts.uid, 0, "{facts:?}");
-            assert_eq!(facts.note, None);
-            assert_eq!(facts.network_isolated, Some(true));
+        if crate::sandbox::running_as_root() {
+            // Never root, and a uid of its own.
+            assert!(facts.uid >= 1 << 30, "{facts:?}");
         }
+        if facts.isolation == crate::sandbox::Isolation::Bubblewrap {
+            assert_eq!(facts.network_isolated, Some(true), "{facts:?}");
+        }
+        // The adapter was told a neutral name; the report keeps the real label.
+        assert!(report.candidate.contains(&sub.path().display().to_string()));
         drop(session);
         assert!(
             !dir.exists(),

@@ -5,11 +5,12 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::candidate::{CandidateCommand, RunOptions, check_command};
+use rtoracle::candidate::{CandidateCommand, RunOptions, SandboxPolicy, check_command, python};
 use rtoracle::oracle::vectors::{Case, read_vectors};
 use rtoracle::oracle::{
     Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
 };
+use rtoracle::sandbox::SandboxError;
 
 /// Which candidate to run (shared by `check` and `fuzz`; `check` without either checks the
 /// course submission in the current folder).
@@ -85,12 +86,71 @@ impl Target {
         }
     }
 
-    /// The command to run.
-    pub fn command(&self) -> anyhow::Result<CandidateCommand> {
+}
+
+/// How the candidate is sandboxed and which Python runs the course adapter (shared by `check`
+/// and `fuzz`).
+#[derive(Debug, clap::Args)]
+pub struct SandboxArgs {
+    /// The Python 3 that runs the course adapter (it must have numpy and PIL); default:
+    /// $RTORACLE_PYTHON, else the first of /usr/bin/python3, /usr/local/bin/python3, python3
+    /// on PATH, ... that has them.
+    #[arg(long, value_name = "PATH")]
+    pub python: Option<PathBuf>,
+    /// Run the candidate without a sandbox, as the current user (root included), for one's own
+    /// code where no sandbox can be made; the output says so.
+    #[arg(long)]
+    pub unsandboxed: bool,
+}
+
+impl SandboxArgs {
+    /// The sandbox policy of `check` and `fuzz`.
+    pub fn policy(&self) -> SandboxPolicy {
+        SandboxPolicy {
+            unsandboxed: self.unsandboxed,
+            ..SandboxPolicy::default()
+        }
+    }
+}
+
+/// A sandbox error with the way out that `check` and `fuzz` offer.
+fn with_hint(e: SandboxError) -> anyhow::Error {
+    match e {
+        SandboxError::Unavailable(_) => {
+            anyhow::anyhow!("{e} (pass --unsandboxed to run your own code without a sandbox)")
+        }
+        other => other.into(),
+    }
+}
+
+impl Target {
+    /// The command to run, after checking that a sandbox can be made (fail closed) and, for the
+    /// course adapter, choosing the interpreter: both before any work.
+    pub fn command(&self, sandbox: &SandboxArgs) -> anyhow::Result<CandidateCommand> {
         self.check()?;
+        let policy = sandbox.policy();
+        rtoracle::sandbox::isolation_for(&policy).map_err(with_hint)?;
         Ok(match (&self.python_course, &self.adapter) {
-            (Some(dir), _) => CandidateCommand::python_course(dir)?,
-            (_, Some(cmd)) => CandidateCommand::adapter(cmd)?,
+            (Some(dir), _) => {
+                let python = python::choose(
+                    sandbox.python.as_deref(),
+                    &python::default_requires(),
+                    &policy,
+                )
+                .map_err(|e| match e {
+                    python::PythonError::Sandbox(e) => with_hint(e),
+                    other => other.into(),
+                })?;
+                CandidateCommand::python_course_with(dir, Some(&python), false)?
+            }
+            (_, Some(cmd)) => {
+                if sandbox.python.is_some() {
+                    anyhow::bail!(
+                        "--python is for --python-course; put the interpreter in the --adapter command"
+                    );
+                }
+                CandidateCommand::adapter(cmd)?
+            }
             _ => anyhow::bail!("give the candidate: --python-course DIR or --adapter 'CMD ARGS'"),
         })
     }
@@ -130,6 +190,8 @@ pub struct Args {
     target: Target,
     #[command(flatten)]
     judging: JudgingArgs,
+    #[command(flatten)]
+    sandbox: SandboxArgs,
     /// A vector file (JSON lines); the built-in suite when absent. Its expectations are used as
     /// written unless --profile or --precision is given, which reclassifies every case.
     #[arg(long, value_name = "FILE")]
@@ -153,7 +215,7 @@ pub struct Args {
 
 /// `rtoracle check` with no candidate: the course submission in the current folder, as
 /// `--python-course .`, announced on stderr (stdout stays the report, JSON with `--json`).
-fn current_submission() -> anyhow::Result<CandidateCommand> {
+fn current_submission() -> anyhow::Result<PathBuf> {
     let here = std::env::current_dir().context("cannot read the current folder")?;
     let shown = rtoracle::escape::terminal_line(&here.display().to_string());
     if !here.join("RT_object.py").is_file() {
@@ -162,7 +224,7 @@ fn current_submission() -> anyhow::Result<CandidateCommand> {
         );
     }
     errln!("checking the course submission in {shown} (as --python-course .)");
-    Ok(CandidateCommand::python_course(&here)?)
+    Ok(here)
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -185,12 +247,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
         hello_timeout: Duration::from_millis(args.hello_timeout_ms),
+        limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
+    rtoracle::sandbox::announce_on_stderr();
     let command = if args.target.python_course.is_none() && args.target.adapter.is_none() {
-        current_submission()?
+        let here = Target {
+            python_course: Some(current_submission()?),
+            adapter: None,
+        };
+        here.command(&args.sandbox)?
     } else {
-        args.target.command()?
+        args.target.command(&args.sandbox)?
     };
     let mut report = check_command(command, &cases, options).context("check")?;
     report.judged_by = Some(judged_by);

@@ -26,6 +26,8 @@ pub struct Args {
     target: super::check::Target,
     #[command(flatten)]
     judging: super::check::JudgingArgs,
+    #[command(flatten)]
+    sandbox: super::check::SandboxArgs,
     /// How many random cases to run (default 10000 when --time is not given; with both,
     /// whichever comes first).
     #[arg(long, value_name = "N", value_parser = super::num::count)]
@@ -80,9 +82,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
+        limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
-    let mut session = Session::start(args.target.command()?, options).context("fuzz")?;
+    rtoracle::sandbox::announce_on_stderr();
+    let command = args.target.command(&args.sandbox)?;
+    let mut session = Session::start(command, options).context("fuzz")?;
     if let Some(e) = &session.hello().error {
         errln!(
             "rtoracle: the submission cannot be imported: {}",

@@ -35,12 +35,14 @@ pub struct Args {
     /// Worker threads for --batch (default: all cores).
     #[arg(long, value_name = "T", value_parser = super::num::threads)]
     threads: Option<usize>,
+    /// The Python 3 that runs the submissions (it must have the rubric's python_requires,
+    /// default numpy and PIL); default: $RTORACLE_PYTHON, else the first of /usr/bin/python3,
+    /// /usr/local/bin/python3, python3 on PATH, ... that has them.
+    #[arg(long, value_name = "PATH")]
+    python: Option<PathBuf>,
     /// Print the rubric in use (the built-in one unless --rubric) and exit.
     #[arg(long)]
     print_rubric: bool,
-    /// The Python 3 to run students' code with (it needs numpy and Pillow).
-    #[arg(long, value_name = "PATH")]
-    python: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -112,12 +114,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
         None => None,
     };
+    // Before grading anything: a sandbox that keeps the code from running as root (fail
+    // closed), and a Python with the rubric's modules that the sandbox user can run.
+    let policy = rtoracle::sandbox::SandboxPolicy::grading();
+    let python = rtoracle::candidate::python::choose(
+        args.python.as_deref(),
+        &rubric.python_requires,
+        &policy,
+    )?;
+    rtoracle::sandbox::announce_on_stderr();
     let code = CourseCodeChecker {
         seed: rubric.seed,
         vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
-        python: args.python.clone(),
         time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
+        policy,
+        python: Some(python),
+        python_requires: rubric.python_requires.clone(),
         ..Default::default()
     };
     // Said once the grading is done, so bad input stays one line on stderr.

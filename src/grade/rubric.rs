@@ -5,6 +5,7 @@
 //! name = "week04"
 //! seed = 0                       # seed of the vector suite
 //! code_time_budget_seconds = 60  # wall time for all of a submission's code checks
+//! python_requires = ["numpy", "PIL"]  # modules the grader's Python must have (the default)
 //!
 //! [[group]]
 //! id = "sphere"                  # check ids start with the group id
@@ -242,6 +243,10 @@ pub struct Rubric {
     /// past it the vectors not yet answered are `not_run`, and the grade of the rest stands.
     #[serde(default = "default_code_time_budget")]
     pub code_time_budget_seconds: f64,
+    /// The modules the Python that runs the submissions must have (default numpy and PIL, which
+    /// the course's `RT_utility.py` imports); `grade` exits 2 when no interpreter has them.
+    #[serde(default = "crate::candidate::python::default_requires")]
+    pub python_requires: Vec<String>,
     /// The groups, in report order.
     #[serde(rename = "group")]
     pub groups: Vec<Group>,

@@ -598,6 +598,16 @@ fn a_forked_child_is_killed_with_its_group() {
         .and_then(|s| s.split_whitespace().next())
         .and_then(|s| s.parse().ok())
         .unwrap_or_else(|| panic!("no pid in {:?}", r.stderr_tail));
+    let facts = r.sandbox.as_ref().expect("sandbox facts");
+    if facts.isolation == rtoracle::sandbox::Isolation::Bubblewrap {
+        // The pid is the PID namespace's: no process of the sandbox's uid may be left.
+        // SAFETY: geteuid has no preconditions.
+        if unsafe { libc::geteuid() } == 0 {
+            let left = rtoracle::sandbox::identity::processes_of(facts.uid);
+            assert!(left.is_empty(), "left: {left:?}");
+        }
+        return;
+    }
     // Gone, or a zombie waiting for init: not sleeping.
     std::thread::sleep(Duration::from_millis(100));
     let state = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();

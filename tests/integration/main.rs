@@ -13,3 +13,4 @@ mod protocol;
 mod readme;
 mod render;
 mod reports;
+mod sandbox;

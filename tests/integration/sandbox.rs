@@ -1,0 +1,454 @@
+//! The sandbox against hostile submissions (GRADING.md, "Running untrusted code"): one test per
+//! class of attack, each a course-layout submission (the honest fixture plus a hostile import)
+//! run through the real binary. They need root, as a grader on Gradescope has it; they say so
+//! and pass when not root.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use rtoracle::candidate::bench::assemble_fixture;
+
+use crate::common::*;
+
+fn root(test: &str) -> bool {
+    // SAFETY: geteuid has no preconditions.
+    let root = unsafe { libc::geteuid() } == 0;
+    if !root {
+        eprintln!("skipped {test}: needs root (the grader's situation on Gradescope)");
+    }
+    root
+}
+
+/// The honest fixture with `hostile` appended to its `RT_object.py` (run at import), in a folder
+/// a sandbox user may read.
+fn hostile(hostile: &str) -> tempfile::TempDir {
+    let dir = assemble_fixture("honest_reference").unwrap();
+    let object = dir.path().join("RT_object.py");
+    let mut text = std::fs::read_to_string(&object).unwrap();
+    text.push_str("\n# --- hostile part ---\n");
+    text.push_str(hostile);
+    std::fs::write(&object, text).unwrap();
+    open_up(dir.path());
+    dir
+}
+
+fn open_up(dir: &Path) {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn check_json(dir: &Path, extra: &[&str]) -> (Output, serde_json::Value) {
+    let mut args = vec!["check", "--python-course", dir.to_str().unwrap(), "--json"];
+    args.extend_from_slice(extra);
+    let out = run_in(dir, &args);
+    let json = serde_json::from_slice(&out.stdout).unwrap_or(serde_json::Value::Null);
+    (out, json)
+}
+
+#[test]
+fn a_submission_cannot_read_root_only_files_nor_the_grader_s() {
+    if !root("a_submission_cannot_read_root_only_files_nor_the_grader_s") {
+        return;
+    }
+    // A grader's file it guesses: world-readable, outside the submission.
+    let grader = tempfile::tempdir().unwrap();
+    open_up(grader.path());
+    let secret = grader.path().join("vectors.jsonl");
+    std::fs::write(&secret, "GRADER-SECRET-VECTORS\n").unwrap();
+    let sub = hostile(&format!(
+        r#"
+import sys as _s
+for _p in ["/etc/shadow", {secret:?}]:
+    try:
+        with open(_p) as _f:
+            _s.stderr.write("READ %s %r\n" % (_p, _f.read(60)))
+    except Exception as _e:
+        _s.stderr.write("DENIED %s %s\n" % (_p, type(_e).__name__))
+"#,
+        secret = secret.display().to_string()
+    ));
+    let (out, json) = check_json(sub.path(), &[]);
+    let tail = json["stderr_tail"].as_str().unwrap_or_default().to_string();
+    assert!(
+        tail.contains("DENIED /etc/shadow"),
+        "{tail}\n{}",
+        stderr(&out)
+    );
+    assert!(!tail.contains("READ /etc/shadow"), "{tail}");
+    // The grader's file is hidden under bubblewrap (the fallback sees world-readable files).
+    if json["sandbox"]["isolation"] == "bubblewrap" {
+        assert!(!tail.contains("GRADER-SECRET"), "{tail}");
+        assert!(
+            tail.contains(&format!("DENIED {} FileNotFoundError", secret.display())),
+            "{tail}"
+        );
+    }
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}
+
+#[test]
+fn a_double_forked_setsid_sleeper_does_not_outlive_the_check() {
+    if !root("a_double_forked_setsid_sleeper_does_not_outlive_the_check") {
+        return;
+    }
+    let marker = format!("rtoracle-test-sleeper-{}", std::process::id());
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s
+if _o.fork() == 0:
+    _o.setsid()
+    if _o.fork() == 0:
+        _o.execv(_s.executable, [_s.executable, "-c", "import time; time.sleep(600)", {marker:?}])
+    _o._exit(0)
+_s.stderr.write("daemon started\n")
+"#
+    ));
+    for mode in ["auto", "uid"] {
+        let out = rtoracle()
+            .current_dir(sub.path())
+            .env("RTORACLE_SANDBOX", mode)
+            .args(["check", "--python-course", sub.path().to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
+        let survivors = processes_with(&marker);
+        assert!(survivors.is_empty(), "{mode}: still running: {survivors:?}");
+    }
+}
+
+/// The pids whose command line contains `needle`.
+fn processes_with(needle: &str) -> Vec<u32> {
+    let mut found = Vec::new();
+    for e in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        if pid == std::process::id() {
+            continue;
+        }
+        let cmdline = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
+        let state = std::fs::read_to_string(e.path().join("stat")).unwrap_or_default();
+        let zombie = state
+            .rsplit(')')
+            .next()
+            .is_some_and(|r| r.trim_start().starts_with('Z'));
+        if !zombie && String::from_utf8_lossy(&cmdline).contains(needle) {
+            found.push(pid);
+        }
+    }
+    found
+}
+
+/// `name: score / max` lines of `grade --batch`.
+fn scores(out: &Output) -> Vec<(String, String)> {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| {
+            let (name, score) = l.split_once(": ")?;
+            Some((name.to_string(), score.to_string()))
+        })
+        .collect()
+}
+
+#[test]
+fn a_killer_in_a_batch_costs_its_honest_classmates_nothing() {
+    if !root("a_killer_in_a_batch_costs_its_honest_classmates_nothing") {
+        return;
+    }
+    let batch = tempfile::tempdir().unwrap();
+    open_up(batch.path());
+    let honest = assemble_fixture("honest_reference").unwrap();
+    let killer = hostile(
+        r#"
+import os as _o, time as _t
+if _o.fork() == 0:
+    _o.setsid()
+    _end = _t.time() + 8
+    while _t.time() < _end:
+        try:
+            _o.kill(-1, 9)
+        except Exception:
+            pass
+        _t.sleep(0.005)
+    _o._exit(0)
+"#,
+    );
+    let copy = |from: &Path, to: PathBuf| {
+        std::fs::create_dir_all(&to).unwrap();
+        for e in std::fs::read_dir(from).unwrap().flatten() {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    };
+    copy(killer.path(), batch.path().join("a-killer"));
+    for i in 0..3 {
+        copy(honest.path(), batch.path().join(format!("honest-{i}")));
+    }
+    // Alone, an honest submission scores this.
+    let alone_out = tempfile::tempdir().unwrap();
+    let alone = run_in(
+        batch.path(),
+        &[
+            "grade",
+            batch.path().join("honest-0").to_str().unwrap(),
+            "--out",
+            alone_out.path().to_str().unwrap(),
+        ],
+    );
+    assert_eq!(alone.status.code(), Some(0), "{}", stderr(&alone));
+    let total = String::from_utf8_lossy(&alone.stdout)
+        .lines()
+        .find(|l| l.starts_with("total"))
+        .map(|l| l.split_whitespace().skip(1).collect::<Vec<_>>().join(" "))
+        .unwrap();
+    let out_dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        batch.path(),
+        &[
+            "grade",
+            "--batch",
+            batch.path().to_str().unwrap(),
+            "--out",
+            out_dir.path().join("out").to_str().unwrap(),
+            "--threads",
+            "2",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let scores = scores(&out);
+    for i in 0..3 {
+        let name = format!("honest-{i}");
+        let score = scores.iter().find(|(n, _)| *n == name).map(|(_, s)| s);
+        // `12.5 / 100` alone is `12.5 / 100` beside the killer.
+        assert_eq!(
+            score.map(|s| s.split_whitespace().collect::<Vec<_>>().join(" ")),
+            Some(total.clone()),
+            "{name}: {scores:?}"
+        );
+    }
+}
+
+#[test]
+fn the_grader_s_binary_is_not_found_in_proc_under_bubblewrap() {
+    if !root("the_grader_s_binary_is_not_found_in_proc_under_bubblewrap") {
+        return;
+    }
+    let sub = hostile(
+        r#"
+import os as _o, sys as _s
+for _p in _o.listdir("/proc"):
+    if _p.isdigit():
+        try:
+            with open("/proc/%s/cmdline" % _p, "rb") as _f:
+                _c = _f.read().replace(b"\0", b" ").decode("utf-8", "replace")
+        except Exception:
+            continue
+        if "rtoracle" in _c or "grade" in _c:
+            _s.stderr.write("FOUND %s\n" % _c)
+_s.stderr.write("scanned /proc\n")
+"#,
+    );
+    let (out, json) = check_json(sub.path(), &[]);
+    if json["sandbox"]["isolation"] != "bubblewrap" {
+        eprintln!(
+            "skipped: bubblewrap does not work here ({})",
+            json["sandbox"]
+        );
+        return;
+    }
+    let tail = json["stderr_tail"].as_str().unwrap_or_default();
+    assert!(tail.contains("scanned /proc"), "{tail}\n{}", stderr(&out));
+    assert!(!tail.contains("FOUND"), "{tail}");
+}
+
+#[test]
+fn with_no_sandbox_grade_refuses_and_check_runs_only_when_asked_unsandboxed() {
+    if !root("with_no_sandbox_grade_refuses_and_check_runs_only_when_asked_unsandboxed") {
+        return;
+    }
+    let sub = assemble_fixture("honest_reference").unwrap();
+    open_up(sub.path());
+    let out_dir = tempfile::tempdir().unwrap();
+    let report = out_dir.path().join("report");
+    let run = |args: &[&str]| {
+        rtoracle()
+            .current_dir(sub.path())
+            .env("RTORACLE_SANDBOX", "none")
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let grade = run(&[
+        "grade",
+        sub.path().to_str().unwrap(),
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    assert_bad_input(&grade, "untrusted code never runs as root");
+    assert!(!report.exists(), "nothing graded, nothing written");
+    let check = run(&["check", "--python-course", sub.path().to_str().unwrap()]);
+    assert_bad_input(&check, "--unsandboxed");
+    let check = run(&[
+        "check",
+        "--python-course",
+        sub.path().to_str().unwrap(),
+        "--unsandboxed",
+    ]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    assert!(
+        stderr(&check).contains("rtoracle: sandbox: UNSANDBOXED"),
+        "{}",
+        stderr(&check)
+    );
+    let stdout = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        stdout.contains("sandbox: unsandboxed by request"),
+        "{stdout}"
+    );
+    // A mode that does not exist is bad input too.
+    let bad = rtoracle()
+        .env("RTORACLE_SANDBOX", "chroot")
+        .args(["check", "--python-course", sub.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_bad_input(&bad, "RTORACLE_SANDBOX=\"chroot\"");
+}
+
+#[test]
+fn an_interpreter_without_numpy_is_named_with_numpy_by_check_and_grade() {
+    if !Path::new("/usr/bin/python3").is_file() {
+        eprintln!("skipped: no /usr/bin/python3");
+        return;
+    }
+    // A Python that really lacks numpy: the system one without its site-packages (-S).
+    let bin = tempfile::tempdir().unwrap();
+    open_up(bin.path());
+    let fake = bin.path().join("python3-without-numpy");
+    std::fs::write(&fake, "#!/bin/sh\nexec /usr/bin/python3 -S \"$@\"\n").unwrap();
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let lacks = std::process::Command::new(&fake)
+        .args(["-c", "import numpy"])
+        .output()
+        .unwrap();
+    assert!(!lacks.status.success(), "the fake Python has numpy");
+    let sub = assemble_fixture("honest_reference").unwrap();
+    open_up(sub.path());
+    let fake = fake.to_str().unwrap();
+    let check = run_in(
+        sub.path(),
+        &[
+            "check",
+            "--python-course",
+            sub.path().to_str().unwrap(),
+            "--python",
+            fake,
+        ],
+    );
+    assert_bad_input(&check, &format!("--python {fake}: lacks numpy"));
+    assert!(
+        stderr(&check).contains("apt-get install python3-numpy"),
+        "{}",
+        stderr(&check)
+    );
+    let out_dir = tempfile::tempdir().unwrap();
+    let grade = run_in(
+        sub.path(),
+        &[
+            "grade",
+            sub.path().to_str().unwrap(),
+            "--python",
+            fake,
+            "--out",
+            out_dir.path().join("r").to_str().unwrap(),
+        ],
+    );
+    assert_bad_input(&grade, &format!("--python {fake}: lacks numpy"));
+    assert!(!out_dir.path().join("r").exists());
+}
+
+#[test]
+fn only_python_modules_of_regular_files_are_copied_and_the_rest_is_named() {
+    let sub = assemble_fixture("honest_reference").unwrap();
+    open_up(sub.path());
+    // A FIFO, a link to a root-only file and an oversized module: none is opened or copied.
+    let fifo = std::ffi::CString::new(sub.path().join("fifo.py").to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo with a valid path.
+    assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o644) }, 0);
+    std::os::unix::fs::symlink("/etc/shadow", sub.path().join("shadow.py")).unwrap();
+    std::fs::write(sub.path().join("big.py"), vec![b'#'; 2 << 20]).unwrap();
+    std::fs::write(sub.path().join("bad\u{1b}[31mname.py"), "x = 1\n").unwrap();
+    let (out, json) = check_json(sub.path(), &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let skipped: Vec<String> = json["sandbox"]["skipped_files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap().to_string())
+        .collect();
+    let has = |needle: &str| skipped.iter().any(|s| s.contains(needle));
+    assert!(has("fifo.py (not a regular file)"), "{skipped:?}");
+    assert!(has("shadow.py (a symbolic link)"), "{skipped:?}");
+    assert!(has("big.py (2097152 bytes"), "{skipped:?}");
+    // The escape reaches nobody's terminal as an escape.
+    assert!(skipped.iter().all(|s| !s.contains('\u{1b}')), "{skipped:?}");
+    assert_eq!(skipped.len(), 4, "{skipped:?}");
+}
+
+#[test]
+fn sigterm_mid_check_leaves_no_process_and_no_folder() {
+    if !root("sigterm_mid_check_leaves_no_process_and_no_folder") {
+        return;
+    }
+    let marker = format!("rtoracle-test-sigterm-{}", std::process::id());
+    // Its import starts a setsid daemon and then hangs.
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s, time as _t
+if _o.fork() == 0:
+    _o.setsid()
+    _o.execv(_s.executable, [_s.executable, "-c", "import time; time.sleep(600)", {marker:?}])
+_t.sleep(600)
+"#
+    ));
+    let tmp = tempfile::tempdir().unwrap();
+    open_up(tmp.path());
+    let mut child = rtoracle()
+        .current_dir(sub.path())
+        .env("TMPDIR", tmp.path())
+        .args(["check", "--python-course", sub.path().to_str().unwrap()])
+        .args(["--hello-timeout-ms", "60000"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while processes_with(&marker).is_empty() && std::time::Instant::now() < deadline {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(
+        !processes_with(&marker).is_empty(),
+        "the daemon did not start"
+    );
+    let folders = || std::fs::read_dir(tmp.path()).unwrap().count();
+    assert!(folders() > 0, "no sandbox folder in TMPDIR");
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(143));
+    let mut left = processes_with(&marker);
+    for _ in 0..100 {
+        if left.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        left = processes_with(&marker);
+    }
+    assert!(left.is_empty(), "still running: {left:?}");
+    assert_eq!(folders(), 0, "a folder was left in TMPDIR");
+}
