@@ -21,7 +21,7 @@ pub struct Args {
     binary: Option<PathBuf>,
     /// The seed of the suite to package (default: the rubric's when non-zero, else a secret one
     /// drawn from the OS, so students cannot know the vectors in advance).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = super::num::seed)]
     seed: Option<u64>,
 }
 

@@ -289,9 +289,6 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
         if group.all_or_nothing && passed < total {
             message.push_str(" This group is all-or-nothing.");
         }
-        if let Some(f) = smallest_failure(&failures) {
-            message.push_str(&smallest_case_sentence(f));
-        }
         if let Some(d) = outcome.diagnosis.iter().find(|d| d.shape == shape) {
             message.push_str(&format!(" Diagnosis: {}.", d.sentence()));
         }
@@ -302,6 +299,10 @@ fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {
                 " Your triangles face {} (front_face is judged by that winding).",
                 w.formula()
             ));
+        }
+        // Last, so the reports can show the vector's own message apart (it is the candidate's).
+        if let Some(f) = smallest_failure(&failures) {
+            message.push_str(&smallest_case_sentence(f));
         }
         let status = if passed == total {
             CheckStatus::Passed
