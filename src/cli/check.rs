@@ -85,7 +85,6 @@ impl Target {
             Profile::Robust
         }
     }
-
 }
 
 /// How the candidate is sandboxed and which Python runs the course adapter (shared by `check`
