@@ -159,8 +159,9 @@ pub struct CheckReport {
     pub stderr_tail: String,
     /// How many times the candidate's process was restarted.
     pub restarts: u32,
-    /// What the [sandbox](crate::sandbox) did: limits, the user the candidate ran as (and why
-    /// not the drop user, if so), network isolation. `None` for in-process candidates.
+    /// What the [sandbox](crate::sandbox) did: the isolation used (bubblewrap, a uid of its own,
+    /// or unsandboxed by request), the namespaces seen made, limits, the uid the candidate ran
+    /// as, network isolation, files not copied. `None` for in-process candidates.
     #[serde(default)]
     pub sandbox: Option<SandboxFacts>,
     /// The winding of the candidate's triangles, decided from its answers
