@@ -31,8 +31,8 @@ pub struct Target {
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct JudgingArgs {
     /// Whose formulas draw the line between definite and ambiguous: `course` (the course's
-    /// naive formulas; the default for --python-course and for vectors and explain) or `robust`
-    /// (the reference's robust formulas; the default for --adapter).
+    /// naive formulas; the default) or `robust` (the reference's robust formulas: finds the
+    /// precision bugs of naive code).
     #[arg(long, value_name = "course|robust")]
     pub profile: Option<Profile>,
     /// The precision the candidate computes in: `f64` (the default) or `f32` (inputs rounded to
@@ -76,13 +76,20 @@ pub fn reclassify(cases: Vec<Case>, judging: Judging) -> Vec<Case> {
 }
 
 impl Target {
-    /// The profile a candidate is judged by when `--profile` is not given: `course` for the
-    /// course adapter, `robust` for an `--adapter` (another renderer).
+    /// The profile a candidate is judged by when `--profile` is not given: `course` (today's
+    /// policy) for every candidate, so `--precision f32` alone judges an f32 port of naive code
+    /// fairly; `--profile robust` is one flag away, and the report of an `--adapter` candidate
+    /// judged by the default says so.
     pub fn default_profile(&self) -> Profile {
-        if self.adapter.is_none() {
-            Profile::Course
+        Profile::Course
+    }
+
+    /// What the report adds to `judged by:` when the default profile judged another renderer.
+    pub fn profile_hint(&self, judging: &JudgingArgs) -> &'static str {
+        if self.adapter.is_some() && judging.profile.is_none() {
+            " (the default; --profile robust also judges the far, scaled and near-tangent cases a carefully written f64 intersector must get right)"
         } else {
-            Profile::Robust
+            ""
         }
     }
 }
@@ -238,7 +245,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             read_vectors(path)?,
             format!("the expectations in {}", path.display()),
         ),
-        None => (default_suite_with(args.seed, judging), judging.to_string()),
+        None => (
+            default_suite_with(args.seed, judging),
+            format!("{judging}{}", args.target.profile_hint(&args.judging)),
+        ),
     };
     if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
         anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");

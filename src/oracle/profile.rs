@@ -34,7 +34,7 @@ pub enum Profile {
     /// The course's naive formulas (the default for the bundled course adapter).
     #[default]
     Course,
-    /// The reference's robust formulas (the default for `--adapter` candidates).
+    /// The reference's robust formulas (`--profile robust`: finds the precision bugs of naive code).
     Robust,
 }
 
