@@ -8,7 +8,10 @@
 //! after masking what changes from run to run (see [`mask`]):
 //! - numbers of seconds (`1.2 s`, `0.48 s`) become `N s`;
 //! - the version after `rtoracle ` becomes `VERSION`;
-//! - the folder the example ran in becomes `.`, and the binary's path becomes `RTORACLE`.
+//! - the folder the example ran in becomes `.`, and the binary's path becomes `RTORACLE`;
+//! - the number after `uid ` (a sandbox's identity of its own) becomes `N`.
+//!
+//! Setup lines and commands see `RTORACLE_SOURCE`, the checkout, to copy fixtures from.
 //!
 //! A block that cannot run here (slow, needs fixtures that only a checkout has, or prints sizes of
 //! the binary) is marked `console,no-run`; the test prints how many were skipped. A block may be
@@ -134,6 +137,8 @@ fn mask(text: &str, dir: &Path, bin: &Path) -> String {
         |w| w.split('.').count() == 3 && w.split('.').all(|p| p.parse::<u32>().is_ok()),
         "VERSION",
     );
+    // The sandbox's uid of its own differs on every run.
+    let text = mask_after(&text, "uid ", |w| w.parse::<u64>().is_ok(), "N");
     mask_seconds(&text)
 }
 
@@ -205,6 +210,7 @@ fn run_step(command: &str, dir: &Path, path: &str, last: i32) -> (String, i32) {
         .current_dir(dir)
         .env("PATH", path)
         .env("NO_COLOR", "1")
+        .env("RTORACLE_SOURCE", root())
         .output()
         .expect("bash runs");
     (
