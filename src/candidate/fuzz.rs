@@ -4,9 +4,10 @@
 //! front_face, a raised error, a dead process, a timeout, a protocol error), is shrunk to a
 //! small case that still fails the same way.
 //!
-//! Time: the search stops at the first round boundary past [`FuzzOptions::time`] (rounds are
-//! [`FuzzOptions::round`] cases); shrinking then gets at most [`SHRINK_TIME`] more in all, so a
-//! run with a time limit `T` takes about `T` plus that.
+//! Time: with a limit `T` ([`FuzzOptions::time`]) the search stops at the first round boundary
+//! past `T` ([`FuzzOptions::round`] cases a round), and shrinking what it found gets a tenth of
+//! `T` more (at least 0.2 s, at most [`SHRINK_TIME`]), so `--time 6` ends by about 6.6 s.
+//! Without a limit, shrinking gets at most [`SHRINK_TIME`] in all.
 
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
@@ -293,7 +294,13 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
         }
     }
     report.search_seconds = start.elapsed().as_secs_f64();
-    let shrink_until = Instant::now() + SHRINK_TIME;
+    // With a time limit T, shrinking gets a tenth of it more (at least 0.2 s, at most
+    // SHRINK_TIME), so `--time 6` ends by about 6.6 s; without one, SHRINK_TIME.
+    let shrink_time = match options.time {
+        Some(t) => (t / 10).clamp(Duration::from_millis(200), SHRINK_TIME),
+        None => SHRINK_TIME,
+    };
+    let shrink_until = Instant::now() + shrink_time;
     for (case, detail, kind) in found {
         // Timeouts and deaths cost a restart per try: keep them as found.
         let keep = matches!(detail, FuzzKind::Timeout | FuzzKind::Crash);

@@ -36,7 +36,7 @@ pub struct Args {
     #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// Run for this many seconds (checked between rounds of 1000 cases; shrinking what was
-    /// found takes at most 5 s more).
+    /// found takes a tenth of it more, at least 0.2 s and at most 5 s).
     #[arg(long, value_name = "SECS", value_parser = super::num::seconds)]
     time: Option<f64>,
     /// Time allowed per case, in milliseconds.

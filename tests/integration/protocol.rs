@@ -308,7 +308,8 @@ fn fuzz_by_time_runs_for_the_time_and_shows_every_kind() {
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(took >= Duration::from_secs(2), "{took:?}");
-    assert!(took < Duration::from_secs(2 + 5 + 4), "{took:?}");
+    // The search runs the 2 s, shrinking a tenth more (0.2 s); the rest is start-up.
+    assert!(took < Duration::from_secs(2 + 3), "{took:?}");
     // More than one round of 1000: the time bounded the run.
     let run: usize = text.split_whitespace().next().unwrap().parse().unwrap();
     assert!(run > 1000, "{text}");
