@@ -28,6 +28,10 @@ fn registry() -> &'static Mutex<BTreeMap<u64, Cleanup>> {
 }
 
 static NEXT_ID: AtomicU64 = AtomicU64::new(0);
+
+/// Held while a process is started (and recorded for its cleanup), and by the signal thread from
+/// the signal to the exit: so no process can be started after the cleanups have looked for them.
+static SPAWN_GATE: Mutex<()> = Mutex::new(());
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 static INSTALLED: AtomicBool = AtomicBool::new(false);
 
@@ -72,6 +76,15 @@ pub fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::Relaxed)
 }
 
+/// Lets one process be started: hold the returned guard across the spawn and the registration
+/// of its cleanup. `None` once a signal has come (the process is about to exit; start nothing).
+/// While the signal thread cleans up it holds the gate, so a spawn either finished before the
+/// cleanups looked (and they find the new process) or never happens.
+pub fn spawn_gate() -> Option<std::sync::MutexGuard<'static, ()>> {
+    let guard = SPAWN_GATE.lock().unwrap_or_else(|e| e.into_inner());
+    (!interrupted()).then_some(guard)
+}
+
 /// Runs every registered cleanup, newest first, and empties the registry.
 pub fn run_cleanups() {
     let cleanups: Vec<Cleanup> = match registry().lock() {
@@ -95,6 +108,8 @@ pub fn install() -> std::io::Result<()> {
         .name("rtoracle-signals".into())
         .spawn(move || {
             if let Some(sig) = signals.forever().next() {
+                // No process starts from here to the exit (see spawn_gate).
+                let _gate = SPAWN_GATE.lock().unwrap_or_else(|e| e.into_inner());
                 INTERRUPTED.store(true, Ordering::SeqCst);
                 run_cleanups();
                 std::process::exit(128 + sig);

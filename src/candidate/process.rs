@@ -538,6 +538,11 @@ impl Proc {
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
+        // Started and recorded under the gate, so an interruption's cleanup finds it.
+        let gate = crate::interrupt::spawn_gate().ok_or_else(|| HarnessError::Spawn {
+            program: command.program.display().to_string(),
+            reason: std::io::Error::new(std::io::ErrorKind::Interrupted, "interrupted"),
+        })?;
         let mut child = cmd.spawn().map_err(|reason| HarnessError::Spawn {
             program: command.program.display().to_string(),
             reason,
@@ -545,6 +550,7 @@ impl Proc {
         let pid = child.id() as i32;
         let reaper = sandbox.reaper();
         reaper.track(child.id());
+        drop(gate);
         let stdin = child.stdin.take().expect("piped stdin");
         let stdout = child.stdout.take().expect("piped stdout");
         let mut err = child.stderr.take().expect("piped stderr");

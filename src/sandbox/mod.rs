@@ -823,6 +823,8 @@ impl Sandbox {
         args: &[&OsStr],
         timeout: Duration,
     ) -> Result<(bool, String, String), String> {
+        // Started and recorded under the gate, so an interruption's cleanup finds it.
+        let gate = crate::interrupt::spawn_gate().ok_or_else(|| "interrupted".to_string())?;
         let mut child = self
             .command(program)
             .args(args)
@@ -832,6 +834,7 @@ impl Sandbox {
             .spawn()
             .map_err(|e| format!("{}: {e}", program.display()))?;
         self.reaper.track(child.id());
+        drop(gate);
         let out = child.stdout.take();
         let err = child.stderr.take();
         let read = |s: Option<std::process::ChildStdout>| {
