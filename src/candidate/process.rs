@@ -923,8 +923,20 @@ impl Session {
         }
     }
 
-    /// Spawns and does the hello: `Ok(Err(message))` when the hello failed.
+    /// How the candidate's process ended: the sandbox's reason when it stopped the code, else
+    /// the exit status in words.
+    fn describe_end(&self, status: Option<ExitStatus>) -> String {
+        self.sandbox
+            .violation()
+            .unwrap_or_else(|| describe_status(status))
+    }
+
+    /// Spawns and does the hello: `Ok(Err(message))` when the hello failed (or the sandbox has
+    /// stopped the code for good).
     fn launch(&mut self) -> Result<Result<Hello, String>, HarnessError> {
+        if let Some(violation) = self.sandbox.violation() {
+            return Ok(Err(violation));
+        }
         let proc = Proc::spawn(&self.command, &self.sandbox, self.stderr.clone())?;
         if self.facts.is_none() {
             self.facts = Some(self.sandbox.facts(Some(proc.pid as u32)));
@@ -970,7 +982,7 @@ impl Session {
                     let mut proc = proc;
                     let status = proc.exit_status();
                     let _ = proc.kill();
-                    return Ok(Err(self.failure_message(describe_status(status), &junk)));
+                    return Ok(Err(self.failure_message(self.describe_end(status), &junk)));
                 }
                 Err(RecvTimeoutError::Timeout) => {
                     let _ = proc.kill();
@@ -1293,7 +1305,7 @@ impl Session {
                         }
                         let message = format!(
                             "the candidate died on this case: {}",
-                            describe_status(status)
+                            self.describe_end(status)
                         );
                         outcomes[i] = Some(Outcome::Died { message, junk });
                         self.count(CountKind::Crash, case.shape.kind());

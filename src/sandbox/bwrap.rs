@@ -3,8 +3,9 @@
 //!
 //! Promises: the view holds `/usr` and the `/bin`, `/sbin`, `/lib*` of the host (as links where
 //! the host has merged `/usr`), the few `/etc` files the dynamic loader and Debian's
-//! alternatives need, a fresh `/proc` of the new PID namespace, a minimal `/dev` (with its own
-//! `/dev/shm`), an empty `/tmp`, the sandbox folder at [`INSIDE`], and the extra paths a caller
+//! alternatives need, a fresh `/proc` of the new PID namespace, a minimal read-only `/dev`, a
+//! `/tmp` that is a folder of the sandbox folder ([`super::scratch::TMP_DIR`]: the only writable
+//! places are there), the sandbox folder at [`INSIDE`], and the extra paths a caller
 //! exposes read-only. Nothing else of the host is there: no `/home`, `/root`, `/work`, no other
 //! `/tmp` folder; the harness's own binary is covered with an empty file when it lies inside the
 //! view (say `/usr/local/bin/rtoracle`).
@@ -151,7 +152,19 @@ pub fn args(
     for e in ETC {
         push(&[&"--ro-bind-try", &e, &e]);
     }
-    push(&[&"--proc", &"/proc", &"--dev", &"/dev", &"--tmpfs", &"/tmp"]);
+    // `/dev` read-only (its device nodes still work), so `/dev/shm` is not writable; `/tmp` is
+    // a folder of the sandbox folder, where the watchdog measures it (a tmpfs would live in the
+    // host's memory, unbounded: bubblewrap 0.8 has no `--size`).
+    let tmp = dir.join(super::scratch::TMP_DIR);
+    push(&[
+        &"--proc",
+        &"/proc",
+        &"--dev",
+        &"/dev",
+        &"--remount-ro",
+        &"/dev",
+    ]);
+    push(&[&"--bind", &tmp, &"/tmp"]);
     // After the private /tmp, so an exposed path under /tmp is not hidden by it.
     for p in exposed {
         push(&[&"--ro-bind-try", p, p]);

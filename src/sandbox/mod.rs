@@ -16,7 +16,8 @@
 //!   runs in new user, PID, mount, IPC, network, UTS (and cgroup, where allowed) namespaces, with
 //!   `--die-with-parent`, `--new-session`, `--disable-userns`, `--cap-drop ALL`, a cleared
 //!   environment and a minimal read-only view ([`bwrap`]): the system's `/usr` and `/lib*`, the
-//!   loader's `/etc` files, the sandbox folder at `/sandbox`, a private `/tmp` and `/dev/shm`, and
+//!   loader's `/etc` files, a read-only `/dev`, the sandbox folder at `/sandbox` (its `.tmp` is
+//!   the code's `/tmp`: [`scratch`]), and
 //!   for an `--adapter` its program's and its files' folders. Nothing of the grader is visible:
 //!   not its binary, the rubric, the vectors, the reports, the batch folder, another submission,
 //!   `/root` or `/home`. bubblewrap itself runs as the submission's uid (the switch happens before
@@ -30,6 +31,9 @@
 //! - **Limits** in every mode, set with `setrlimit` between `fork` and `exec` (inherited through
 //!   bubblewrap): CPU time, address space, open files, file size, no core files, and a process
 //!   count for a per-submission uid. File descriptors other than the standard three are closed.
+//! - **Bounded writing, nothing left** ([`scratch`]): a watchdog ends the code once its files
+//!   (its folder, its `/tmp`, and what a per-submission uid owns in the host's world-writable
+//!   folders) pass the policy's `disk_bytes`, and those files are swept when the sandbox goes.
 //! - **Nothing outlives it.** [`Sandbox::reaper`] ends every process the code started: the PID
 //!   namespace dies with bubblewrap (killed with its process group), and a per-submission uid is
 //!   swept with [`identity::kill_all`] (double-forked `setsid` sleepers included). Dropping the
@@ -57,6 +61,7 @@
 
 pub mod bwrap;
 pub mod identity;
+pub mod scratch;
 
 use std::ffi::{CString, OsStr, OsString};
 use std::io::Read;
@@ -162,12 +167,20 @@ pub struct SandboxPolicy {
     /// Processes and threads of a per-submission uid (`RLIMIT_NPROC`; set only for such a uid,
     /// since it counts every process of the user).
     pub processes: u64,
+    /// Bytes the code may keep in files, its `/tmp` included ([`scratch::Watchdog`]).
+    #[serde(default = "default_disk_bytes")]
+    pub disk_bytes: u64,
     /// Try a new network namespace in the fallback (bubblewrap always makes one).
     pub isolate_network: bool,
     /// Run without a sandbox, as the current user (root included): `--unsandboxed`, for one's
     /// own code. Limits, the folder and the session still apply.
     #[serde(default)]
     pub unsandboxed: bool,
+}
+
+/// [`SandboxPolicy::disk_bytes`] of `check` and `fuzz` (and of reports written before it existed).
+fn default_disk_bytes() -> u64 {
+    256 << 20
 }
 
 impl Default for SandboxPolicy {
@@ -179,6 +192,7 @@ impl Default for SandboxPolicy {
             open_files: 64,
             file_size_bytes: 64 << 20,
             processes: 64,
+            disk_bytes: default_disk_bytes(),
             isolate_network: true,
             unsandboxed: false,
         }
@@ -186,12 +200,14 @@ impl Default for SandboxPolicy {
 }
 
 impl SandboxPolicy {
-    /// The tighter limits of `grade`: 30 CPU seconds, 1 GiB, 16 MiB files.
+    /// The tighter limits of `grade`: 30 CPU seconds, 1 GiB, 16 MiB files, 64 MiB of files in
+    /// all.
     pub fn grading() -> Self {
         SandboxPolicy {
             cpu_seconds: 30,
             memory_bytes: 1 << 30,
             file_size_bytes: 16 << 20,
+            disk_bytes: 64 << 20,
             ..SandboxPolicy::default()
         }
     }
@@ -448,6 +464,8 @@ pub struct Sandbox {
     reaper: Reaper,
     note: Option<String>,
     skipped: Vec<String>,
+    /// Measures what the code writes (dropped, and so stopped, before the folder is removed).
+    watchdog: Option<scratch::Watchdog>,
     _cleanup: crate::interrupt::CleanupGuard,
 }
 
@@ -544,9 +562,13 @@ impl Sandbox {
             std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o644))
                 .map_err(io)?;
         }
-        std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o700)).map_err(io)?;
-        if let Some((uid, gid)) = switch_to {
-            std::os::unix::fs::chown(dir.path(), Some(uid), Some(gid)).map_err(io)?;
+        let tmp = dir.path().join(scratch::TMP_DIR);
+        std::fs::create_dir(&tmp).map_err(io)?;
+        for folder in [&tmp, &dir.path().to_path_buf()] {
+            std::fs::set_permissions(folder, std::fs::Permissions::from_mode(0o700)).map_err(io)?;
+            if let Some((uid, gid)) = switch_to {
+                std::os::unix::fs::chown(folder, Some(uid), Some(gid)).map_err(io)?;
+            }
         }
         let reaper = Reaper {
             uid: switch_to.map(|s| s.0),
@@ -557,9 +579,18 @@ impl Sandbox {
             let path = dir.path().to_path_buf();
             crate::interrupt::on_interrupt(move || {
                 reaper.reap();
+                if let Some(uid) = reaper.uid {
+                    scratch::sweep(uid);
+                }
                 remove_tree(&path);
             })
         };
+        let watchdog = scratch::Watchdog::start(
+            dir.path().to_path_buf(),
+            reaper.uid,
+            policy.disk_bytes,
+            reaper.clone(),
+        );
         Ok(Sandbox {
             policy,
             isolation,
@@ -570,6 +601,7 @@ impl Sandbox {
             reaper,
             note,
             skipped: Vec::new(),
+            watchdog: Some(watchdog),
             _cleanup: cleanup,
         })
     }
@@ -610,6 +642,14 @@ impl Sandbox {
     /// Whether the code runs as a uid of its own (a root harness).
     pub fn drops_user(&self) -> bool {
         self.switch_to.is_some()
+    }
+
+    /// Why the code was stopped for what it wrote ([`scratch::Watchdog`]), if it was: then
+    /// nothing more should be started in this sandbox.
+    pub fn violation(&self) -> Option<String> {
+        self.watchdog
+            .as_ref()
+            .and_then(scratch::Watchdog::violation)
     }
 
     /// What ends the code's processes (for a restart or the end of a session).
@@ -992,7 +1032,11 @@ fn read_with_timeout(fd: OwnedFd, timeout: Duration) -> String {
 
 impl Drop for Sandbox {
     fn drop(&mut self) {
+        self.watchdog = None;
         self.reaper.reap();
+        if let Some(uid) = self.reaper.uid {
+            scratch::sweep(uid);
+        }
         if let Some(dir) = self.dir.take() {
             let path = dir.path().to_path_buf();
             if dir.close().is_err() {

@@ -120,6 +120,74 @@ _s.stderr.write("daemon started\n")
     }
 }
 
+/// Files a submission made anywhere it could write, and their bloat: in both modes it is stopped
+/// once it holds more than the policy's `disk_bytes`, said so in words, and none of its files is
+/// left (in the fallback, the host's `/tmp`, `/var/tmp` and `/dev/shm` are swept of the uid's
+/// files, a link it planted to a grader file included, the file itself untouched).
+#[test]
+fn a_submission_that_fills_the_disk_is_stopped_and_leaves_no_file() {
+    if !root("a_submission_that_fills_the_disk_is_stopped_and_leaves_no_file") {
+        return;
+    }
+    let marker = format!("rtoracle-test-bloat-{}", std::process::id());
+    let grader = tempfile::tempdir().unwrap();
+    open_up(grader.path());
+    let precious = grader.path().join("precious.txt");
+    std::fs::write(&precious, "keep me").unwrap();
+    let sub = hostile(&format!(
+        r#"
+import os as _o
+_chunk = b"x" * (1 << 20)
+for _d in ("/tmp", "/var/tmp", "/dev/shm", "."):
+    try:
+        with open(_o.path.join(_d, {marker:?}), "wb") as _f:
+            _f.write(_chunk)
+        _o.symlink({precious:?}, _o.path.join(_d, {marker:?} + "-link"))
+        _o.makedirs(_o.path.join(_d, {marker:?} + "-dir", "deep"))
+    except OSError:
+        pass
+for _n in range(400):
+    with open("/tmp/{marker}-%d" % _n, "wb") as _f:
+        for _ in range(8):
+            _f.write(_chunk)
+"#,
+        precious = precious.display().to_string()
+    ));
+    for mode in ["auto", "uid"] {
+        let out = rtoracle()
+            .current_dir(sub.path())
+            .env("RTORACLE_SANDBOX", mode)
+            .args([
+                "check",
+                "--python-course",
+                sub.path().to_str().unwrap(),
+                "--json",
+            ])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            text.contains("the sandbox stopped it: it wrote more than 256 MiB"),
+            "{mode}: {}\n{}",
+            &text[..text.len().min(2000)],
+            stderr(&out)
+        );
+        assert_eq!(out.status.code(), Some(1), "{mode}: {}", stderr(&out));
+        for root in ["/tmp", "/var/tmp", "/dev/shm"] {
+            let left: Vec<_> = std::fs::read_dir(root)
+                .map(|d| {
+                    d.flatten()
+                        .filter(|e| e.file_name().to_string_lossy().contains(&marker))
+                        .map(|e| e.path())
+                        .collect()
+                })
+                .unwrap_or_default();
+            assert!(left.is_empty(), "{mode}: left {left:?}");
+        }
+        assert_eq!(std::fs::read_to_string(&precious).unwrap(), "keep me");
+    }
+}
+
 /// The pids whose command line contains `needle`.
 fn processes_with(needle: &str) -> Vec<u32> {
     let mut found = Vec::new();
