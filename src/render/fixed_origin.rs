@@ -321,17 +321,42 @@ impl PreparedTriangle {
         index: &mut [u64; WIDTH],
         me: u64,
     ) {
-        if !self.classifies {
+        let (inside, open) = if self.classifies {
+            self.classify(d)
+        } else {
+            ([0; WIDTH], [u64::MAX; WIDTH])
+        };
+        if inside.iter().fold(0, |any, &i| any | i) != 0 {
+            let n = self.triangle.normal;
             for k in 0..WIDTH {
+                // The triangle's `t`: `(n . a - n . O) / n . d`, finite, in the closed interval.
+                let t = self.offset / (n.x * d.x[k] + n.y * d.y[k] + n.z * d.z[k]);
+                let hit = (inside[k] != 0) & t.is_finite() & (min <= t) & (t <= closest[k]);
+                closest[k] = if hit { t } else { closest[k] };
+                index[k] = if hit { me } else { index[k] };
+            }
+        }
+        if open.iter().fold(0, |any, &o| any | o) != 0 {
+            for k in 0..WIDTH {
+                if open[k] == 0 {
+                    continue;
+                }
                 let within = Interval::new(min, closest[k]);
                 if let Some(t) = self.triangle.hit_t(&Ray::new(origin, d.lane(k)), within) {
                     closest[k] = t;
                     index[k] = me;
                 }
             }
-            return;
         }
-        // Masks as all-ones or zero words, which stay in vector registers.
+    }
+
+    /// The pre-classification of each lane, as masks (all-ones or zero words, which stay in
+    /// vector registers): `(inside, open)`, the lanes whose line surely meets the triangle's
+    /// inside, and those it cannot decide. The others surely miss.
+    #[inline(always)]
+    // Lane loops index several arrays in step.
+    #[allow(clippy::needless_range_loop)]
+    fn classify(&self, d: &Directions) -> ([u64; WIDTH], [u64; WIDTH]) {
         let mut inside = [0u64; WIDTH];
         let mut open = [0u64; WIDTH];
         for k in 0..WIDTH {
@@ -358,28 +383,7 @@ impl PreparedTriangle {
                 u64::MAX
             };
         }
-        if inside.iter().fold(0, |any, &i| any | i) != 0 {
-            let n = self.triangle.normal;
-            for k in 0..WIDTH {
-                // The triangle's `t`: `(n . a - n . O) / n . d`, finite, in the closed interval.
-                let t = self.offset / (n.x * d.x[k] + n.y * d.y[k] + n.z * d.z[k]);
-                let hit = (inside[k] != 0) & t.is_finite() & (min <= t) & (t <= closest[k]);
-                closest[k] = if hit { t } else { closest[k] };
-                index[k] = if hit { me } else { index[k] };
-            }
-        }
-        if open.iter().fold(0, |any, &o| any | o) != 0 {
-            for k in 0..WIDTH {
-                if open[k] == 0 {
-                    continue;
-                }
-                let within = Interval::new(min, closest[k]);
-                if let Some(t) = self.triangle.hit_t(&Ray::new(origin, d.lane(k)), within) {
-                    closest[k] = t;
-                    index[k] = me;
-                }
-            }
-        }
+        (inside, open)
     }
 }
 
@@ -483,12 +487,7 @@ impl FixedOrigin {
         let mut index = [NO_HIT; WIDTH];
         match &self.layout {
             Layout::Spheres(spheres) => {
-                let mut a = [0.0; WIDTH];
-                let mut a_margin = [0.0; WIDTH];
-                for k in 0..WIDTH {
-                    a[k] = d.x[k] * d.x[k] + d.y[k] * d.y[k] + d.z[k] * d.z[k];
-                    a_margin[k] = Self::margin(a[k]);
-                }
+                let (a, a_margin) = Self::squared_lengths(d);
                 for (me, sphere) in spheres.iter().enumerate() {
                     let lanes = sphere.hit_lanes(
                         d,
@@ -519,12 +518,7 @@ impl FixedOrigin {
                 }
             }
             Layout::Mixed(objects) => {
-                let mut a = [0.0; WIDTH];
-                let mut a_margin = [0.0; WIDTH];
-                for k in 0..WIDTH {
-                    a[k] = d.x[k] * d.x[k] + d.y[k] * d.y[k] + d.z[k] * d.z[k];
-                    a_margin[k] = Self::margin(a[k]);
-                }
+                let (a, a_margin) = Self::squared_lengths(d);
                 for (me, object) in objects.iter().enumerate() {
                     let me = me as u64;
                     match object {
@@ -565,6 +559,20 @@ impl FixedOrigin {
             }
         }
         index
+    }
+
+    /// Each lane's `a = d . d` and `a * PREFILTER_MARGIN` (see [`Self::margin`]).
+    #[inline(always)]
+    // Lane loops index several arrays in step.
+    #[allow(clippy::needless_range_loop)]
+    fn squared_lengths(d: &Directions) -> (Lanes, Lanes) {
+        let mut a = [0.0; WIDTH];
+        let mut a_margin = [0.0; WIDTH];
+        for k in 0..WIDTH {
+            a[k] = d.x[k] * d.x[k] + d.y[k] * d.y[k] + d.z[k] * d.z[k];
+            a_margin[k] = Self::margin(a[k]);
+        }
+        (a, a_margin)
     }
 
     /// [`Self::closest_packet`] one lane at a time.
