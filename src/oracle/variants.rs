@@ -35,7 +35,32 @@ pub struct Variant {
     /// Whether a fair grader must accept it.
     pub honest: bool,
     /// The intersection routine.
-    pub run: fn(&ShapeSpec, &RaySpec, [f64; 2]) -> Answer,
+    pub run: Routine,
+}
+
+/// An intersection routine: the answer for a shape, a ray and an interval `[t_min, t_max]`.
+pub type Routine = fn(&ShapeSpec, &RaySpec, [f64; 2]) -> Answer;
+
+impl Variant {
+    /// A variant a fair grader must accept.
+    pub const fn honest(name: &'static str, shape: ShapeKind, run: Routine) -> Variant {
+        Variant {
+            name,
+            shape,
+            honest: true,
+            run,
+        }
+    }
+
+    /// A variant with a mistake a grader must catch.
+    pub const fn buggy(name: &'static str, shape: ShapeKind, run: Routine) -> Variant {
+        Variant {
+            name,
+            shape,
+            honest: false,
+            run,
+        }
+    }
 }
 
 impl std::fmt::Debug for Variant {
@@ -431,36 +456,16 @@ rtiow!(rtiow_sphere_f32_far_first, rtiow_quad_f32_unused, f32, true);
 /// cancellation on far and scaled spheres.
 pub fn rtiow() -> Vec<Variant> {
     vec![
-        Variant {
-            name: "sphere-rtiow",
-            shape: ShapeKind::Sphere,
-            honest: true,
-            run: rtiow_sphere,
-        },
-        Variant {
-            name: "quad-rtiow",
-            shape: ShapeKind::Quad,
-            honest: true,
-            run: rtiow_quad,
-        },
+        Variant::honest("sphere-rtiow", ShapeKind::Sphere, rtiow_sphere),
+        Variant::honest("quad-rtiow", ShapeKind::Quad, rtiow_quad),
     ]
 }
 
 /// The same code in `f32` (inputs rounded to `f32`): honest under `--precision f32`.
 pub fn rtiow_f32() -> Vec<Variant> {
     vec![
-        Variant {
-            name: "sphere-rtiow-f32",
-            shape: ShapeKind::Sphere,
-            honest: true,
-            run: rtiow_sphere_f32,
-        },
-        Variant {
-            name: "quad-rtiow-f32",
-            shape: ShapeKind::Quad,
-            honest: true,
-            run: rtiow_quad_f32,
-        },
+        Variant::honest("sphere-rtiow-f32", ShapeKind::Sphere, rtiow_sphere_f32),
+        Variant::honest("quad-rtiow-f32", ShapeKind::Quad, rtiow_quad_f32),
     ]
 }
 
@@ -507,18 +512,8 @@ fn robust_sphere_f32(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) -> Answer {
 /// quad formula): honest under `robust/f32`.
 pub fn robust_f32() -> Vec<Variant> {
     vec![
-        Variant {
-            name: "sphere-robust-f32",
-            shape: ShapeKind::Sphere,
-            honest: true,
-            run: robust_sphere_f32,
-        },
-        Variant {
-            name: "quad-rtiow-f32",
-            shape: ShapeKind::Quad,
-            honest: true,
-            run: rtiow_quad_f32,
-        },
+        Variant::honest("sphere-robust-f32", ShapeKind::Sphere, robust_sphere_f32),
+        Variant::honest("quad-rtiow-f32", ShapeKind::Quad, rtiow_quad_f32),
     ]
 }
 
@@ -565,12 +560,7 @@ pub fn honest() -> Vec<Variant> {
         sphere_variant!("sphere-full-quadratic", true, { full_b }),
         sphere_variant!("sphere-normalised-direction", true, { normalise }),
         sphere_variant!("sphere-full-quadratic-closed", true, { full_b, closed }),
-        Variant {
-            name: "sphere-reference",
-            shape: ShapeKind::Sphere,
-            honest: true,
-            run: reference,
-        },
+        Variant::honest("sphere-reference", ShapeKind::Sphere, reference),
         plane_variant!("quad-course", Quad, true, {}),
         plane_variant!("quad-open-interval", Quad, true, { open_interval }),
         plane_variant!("quad-strict-edges", Quad, true, { strict_edges }),
@@ -738,76 +728,47 @@ fn moller_trumbore_absolute_epsilon(shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 
     moller_trumbore(shape, ray, iv)
 }
 
+/// A quad variant making the one mistake of [`QuadExtra`] named by `field`.
+macro_rules! quad_mistake {
+    ($name:literal, $field:ident) => {
+        Variant {
+            name: $name,
+            shape: ShapeKind::Quad,
+            honest: false,
+            run: |s, r, i| {
+                let mistake = QuadExtra {
+                    $field: true,
+                    ..Default::default()
+                };
+                quad_extra(mistake, s, r, i)
+            },
+        }
+    };
+}
+
 /// More buggy variants (the diagnosis's catalogue is [`buggy`] and these): each must fail at
 /// least one definite vector of the default suite.
 pub fn buggy_extra() -> Vec<Variant> {
     vec![
-        Variant {
-            name: "sphere-sqrt-precedence",
-            shape: ShapeKind::Sphere,
-            honest: false,
-            run: sphere_sqrt_precedence,
-        },
-        Variant {
-            name: "sphere-normal-not-flipped",
-            shape: ShapeKind::Sphere,
-            honest: false,
-            run: sphere_normal_not_flipped,
-        },
-        Variant {
-            name: "quad-beta-uses-v",
-            shape: ShapeKind::Quad,
-            honest: false,
-            run: |s, r, i| {
-                let o = QuadExtra {
-                    beta_uses_v: true,
-                    ..Default::default()
-                };
-                quad_extra(o, s, r, i)
-            },
-        },
-        Variant {
-            name: "quad-d-from-u",
-            shape: ShapeKind::Quad,
-            honest: false,
-            run: |s, r, i| {
-                let o = QuadExtra {
-                    d_from_u: true,
-                    ..Default::default()
-                };
-                quad_extra(o, s, r, i)
-            },
-        },
-        Variant {
-            name: "quad-interior-upper-bounds-only",
-            shape: ShapeKind::Quad,
-            honest: false,
-            run: |s, r, i| {
-                let o = QuadExtra {
-                    upper_bounds_only: true,
-                    ..Default::default()
-                };
-                quad_extra(o, s, r, i)
-            },
-        },
-        Variant {
-            name: "quad-unnormalised-normal",
-            shape: ShapeKind::Quad,
-            honest: false,
-            run: |s, r, i| {
-                let o = QuadExtra {
-                    unnormalised_normal: true,
-                    ..Default::default()
-                };
-                quad_extra(o, s, r, i)
-            },
-        },
-        Variant {
-            name: "triangle-absolute-epsilon",
-            shape: ShapeKind::Triangle,
-            honest: false,
-            run: moller_trumbore_absolute_epsilon,
-        },
+        Variant::buggy(
+            "sphere-sqrt-precedence",
+            ShapeKind::Sphere,
+            sphere_sqrt_precedence,
+        ),
+        Variant::buggy(
+            "sphere-normal-not-flipped",
+            ShapeKind::Sphere,
+            sphere_normal_not_flipped,
+        ),
+        quad_mistake!("quad-beta-uses-v", beta_uses_v),
+        quad_mistake!("quad-d-from-u", d_from_u),
+        quad_mistake!("quad-interior-upper-bounds-only", upper_bounds_only),
+        quad_mistake!("quad-unnormalised-normal", unnormalised_normal),
+        Variant::buggy(
+            "triangle-absolute-epsilon",
+            ShapeKind::Triangle,
+            moller_trumbore_absolute_epsilon,
+        ),
     ]
 }
 
