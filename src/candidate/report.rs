@@ -285,28 +285,52 @@ fn num(x: f64) -> String {
     }
 }
 
+/// How an expected answer is written: its numbers, its booleans, and what follows a miss and a
+/// normal (the words of any language, or Python's).
+struct Dialect {
+    number: fn(f64) -> String,
+    boolean: fn(bool) -> &'static str,
+    miss: &'static str,
+    normal_note: &'static str,
+}
+
 /// The expected answer of a vector in words, for any language.
 pub fn expected_in_words(e: &Expect) -> String {
+    expected_as(
+        e,
+        &Dialect {
+            number: num,
+            boolean: |b| if b { "true" } else { "false" },
+            miss: "a miss",
+            normal_note: " (unit, facing the ray)",
+        },
+    )
+}
+
+/// The expected answer of a vector written in `dialect`.
+fn expected_as(e: &Expect, dialect: &Dialect) -> String {
+    let number = dialect.number;
     match e.class {
-        Class::Miss => "a miss".to_string(),
+        Class::Miss => dialect.miss.to_string(),
         Class::Hit => {
             let mut s = String::from("a hit");
             if let Some(t) = e.t {
-                s.push_str(&format!(" at t = {}", num(t)));
+                s.push_str(&format!(" at t = {}", number(t)));
                 if let Some(tol) = e.t_tol {
                     s.push_str(&format!(" (+- {tol:.1e})"));
                 }
             }
             if let Some(n) = e.normal {
                 s.push_str(&format!(
-                    ", normal ({}, {}, {}) (unit, facing the ray)",
-                    num(n[0]),
-                    num(n[1]),
-                    num(n[2])
+                    ", normal ({}, {}, {}){}",
+                    number(n[0]),
+                    number(n[1]),
+                    number(n[2]),
+                    dialect.normal_note
                 ));
             }
             if let Some(f) = e.front_face {
-                s.push_str(&format!(", front_face {f}"));
+                s.push_str(&format!(", front_face {}", (dialect.boolean)(f)));
             }
             s
         }
@@ -534,36 +558,15 @@ pub fn python_repro(case: &Case) -> String {
             format!("Triangle({}, {}, {})", py3(a), py3(b), py3(c)),
         ),
     };
-    let e = &case.expect;
-    let expected = match e.class {
-        Class::Miss => "a miss (None)".to_string(),
-        Class::Hit => {
-            let mut s = String::from("a hit");
-            if let Some(t) = e.t {
-                s.push_str(&format!(" at t = {}", py(t)));
-                if let Some(tol) = e.t_tol {
-                    s.push_str(&format!(" (+- {tol:.1e})"));
-                }
-            }
-            if let Some(n) = e.normal {
-                s.push_str(&format!(
-                    ", normal ({}, {}, {})",
-                    py(n[0]),
-                    py(n[1]),
-                    py(n[2])
-                ));
-            }
-            if let Some(f) = e.front_face {
-                s.push_str(&format!(
-                    ", front_face {}",
-                    if f { "True" } else { "False" }
-                ));
-            }
-            s
-        }
-        Class::Ambiguous => "ambiguous (not scored)".to_string(),
-        Class::Any => "anything (not scored)".to_string(),
-    };
+    let expected = expected_as(
+        &case.expect,
+        &Dialect {
+            number: py,
+            boolean: |b| if b { "True" } else { "False" },
+            miss: "a miss (None)",
+            normal_note: "",
+        },
+    );
     format!(
         "from RT_utility import Vec3, Interval\n\
          from RT_ray import Ray\n\
