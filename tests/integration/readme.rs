@@ -3,24 +3,38 @@
 //!
 //! A `console` block is a list of commands (`$ ` lines), each followed by its output (stdout and
 //! stderr together) up to the next command or the closing fence. The test runs every block of a
-//! section in order, in one fresh folder per section (so a file written by one block is there for
-//! the next), with `rtoracle` on `PATH` being the binary under test, and compares the outputs
-//! after masking what changes from run to run (see [`mask`]):
+//! section in order (the sections at the same time), in one fresh folder per section (so a file written by one block is there for
+//! the next; mode 755, so a sandbox user can run a script written there), with `rtoracle` on
+//! `PATH` being the binary under test and `RTORACLE_CACHE_DIR` the section folder's `.cache` (so
+//! no golden is cached in the user's home), and compares the outputs after masking what changes
+//! from run to run (see [`mask`]):
 //! - numbers of seconds (`1.2 s`, `0.48 s`) become `N s`;
-//! - the version after `rtoracle ` becomes `VERSION`;
+//! - the version after `rtoracle ` and in a cached golden's name (`...-4096spp-0.1.0.exr`)
+//!   becomes `VERSION`;
 //! - the folder the example ran in becomes `.`, and the binary's path becomes `RTORACLE`;
-//! - the number after `uid ` (a sandbox's identity of its own) becomes `N`.
+//! - a sandbox's uid of its own (the number after `uid ` in text, `'uid': ` in a Python dict,
+//!   `"uid": ` in JSON) becomes `N`;
+//! - a seed drawn from the OS (`seed 1467482570707934685 (secret, drawn now)`) becomes `N`; a
+//!   seed given with `--seed` is compared.
 //!
 //! Setup lines and commands see `RTORACLE_SOURCE`, the checkout, to copy fixtures from.
 //!
-//! A block that cannot run here (slow, needs fixtures that only a checkout has, or prints sizes of
-//! the binary) is marked `console,no-run`; the test prints how many were skipped. A block may be
-//! preceded by `<!-- setup: SHELL -->`: the shell line runs, silently, in the section's folder
-//! first.
+//! Comment lines right before a block prepare or explain it:
+//! - `<!-- fixtures: WHAT... -->` makes fixture submissions in the section's folder first: `NAME`
+//!   (or `NAME=FOLDER`, `FOLDER` ending in the name) is `tests/fixtures/submissions/NAME` made a
+//!   submission by `rtoracle::grade::bench::materialize` (its images rendered), and
+//!   `python:VARIANT=FOLDER` is the `check` fixture `tests/fixtures/python/variants/VARIANT` (the
+//!   common modules, then the variant's) by `rtoracle::candidate::bench::assemble_fixture`;
+//! - `<!-- setup: SHELL -->`: the shell line runs, silently, in the section's folder (after the
+//!   fixtures are made);
+//! - `<!-- no-run: REASON -->` says why a block marked `console,no-run` cannot run in the tests
+//!   (every such block must say it; the test prints how many were skipped).
 //!
 //! `RTORACLE_UPDATE_README=1 cargo test --test integration -- readme::` writes the real outputs
-//! into `docs/sections/` instead of comparing, and reassembles README.md.
+//! of the examples that differ into `docs/sections/` instead of comparing (the others keep their
+//! masked figures), and reassembles README.md.
 
+use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -66,14 +80,89 @@ struct Step {
     output: Vec<String>,
 }
 
-/// A console block: its steps, whether it runs, its setup, and its line range in the file (the
-/// lines between the fences).
+/// A console block: its steps, whether it runs, the directives before it (see the module docs),
+/// its line range in the file (the lines between the fences) and the line of its opening fence.
 #[derive(Debug)]
 struct Block {
     steps: Vec<Step>,
     run: bool,
     setup: Option<String>,
+    fixtures: Vec<Fixture>,
+    no_run_reason: Option<String>,
     body: std::ops::Range<usize>,
+    fence: usize,
+}
+
+/// A fixture to make in the section's folder before a block.
+#[derive(Debug, PartialEq)]
+enum Fixture {
+    /// `tests/fixtures/submissions/<name>`, materialized into the folder.
+    Submission { name: String, folder: String },
+    /// `tests/fixtures/python/variants/<variant>` with the common modules, into the folder.
+    Python { variant: String, folder: String },
+}
+
+/// The value of the directive `<!-- key: VALUE -->` on `line`, if it is one.
+fn directive<'a>(line: &'a str, key: &str) -> Option<&'a str> {
+    line.trim()
+        .strip_prefix("<!--")?
+        .trim_start()
+        .strip_prefix(key)?
+        .strip_prefix(':')?
+        .strip_suffix("-->")
+        .map(str::trim)
+}
+
+/// The fixtures of a `fixtures:` directive (see the module docs).
+fn parse_fixtures(spec: &str) -> Result<Vec<Fixture>, String> {
+    spec.split_whitespace()
+        .map(|word| {
+            let (what, folder) = match word.split_once('=') {
+                Some((what, folder)) => (what, folder),
+                None => (word.rsplit('/').next().unwrap_or(word), word),
+            };
+            if what.is_empty()
+                || folder.is_empty()
+                || folder.starts_with('/')
+                || folder.contains("..")
+            {
+                return Err(format!(
+                    "fixture {word:?}: want NAME, FOLDER/NAME, NAME=FOLDER or python:VARIANT=FOLDER"
+                ));
+            }
+            Ok(match what.strip_prefix("python:") {
+                Some(variant) => Fixture::Python {
+                    variant: variant.to_string(),
+                    folder: folder.to_string(),
+                },
+                None => Fixture::Submission {
+                    name: what.to_string(),
+                    folder: folder.to_string(),
+                },
+            })
+        })
+        .collect()
+}
+
+/// Makes `fixture` in `dir`.
+fn make_fixture(fixture: &Fixture, dir: &Path) -> Result<(), String> {
+    match fixture {
+        Fixture::Submission { name, folder } => {
+            rtoracle::grade::bench::materialize(name, &dir.join(folder)).map(|_| ())
+        }
+        Fixture::Python { variant, folder } => {
+            let made = rtoracle::candidate::bench::assemble_fixture(variant)
+                .map_err(|e| format!("python fixture {variant}: {e}"))?;
+            let dest = dir.join(folder);
+            std::fs::create_dir_all(&dest).map_err(|e| format!("{}: {e}", dest.display()))?;
+            for entry in std::fs::read_dir(made.path()).map_err(|e| e.to_string())? {
+                let entry = entry.map_err(|e| e.to_string())?;
+                std::fs::copy(entry.path(), dest.join(entry.file_name()))
+                    .map_err(|e| format!("{}: {e}", entry.path().display()))?;
+            }
+            Ok(())
+        }
+    }
 }
 
 fn blocks(text: &str) -> Vec<Block> {
@@ -81,7 +170,10 @@ fn blocks(text: &str) -> Vec<Block> {
     let mut out = Vec::new();
     let mut i = 0;
     while i < lines.len() {
-        let info = lines[i].strip_prefix("```").map(str::trim);
+        // A fence of 3 or more backticks (4 when the output holds fences of 3), closed by a
+        // line of as many or more backticks only.
+        let ticks = lines[i].len() - lines[i].trim_start_matches('`').len();
+        let info = (ticks >= 3).then(|| lines[i][ticks..].trim());
         let run = match info {
             Some("console") => true,
             Some("console,no-run") => false,
@@ -90,14 +182,27 @@ fn blocks(text: &str) -> Vec<Block> {
                 continue;
             }
         };
-        let setup = i
-            .checked_sub(1)
-            .and_then(|j| lines[j].trim().strip_prefix("<!-- setup:"))
-            .and_then(|s| s.strip_suffix("-->"))
-            .map(|s| s.trim().to_string());
+        // The directive lines right above the fence.
+        let (mut setup, mut fixtures, mut no_run_reason) = (None, Vec::new(), None);
+        let mut j = i;
+        while j > 0 && lines[j - 1].trim().starts_with("<!--") {
+            j -= 1;
+            let line = lines[j];
+            if let Some(s) = directive(line, "setup") {
+                setup = Some(s.to_string());
+            } else if let Some(s) = directive(line, "fixtures") {
+                fixtures = parse_fixtures(s).unwrap_or_else(|e| panic!("line {}: {e}", j + 1));
+            } else if let Some(s) = directive(line, "no-run") {
+                no_run_reason = Some(s.to_string()).filter(|s| !s.is_empty());
+            }
+        }
         let start = i + 1;
         let mut end = start;
-        while end < lines.len() && !lines[end].starts_with("```") {
+        let closes = |line: &str| {
+            let line = line.trim_end();
+            line.len() >= ticks && line.bytes().all(|b| b == b'`')
+        };
+        while end < lines.len() && !closes(lines[end]) {
             end += 1;
         }
         let mut steps: Vec<Step> = Vec::new();
@@ -118,7 +223,10 @@ fn blocks(text: &str) -> Vec<Block> {
             steps,
             run,
             setup,
+            fixtures,
+            no_run_reason,
             body: start..end,
+            fence: i,
         });
         i = end + 1;
     }
@@ -131,28 +239,48 @@ fn mask(text: &str, dir: &Path, bin: &Path) -> String {
         .replace(&bin.display().to_string(), "RTORACLE")
         .replace(&format!("{}/", dir.display()), "")
         .replace(&dir.display().to_string(), ".");
+    let text = mask_after(&text, "rtoracle ", "", is_version, "VERSION");
+    // A cached golden's name ends in the tool's version: `<sha256>-<spp>spp-<version>.exr`.
     let text = mask_after(
         &text,
-        "rtoracle ",
-        |w| w.split('.').count() == 3 && w.split('.').all(|p| p.parse::<u32>().is_ok()),
-        "VERSION",
+        "spp-",
+        "",
+        |w| w.strip_suffix(".exr").is_some_and(is_version),
+        "VERSION.exr",
     );
-    // The sandbox's uid of its own differs on every run.
-    let text = mask_after(&text, "uid ", |w| w.parse::<u64>().is_ok(), "N");
+    // The sandbox's uid of its own differs on every run: in text, a Python dict and JSON.
+    let is_number = |w: &str| !w.is_empty() && w.bytes().all(|b| b.is_ascii_digit());
+    let text = mask_after(&text, "uid ", "", is_number, "N");
+    let text = mask_after(&text, "'uid': ", "", is_number, "N");
+    let text = mask_after(&text, "\"uid\": ", "", is_number, "N");
+    // A secret seed is drawn from the OS on every run (one given with `--seed` is not masked).
+    let text = mask_after(&text, "seed ", " (secret, drawn now)", is_number, "N");
     mask_seconds(&text)
 }
 
-/// Replaces each word after `prefix` for which `is` holds by `by`.
-fn mask_after(text: &str, prefix: &str, is: impl Fn(&str) -> bool, by: &str) -> String {
+/// `0.1.0`: three numbers separated by dots.
+fn is_version(w: &str) -> bool {
+    w.split('.').count() == 3 && w.split('.').all(|p| p.parse::<u32>().is_ok())
+}
+
+/// Replaces each word after `prefix` for which `is` holds, and which `suffix` follows, by `by`.
+/// A word ends at white space, `)`, `,` or `}`.
+fn mask_after(
+    text: &str,
+    prefix: &str,
+    suffix: &str,
+    is: impl Fn(&str) -> bool,
+    by: &str,
+) -> String {
     let mut out = String::new();
     let mut rest = text;
     while let Some(at) = rest.find(prefix) {
         out.push_str(&rest[..at + prefix.len()]);
         rest = &rest[at + prefix.len()..];
         let end = rest
-            .find(|c: char| c.is_whitespace() || c == ')' || c == ',')
+            .find(|c: char| c.is_whitespace() || matches!(c, ')' | ',' | '}'))
             .unwrap_or(rest.len());
-        if is(&rest[..end]) {
+        if is(&rest[..end]) && rest[end..].starts_with(suffix) {
             out.push_str(by);
             rest = &rest[end..];
         }
@@ -200,8 +328,9 @@ fn bin_dir() -> (tempfile::TempDir, PathBuf) {
     (dir, bin)
 }
 
-/// Runs one shell command in `dir` with `$?` set to `last`; returns its output (stdout and
-/// stderr together, in order) and exit code.
+/// Runs one shell command in `dir` (the section's folder) with `$?` set to `last`, and with the
+/// golden cache in `dir/.cache`; returns its output (stdout and stderr together, in order) and
+/// exit code.
 fn run_step(command: &str, dir: &Path, path: &str, last: i32) -> (String, i32) {
     let script = format!("(exit {last}); {command}");
     let out = Command::new("bash")
@@ -211,12 +340,101 @@ fn run_step(command: &str, dir: &Path, path: &str, last: i32) -> (String, i32) {
         .env("PATH", path)
         .env("NO_COLOR", "1")
         .env("RTORACLE_SOURCE", root())
+        .env("RTORACLE_CACHE_DIR", dir.join(".cache"))
         .output()
         .expect("bash runs");
     (
         String::from_utf8_lossy(&out.stdout).into_owned(),
         out.status.code().unwrap_or(-1),
     )
+}
+
+/// What running one section's examples gave.
+struct SectionRun {
+    ran: usize,
+    skipped: usize,
+    failures: Vec<String>,
+}
+
+/// Runs the console blocks of `section` in a fresh folder of its own (see the module docs);
+/// with `update`, writes the real outputs of those that differ into its file.
+fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRun {
+    let file = root().join(format!("docs/sections/{section}.md"));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    // World-readable, as a user's folder usually is: the sandbox user runs scripts from it
+    // (`--python ./python3-no-numpy`).
+    let work = tempfile::Builder::new()
+        .permissions(std::fs::Permissions::from_mode(0o755))
+        .tempdir()
+        .unwrap();
+    let mut run = SectionRun {
+        ran: 0,
+        skipped: 0,
+        failures: Vec::new(),
+    };
+    // Blocks in reverse order when rewriting, so earlier line numbers stay valid.
+    let mut rewritten: Vec<(std::ops::Range<usize>, Vec<String>)> = Vec::new();
+    for block in blocks(&text) {
+        if !block.run {
+            run.skipped += 1;
+            if block.no_run_reason.is_none() {
+                run.failures.push(format!(
+                    "docs/sections/{section}.md:{}: a `console,no-run` block without a `<!-- no-run: REASON -->` line before it",
+                    block.fence + 1
+                ));
+            }
+            continue;
+        }
+        run.ran += 1;
+        for fixture in &block.fixtures {
+            if let Err(e) = make_fixture(fixture, work.path()) {
+                panic!("{section}: fixture {fixture:?}: {e}");
+            }
+        }
+        if let Some(setup) = &block.setup {
+            let (out, code) = run_step(setup, work.path(), path, 0);
+            assert_eq!(code, 0, "{section}: setup {setup:?} failed: {out}");
+        }
+        let mut last = 0;
+        let mut body = Vec::new();
+        for step in &block.steps {
+            let (out, code) = run_step(&step.command, work.path(), path, last);
+            last = code;
+            let got = mask(out.trim_end_matches('\n'), work.path(), bin);
+            let want = mask(&step.output.join("\n"), work.path(), bin);
+            if got != want {
+                run.failures.push(format!(
+                    "docs/sections/{section}.md: `$ {}`\n--- the docs show:\n{want}\n--- it prints:\n{got}",
+                    step.command
+                ));
+            }
+            body.push(format!("$ {}", step.command));
+            if got == want {
+                // Unchanged but for what the masks hide: the docs keep their figures.
+                body.extend(step.output.iter().cloned());
+            } else if !out.trim_end_matches('\n').is_empty() {
+                // The section's folder as the masks see it (a reader's own folder).
+                let shown = out
+                    .trim_end_matches('\n')
+                    .replace(&format!("{}/", work.path().display()), "")
+                    .replace(&work.path().display().to_string(), ".");
+                body.extend(shown.lines().map(String::from));
+            }
+        }
+        rewritten.push((block.body.clone(), body));
+    }
+    if update && !rewritten.is_empty() {
+        for (range, body) in rewritten.into_iter().rev() {
+            lines.splice(range, body);
+        }
+        let mut new = lines.join("\n");
+        if text.ends_with('\n') {
+            new.push('\n');
+        }
+        std::fs::write(&file, new).unwrap();
+    }
+    run
 }
 
 #[test]
@@ -228,59 +446,21 @@ fn every_console_example_of_the_readme_is_real_output() {
         bins.path().display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    let (mut ran, mut skipped) = (0, 0);
-    let mut failures = Vec::new();
-    for section in SECTIONS {
-        let file = root().join(format!("docs/sections/{section}.md"));
-        let text = std::fs::read_to_string(&file).unwrap();
-        let mut lines: Vec<String> = text.lines().map(String::from).collect();
-        let work = tempfile::tempdir().unwrap();
-        // Blocks in reverse order when rewriting, so earlier line numbers stay valid.
-        let mut rewritten: Vec<(std::ops::Range<usize>, Vec<String>)> = Vec::new();
-        for block in blocks(&text) {
-            if !block.run {
-                skipped += 1;
-                continue;
-            }
-            ran += 1;
-            if let Some(setup) = &block.setup {
-                let (out, code) = run_step(setup, work.path(), &path, 0);
-                assert_eq!(code, 0, "{section}: setup {setup:?} failed: {out}");
-            }
-            let mut last = 0;
-            let mut body = Vec::new();
-            for step in &block.steps {
-                let (out, code) = run_step(&step.command, work.path(), &path, last);
-                last = code;
-                let got = mask(out.trim_end_matches('\n'), work.path(), &bin);
-                let want = mask(&step.output.join("\n"), work.path(), &bin);
-                if got != want {
-                    failures.push(format!(
-                        "docs/sections/{section}.md: `$ {}`\n--- the docs show:\n{want}\n--- it prints:\n{got}",
-                        step.command
-                    ));
-                }
-                body.push(format!("$ {}", step.command));
-                if !out.trim_end_matches('\n').is_empty() {
-                    let shown = out
-                        .trim_end_matches('\n')
-                        .replace(&format!("{}/", work.path().display()), "");
-                    body.extend(shown.lines().map(String::from));
-                }
-            }
-            rewritten.push((block.body.clone(), body));
-        }
-        if update && !rewritten.is_empty() {
-            for (range, body) in rewritten.into_iter().rev() {
-                lines.splice(range, body);
-            }
-            let mut new = lines.join("\n");
-            if text.ends_with('\n') {
-                new.push('\n');
-            }
-            std::fs::write(&file, new).unwrap();
-        }
-    }
+    // The sections are independent (a folder each), so they run at the same time: the test
+    // takes about as long as `grade`, its longest.
+    let runs: Vec<SectionRun> = std::thread::scope(|s| {
+        let handles: Vec<_> = SECTIONS
+            .iter()
+            .map(|section| s.spawn(|| run_section(section, update, &path, &bin)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a section's examples ran"))
+            .collect()
+    });
+    let ran: usize = runs.iter().map(|r| r.ran).sum();
+    let skipped: usize = runs.iter().map(|r| r.skipped).sum();
+    let failures: Vec<String> = runs.into_iter().flat_map(|r| r.failures).collect();
     eprintln!("README examples: {ran} blocks run, {skipped} marked no-run");
     if update {
         let status = Command::new("bash")
@@ -312,4 +492,69 @@ fn the_masks_hide_only_what_changes() {
         "wrote g/a.exr (64 spp, 690106 bytes) in N s; rtoracle VERSION from RTORACLE; 3 spheres"
     );
     assert_eq!(mask_seconds("x 0.48 s, 12 ss, v2 s"), "x N s, 12 ss, v2 s");
+    // A sandbox's uid, in text, a Python dict and JSON; nothing else named uid.
+    assert_eq!(
+        mask(
+            "uid 1077390338 (a uid of its own); {'uid': 1077390338}, {\"uid\": 12, 'uid': None, 'uids': 3}",
+            dir,
+            bin
+        ),
+        "uid N (a uid of its own); {'uid': N}, {\"uid\": N, 'uid': None, 'uids': 3}"
+    );
+    // A seed drawn now, not one given.
+    assert_eq!(
+        mask(
+            "rubric.toml with seed 1467482570707934685 (secret, drawn now); seed 42 (from --seed); seed 7",
+            dir,
+            bin
+        ),
+        "rubric.toml with seed N (secret, drawn now); seed 42 (from --seed); seed 7"
+    );
+    // The version in a cached golden's name, not the sample count or the hash.
+    assert_eq!(
+        mask(
+            "/tmp/x/.cache/goldens/549a18-4096spp-0.1.0.exr golden-64spp-v1.exr, 4096spp-0.1.exr",
+            dir,
+            bin
+        ),
+        ".cache/goldens/549a18-4096spp-VERSION.exr golden-64spp-v1.exr, 4096spp-0.1.exr"
+    );
+}
+
+#[test]
+fn directives_before_a_block_are_read() {
+    let text = "x\n<!-- no-run: slow -->\n```console,no-run\n$ a\n```\n\
+                <!-- fixtures: sphere-bug honest=week04-honest subs/hang python:bug_far_root_first=far -->\n\
+                <!-- setup: touch f -->\n```console\n$ b\nout\n```\n```console\n$ c\n```\n";
+    let b = blocks(text);
+    assert_eq!(b.len(), 3);
+    assert!(!b[0].run);
+    assert_eq!(b[0].no_run_reason.as_deref(), Some("slow"));
+    assert!(b[1].run && b[1].no_run_reason.is_none());
+    assert_eq!(b[1].setup.as_deref(), Some("touch f"));
+    let sub = |name: &str, folder: &str| Fixture::Submission {
+        name: name.into(),
+        folder: folder.into(),
+    };
+    assert_eq!(
+        b[1].fixtures,
+        [
+            sub("sphere-bug", "sphere-bug"),
+            sub("honest", "week04-honest"),
+            sub("hang", "subs/hang"),
+            Fixture::Python {
+                variant: "bug_far_root_first".into(),
+                folder: "far".into()
+            }
+        ]
+    );
+    assert_eq!(b[1].steps[0].output, ["out"]);
+    // Directives belong to the block right below them only.
+    assert!(b[2].setup.is_none() && b[2].fixtures.is_empty());
+    // A block of four backticks holds fences of three.
+    let b = blocks("````console\n$ cat f.md\n```python\nx = 1\n```\n````\n```toml\n```\n");
+    assert_eq!(b.len(), 1);
+    assert_eq!(b[0].steps[0].output, ["```python", "x = 1", "```"]);
+    assert!(parse_fixtures("honest=/tmp/x").is_err());
+    assert!(parse_fixtures("honest=../x").is_err());
 }
