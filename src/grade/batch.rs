@@ -13,11 +13,10 @@ use rayon::prelude::*;
 
 use super::inputs::{CodeChecker, FailureKind, ImageChecker};
 use super::rubric::Rubric;
-use super::run::{
-    Format, GradeError, GradeReport, check_replaceable, grade_into, round2, staging_dir, swap_in,
-};
+use super::run::{Format, GradeError, GradeReport, REPORT_FOLDER, grade_into, round2};
 use crate::escape::{csv_cell, markdown_inline};
 use crate::oracle::vectors::ShapeKind;
+use crate::output::OutputDir;
 
 /// One submission of a batch.
 #[derive(Debug)]
@@ -58,12 +57,9 @@ pub fn grade_batch(
     if !dir.is_dir() {
         return Err(GradeError::NoSubmission(dir.to_path_buf()));
     }
-    let out = &crate::compare::report::resolve_link(out);
-    let subs = submissions(dir, Some(out))?;
-    check_replaceable(out)?;
     // Everything is written into a fresh folder beside `out` and swapped in whole at the end.
-    let (tmp, _guard) = staging_dir(out)?;
-    let staging = tmp.path().to_path_buf();
+    let output = OutputDir::create(out, "", &REPORT_FOLDER)?;
+    let subs = submissions(dir, Some(output.target()))?;
     let bar = if std::io::stderr().is_terminal() {
         let bar =
             ProgressBar::with_draw_target(Some(subs.len() as u64), ProgressDrawTarget::stderr());
@@ -82,13 +78,20 @@ pub fn grade_batch(
                 .file_name()
                 .map(|n| n.to_string_lossy().to_string())
                 .unwrap_or_default();
-            let target = staging.join(&name);
             let result = catch_unwind(AssertUnwindSafe(|| {
-                std::fs::create_dir(&target).map_err(|e| GradeError::Output {
-                    path: out.join(&name),
+                std::fs::create_dir(output.path().join(&name)).map_err(|e| GradeError::Output {
+                    path: output.shown(&name),
                     message: e.to_string(),
                 })?;
-                grade_into(sub, rubric, code, images, &target, formats)
+                grade_into(
+                    sub,
+                    rubric,
+                    code,
+                    images,
+                    &output,
+                    Path::new(&name),
+                    formats,
+                )
             }));
             bar.inc(1);
             let result = match result {
@@ -100,17 +103,9 @@ pub fn grade_batch(
         })
         .collect();
     bar.finish_and_clear();
-    let write = |file: &str, text: String| {
-        super::run::write_public(&staging.join(file), text.as_bytes()).map_err(|e| {
-            GradeError::Output {
-                path: out.join(file),
-                message: e.to_string(),
-            }
-        })
-    };
-    write("gradebook.csv", gradebook_csv(rubric, &entries))?;
-    write("summary.md", summary_md(rubric, &entries))?;
-    swap_in(tmp, out)?;
+    output.write("gradebook.csv", gradebook_csv(rubric, &entries).as_bytes())?;
+    output.write("summary.md", summary_md(rubric, &entries).as_bytes())?;
+    output.commit()?;
     Ok(entries)
 }
 

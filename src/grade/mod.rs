@@ -45,6 +45,6 @@ pub use inputs::{
 pub use rubric::{GoldenFile, Group, GroupKind, Rubric, RubricError, Visibility};
 pub use run::{
     CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, Format, GradeError, GradeReport,
-    ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,
+    ImageResult, REPORT_FOLDER, Reproducibility, grade, grade_to_dir, round2, smallest_failure,
     write_reports,
 };

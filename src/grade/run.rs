@@ -12,6 +12,7 @@ use super::inputs::{
 };
 use super::report;
 use super::rubric::{Group, GroupKind, Rubric, SceneSource, Visibility};
+use crate::output::{OutputDir, OutputError, Replaceable};
 
 /// How many failing vectors of a group the reports show.
 pub const FAILURES_SHOWN: usize = 5;
@@ -628,33 +629,29 @@ impl Format {
     }
 }
 
-/// Writes `bytes` to `path` atomically, readable by everyone (`0644`: reports are read by other
-/// users, such as a web server or Gradescope's harness).
-pub fn write_public(path: &Path, bytes: &[u8]) -> Result<(), crate::image_io::ImageError> {
-    use std::os::unix::fs::PermissionsExt;
-    crate::image_io::write_atomically(path, bytes)?;
-    let _ = std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o644));
-    Ok(())
+impl Format {
+    /// `report` in this format.
+    pub fn render(self, report: &GradeReport) -> String {
+        match self {
+            Format::Json => report::json::render(report),
+            Format::Gradescope => report::gradescope::render(report),
+            Format::Junit => report::junit::render(report),
+            Format::Markdown => report::markdown::render(report),
+        }
+    }
 }
 
-/// Writes `report` in each of `formats` into `out_dir` (each file atomically).
+/// Writes `report` in each of `formats` into the existing folder `out_dir` (each file whole or
+/// not at all, readable by everyone: reports are read by other users, such as a web server or
+/// Gradescope's harness).
 pub fn write_reports(
     report: &GradeReport,
     out_dir: &Path,
     formats: &[Format],
 ) -> Result<(), GradeError> {
     for &f in formats {
-        let text = match f {
-            Format::Json => report::json::render(report),
-            Format::Gradescope => report::gradescope::render(report),
-            Format::Junit => report::junit::render(report),
-            Format::Markdown => report::markdown::render(report),
-        };
         let path = out_dir.join(f.file_name());
-        write_public(&path, text.as_bytes()).map_err(|e| GradeError::Output {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
+        crate::output::write_file(&path, "", f.render(report).as_bytes())?;
     }
     Ok(())
 }
@@ -673,85 +670,27 @@ fn is_report_file(name: &str) -> bool {
     ) || (name.starts_with("heatmap-") && name.ends_with(".png"))
 }
 
-/// Checks, before any work, that `out_dir` may be replaced by a fresh report folder: it is
-/// missing, or a folder holding only rtoracle's reports (and, for a batch, folders of them), so
-/// no file of the user's is ever removed.
-pub(crate) fn check_replaceable(out_dir: &Path) -> Result<(), GradeError> {
-    fn walk(dir: &Path, depth: usize) -> Result<(), String> {
-        let entries =
-            std::fs::read_dir(dir).map_err(|e| format!("cannot be read ({})", e.kind()))?;
-        for e in entries.flatten() {
-            let name = e.file_name().to_string_lossy().to_string();
-            let t = e
-                .file_type()
-                .map_err(|e| format!("cannot be read ({})", e.kind()))?;
-            if t.is_file() && is_report_file(&name) {
-                continue;
-            }
-            if t.is_dir() && depth == 0 {
-                walk(&e.path(), 1)
-                    .map_err(|_| format!("holds {name}, which is not an rtoracle report folder"))?;
-                continue;
-            }
-            return Err(format!("holds {name}, which is not an rtoracle report"));
+/// What a folder may hold to be replaced by grading's reports: only rtoracle's reports (and,
+/// for a batch, folders of them), so no file of the user's is ever removed.
+pub const REPORT_FOLDER: Replaceable = Replaceable {
+    what: "an rtoracle grade report",
+    is_output_file: is_report_file,
+    folders: true,
+};
+
+impl From<OutputError> for GradeError {
+    fn from(e: OutputError) -> Self {
+        GradeError::Output {
+            path: e.path,
+            message: e.message,
         }
-        Ok(())
-    }
-    let fail = |message: String| GradeError::Output {
-        path: out_dir.to_path_buf(),
-        message,
-    };
-    match std::fs::symlink_metadata(out_dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(fail(format!("cannot be read ({})", e.kind()))),
-        Ok(m) if !m.is_dir() => Err(fail("exists and is not a folder".into())),
-        Ok(_) => walk(out_dir, 0).map_err(|why| {
-            fail(format!(
-                "{why}; it is replaced whole, so choose an empty or new folder"
-            ))
-        }),
     }
 }
 
-/// A fresh temporary folder beside `out_dir` (same file system, so it can be renamed into place),
-/// removed on Ctrl-C or SIGTERM while the guard lives and on drop.
-pub(crate) fn staging_dir(
-    out_dir: &Path,
-) -> Result<(tempfile::TempDir, crate::interrupt::CleanupGuard), GradeError> {
-    let parent = match out_dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let name = out_dir
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}.rtoracle-"))
-        .tempdir_in(parent)
-        .map_err(|e| GradeError::Output {
-            path: out_dir.to_path_buf(),
-            message: format!("cannot make a temporary folder beside it: {e}"),
-        })?;
-    let guard = crate::interrupt::remove_on_interrupt(tmp.path());
-    Ok((tmp, guard))
-}
-
-/// Puts the finished folder `tmp` where `dest` is, whole (see
-/// [`crate::compare::report::swap_in`]), readable by everyone (reports are read by other users).
-/// The one place grading swaps folders, so it can later use a shared output helper.
-pub(crate) fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> Result<(), GradeError> {
-    use std::os::unix::fs::PermissionsExt;
-    let _ = std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755));
-    crate::compare::report::swap_in(tmp, dest).map_err(|e| GradeError::Output {
-        path: dest.to_path_buf(),
-        message: e.to_string(),
-    })
-}
-
-/// Grades into a fresh temporary folder and swaps it in whole as `out_dir` (see [`swap_in`]):
+/// Grades into a fresh staging folder and swaps it in whole as `out_dir` (see [`OutputDir`]):
 /// what `rtoracle grade DIR --out OUT` does. An existing `out_dir` must hold only rtoracle's
-/// reports (checked before any work); an interruption leaves no temporary folder behind.
+/// reports ([`REPORT_FOLDER`], checked before any work); an interruption leaves no temporary
+/// folder behind and a previous report as it was.
 pub fn grade_to_dir(
     submission: &Path,
     rubric: &Rubric,
@@ -763,25 +702,35 @@ pub fn grade_to_dir(
     if !submission.is_dir() {
         return Err(GradeError::NoSubmission(submission.to_path_buf()));
     }
-    let out_dir = &crate::compare::report::resolve_link(out_dir);
-    check_replaceable(out_dir)?;
-    let (tmp, _guard) = staging_dir(out_dir)?;
-    let report = grade_into(submission, rubric, code, images, tmp.path(), formats)?;
-    swap_in(tmp, out_dir)?;
+    let out = OutputDir::create(out_dir, "", &REPORT_FOLDER)?;
+    let report = grade_into(
+        submission,
+        rubric,
+        code,
+        images,
+        &out,
+        Path::new(""),
+        formats,
+    )?;
+    out.commit()?;
     Ok(report)
 }
 
-/// Grades and writes the reports into the existing, empty folder `out_dir`.
+/// Grades and writes the reports into the existing, empty folder `rel` of the staging folder
+/// `out` (`""` for its top).
 pub(crate) fn grade_into(
     submission: &Path,
     rubric: &Rubric,
     code: &dyn CodeChecker,
     images: &dyn ImageChecker,
-    out_dir: &Path,
+    out: &OutputDir,
+    rel: &Path,
     formats: &[Format],
 ) -> Result<GradeReport, GradeError> {
-    let report = grade(submission, rubric, code, images, out_dir)?;
-    write_reports(&report, out_dir, formats)?;
+    let report = grade(submission, rubric, code, images, &out.path().join(rel))?;
+    for &f in formats {
+        out.write(rel.join(f.file_name()), f.render(&report).as_bytes())?;
+    }
     Ok(report)
 }
 
@@ -1073,6 +1022,65 @@ mod tests {
             [Format::Json, Format::Markdown]
         );
         assert!(Format::parse_list("json,pdf").is_err());
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_report_folder_is_replaced_whole_through_a_link_and_a_users_file_stops_it_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        fake_images(&sub);
+        // A previous batch's folder behind a link: replaced whole, the link stays.
+        let real = dir.path().join("real");
+        std::fs::create_dir_all(real.join("old-sub")).unwrap();
+        std::fs::write(real.join("gradebook.csv"), b"old").unwrap();
+        std::fs::write(real.join("old-sub/heatmap-x.png"), b"old").unwrap();
+        let link = dir.path().join("link");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        let code = FakeCode::new(counts(2, 1), counts(2, 2));
+        let r = grade_to_dir(
+            &sub,
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &link,
+            &[Format::Json],
+        );
+        assert_eq!(r.unwrap().score, 85.0);
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(names(&real), ["report.json"]);
+        assert_eq!(names(dir.path()), ["link", "real", "sub"]);
+        // A file of the user's: refused before grading (which would panic here), and kept.
+        std::fs::write(real.join("notes.txt"), b"mine").unwrap();
+        let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
+        code.panic_on = Some("sub".into());
+        let e = grade_to_dir(
+            &sub,
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &link,
+            &[Format::Json],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("holds notes.txt"), "{e}");
+        assert_eq!(names(&real), ["notes.txt", "report.json"]);
+        assert_eq!(names(dir.path()), ["link", "real", "sub"]);
     }
 
     #[test]
