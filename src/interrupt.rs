@@ -3,8 +3,9 @@
 //!
 //! Work that leaves something behind if the process dies (a sandbox folder holding a student's
 //! code, a temporary output folder, processes of a sandbox identity) registers a cleanup with
-//! [`on_interrupt`] (or [`remove_on_interrupt`] for a path) and keeps the returned
-//! [`CleanupGuard`] while the thing exists; dropping the guard unregisters it, so the normal path
+//! [`on_interrupt`] (or [`remove_on_interrupt`] for a path; [`create_temporary`] makes a
+//! temporary file or folder and registers it in one step no signal can split) and keeps the
+//! returned [`CleanupGuard`] while the thing exists; dropping the guard unregisters it, so the normal path
 //! cleans up as usual (say by `tempfile`'s drop) and the cleanup runs only on an interruption.
 //!
 //! [`install`] (called once by the binary, before any work) starts a thread that waits for
@@ -112,16 +113,44 @@ pub fn on_interrupt(cleanup: impl Fn() + Send + Sync + 'static) -> CleanupGuard 
     REGISTRY.register(Box::new(cleanup))
 }
 
-/// Registers the removal of `path` (a folder, recursively, or a file) on interruption.
+/// Registers the removal of `path` (a folder, recursively, or a file) on interruption. A folder
+/// that another thread is still writing into when the cleanup runs may not go at the first try
+/// (a file made between the listing and the removal): it is tried a few more times.
 pub fn remove_on_interrupt(path: impl Into<PathBuf>) -> CleanupGuard {
     let path = path.into();
     on_interrupt(move || {
-        if path.is_dir() {
-            let _ = std::fs::remove_dir_all(&path);
-        } else {
-            let _ = std::fs::remove_file(&path);
+        for _ in 0..REMOVAL_TRIES {
+            match std::fs::symlink_metadata(&path) {
+                Ok(m) if m.is_dir() => {
+                    let _ = std::fs::remove_dir_all(&path);
+                }
+                Ok(_) => {
+                    let _ = std::fs::remove_file(&path);
+                }
+                Err(_) => return,
+            }
         }
     })
+}
+
+/// How many times a cleanup tries to remove a path (see [`remove_on_interrupt`]).
+const REMOVAL_TRIES: usize = 8;
+
+/// Makes a temporary file or folder with `make` and registers its removal on interruption (of
+/// the path `path_of` gives), both under the gate the signal thread holds while it cleans up: so
+/// the thing is either made before the cleanups look, and removed by them, or never made (an
+/// `Interrupted` error once a signal has come). Temporary things made while other threads work
+/// (a batch grades submissions in parallel) must be made this way: one made during the cleanups
+/// would be missed by them.
+pub fn create_temporary<T>(
+    make: impl FnOnce() -> std::io::Result<T>,
+    path_of: impl FnOnce(&T) -> &std::path::Path,
+) -> std::io::Result<(T, CleanupGuard)> {
+    let _gate = hold_off()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::Interrupted, "interrupted"))?;
+    let made = make()?;
+    let guard = remove_on_interrupt(path_of(&made));
+    Ok((made, guard))
 }
 
 /// Whether a signal has been received (long loops may stop early; the process exits soon).

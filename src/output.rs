@@ -106,18 +106,6 @@ fn interrupted() -> std::io::Error {
     std::io::Error::new(std::io::ErrorKind::Interrupted, "interrupted")
 }
 
-/// Makes a temporary file or folder with `make` and registers its removal on interruption,
-/// under [`interrupt::hold_off`], so no signal can fall between the two.
-fn staged<T>(
-    make: impl FnOnce() -> std::io::Result<T>,
-    path_of: impl FnOnce(&T) -> &Path,
-) -> std::io::Result<(T, CleanupGuard)> {
-    let _hold = interrupt::hold_off().ok_or_else(interrupted)?;
-    let made = make()?;
-    let guard = interrupt::remove_on_interrupt(path_of(&made));
-    Ok((made, guard))
-}
-
 /// The folder a path lives in (`.` for a bare name).
 pub fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
@@ -246,7 +234,7 @@ impl OutputFile {
 
     /// Opens the temporary sibling of `path`, a path known to be writable.
     fn open(path: &Path, option: &str) -> Result<Self, OutputError> {
-        let (tmp, guard) = staged(
+        let (tmp, guard) = interrupt::create_temporary(
             || {
                 tempfile::Builder::new()
                     .prefix(&temp_prefix(path))
@@ -438,7 +426,7 @@ impl OutputDir {
     /// removed on an interruption from the moment it exists.
     pub fn create(path: &Path, option: &str, replace: &Replaceable) -> Result<Self, OutputError> {
         let target = replaceable_target(path, option, replace)?;
-        let (tmp, guard) = staged(
+        let (tmp, guard) = interrupt::create_temporary(
             || {
                 tempfile::Builder::new()
                     .prefix(&temp_prefix(&target))
@@ -566,7 +554,7 @@ fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
 /// folder. `Ok(false)` when `target` cannot be renamed (nothing has changed).
 fn swap_aside(new: &Path, target: &Path) -> std::io::Result<bool> {
     // A free name beside the target; renaming a folder onto an empty folder replaces it.
-    let (aside, _remove) = staged(
+    let (aside, _remove) = interrupt::create_temporary(
         || {
             tempfile::Builder::new()
                 .prefix(&temp_prefix(target))
@@ -599,7 +587,7 @@ fn swap_aside(new: &Path, target: &Path) -> std::io::Result<bool> {
 /// removed after. On an error every move is undone.
 fn swap_by_moves(new: &Path, target: &Path) -> std::io::Result<()> {
     let hidden = |tag: &str| {
-        staged(
+        interrupt::create_temporary(
             || {
                 tempfile::Builder::new()
                     .prefix(&format!(".rtoracle-{tag}-"))
@@ -660,10 +648,11 @@ fn copy_tree(from: &Path, to: &Path) -> std::io::Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn names(dir: &Path) -> Vec<String> {
+    /// The names in `dir`, sorted (a test helper of other modules too).
+    pub(crate) fn names(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

@@ -451,11 +451,17 @@ fn check_image(
 ) -> ImageOutcome {
     let rel = g.file.as_deref().expect("validated");
     let scene = g.scene_source().expect("validated");
-    let stage = match tempfile::Builder::new()
-        .prefix(".rtoracle-image-")
-        .tempdir()
-    {
-        Ok(t) => t,
+    // Made and registered in one step: a batch makes these on many threads at once.
+    let made = crate::interrupt::create_temporary(
+        || {
+            tempfile::Builder::new()
+                .prefix(".rtoracle-image-")
+                .tempdir()
+        },
+        |t| t.path(),
+    );
+    let (stage, _cleanup) = match made {
+        Ok(made) => made,
         Err(e) => {
             return ImageOutcome::unusable(format!(
                 "{rel} could not be staged for comparison ({})",
@@ -463,7 +469,6 @@ fn check_image(
             ));
         }
     };
-    let _cleanup = crate::interrupt::remove_on_interrupt(stage.path());
     let staged =
         match super::intake::stage_image(submission, rel, expected_size(&scene), stage.path()) {
             Ok(p) => p,
@@ -840,6 +845,7 @@ mod tests {
     use super::fakes::*;
     use super::*;
     use crate::grade::rubric::sha256_hex;
+    use crate::output::tests::names;
 
     fn run(rubric: &Rubric, code: &FakeCode, images: &FakeImage) -> GradeReport {
         let sub = tempfile::tempdir().unwrap();
@@ -1024,15 +1030,6 @@ mod tests {
         assert!(Format::parse_list("json,pdf").is_err());
     }
 
-    fn names(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
-
     #[test]
     fn a_report_folder_is_replaced_whole_through_a_link_and_a_users_file_stops_it_first() {
         let dir = tempfile::tempdir().unwrap();
@@ -1046,16 +1043,18 @@ mod tests {
         std::fs::write(real.join("old-sub/heatmap-x.png"), b"old").unwrap();
         let link = dir.path().join("link");
         std::os::unix::fs::symlink(&real, &link).unwrap();
+        let grade_to_link = |code: &FakeCode| {
+            grade_to_dir(
+                &sub,
+                &Rubric::week04(),
+                code,
+                &all_pass(),
+                &link,
+                &[Format::Json],
+            )
+        };
         let code = FakeCode::new(counts(2, 1), counts(2, 2));
-        let r = grade_to_dir(
-            &sub,
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &link,
-            &[Format::Json],
-        );
-        assert_eq!(r.unwrap().score, 85.0);
+        assert_eq!(grade_to_link(&code).unwrap().score, 85.0);
         assert!(
             std::fs::symlink_metadata(&link)
                 .unwrap()
@@ -1068,16 +1067,7 @@ mod tests {
         std::fs::write(real.join("notes.txt"), b"mine").unwrap();
         let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
         code.panic_on = Some("sub".into());
-        let e = grade_to_dir(
-            &sub,
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &link,
-            &[Format::Json],
-        )
-        .unwrap_err()
-        .to_string();
+        let e = grade_to_link(&code).unwrap_err().to_string();
         assert!(e.contains("holds notes.txt"), "{e}");
         assert_eq!(names(&real), ["notes.txt", "report.json"]);
         assert_eq!(names(dir.path()), ["link", "real", "sub"]);
