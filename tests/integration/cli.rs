@@ -567,17 +567,30 @@ fn interrupted(
     after: Duration,
     signal: i32,
 ) -> (Option<i32>, Vec<String>) {
+    interrupted_when(dir, args, &[], signal, |_| std::thread::sleep(after))
+}
+
+/// Starts `args` in `dir` with a private `TMPDIR` and `envs`, calls `wait` with the child,
+/// sends `signal`, and returns the exit code and what was left in `TMPDIR`.
+fn interrupted_when(
+    dir: &Path,
+    args: &[&str],
+    envs: &[(&str, &Path)],
+    signal: i32,
+    wait: impl FnOnce(&mut std::process::Child),
+) -> (Option<i32>, Vec<String>) {
     let private = tempfile::tempdir().unwrap();
     let mut child = rtoracle()
         .current_dir(dir)
         .args(args)
         .env("TMPDIR", private.path())
+        .envs(envs.iter().copied())
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    std::thread::sleep(after);
+    wait(&mut child);
     // SAFETY: kill(2) on our own child's pid, which has not been waited for.
     unsafe {
         libc::kill(child.id() as i32, signal);
@@ -675,53 +688,24 @@ fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
     out
 }
 
-/// Starts `args` in `dir` with a private `TMPDIR` and `envs`, waits until its staging folder
-/// (a name starting with `staging`) stands in `dir` and `then` more, sends `signal`, and returns
-/// the exit code and what was left in `TMPDIR`.
-fn interrupted_while_staged(
-    dir: &Path,
-    args: &[&str],
-    envs: &[(&str, &Path)],
-    staging: &str,
+/// Waits until a name starting with `staging` stands in `dir` (the child's staging folder), then
+/// `then` more.
+fn until_staged<'a>(
+    dir: &'a Path,
+    staging: &'a str,
     then: Duration,
-    signal: i32,
-) -> (Option<i32>, Vec<String>) {
-    let private = tempfile::tempdir().unwrap();
-    let mut child = rtoracle()
-        .current_dir(dir)
-        .args(args)
-        .env("TMPDIR", private.path())
-        .envs(envs.iter().copied())
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while !names(dir).iter().any(|n| n.starts_with(staging)) {
-        if let Some(s) = child.try_wait().unwrap() {
-            panic!("{args:?} ended ({s}) before its staging folder {staging}* appeared");
+) -> impl FnOnce(&mut std::process::Child) + 'a {
+    move |child| {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while !names(dir).iter().any(|n| n.starts_with(staging)) {
+            if let Some(s) = child.try_wait().unwrap() {
+                panic!("it ended ({s}) before its staging folder {staging}* appeared");
+            }
+            assert!(Instant::now() < deadline, "no {staging}* in 60 s");
+            std::thread::sleep(Duration::from_millis(5));
         }
-        assert!(Instant::now() < deadline, "{args:?}: no {staging}* in 60 s");
-        std::thread::sleep(Duration::from_millis(5));
+        std::thread::sleep(then);
     }
-    std::thread::sleep(then);
-    // SAFETY: kill(2) on our own child's pid, which has not been waited for.
-    unsafe {
-        libc::kill(child.id() as i32, signal);
-    }
-    let deadline = Instant::now() + Duration::from_secs(30);
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("{args:?} did not exit within 30 s of signal {signal}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    (status.code(), names(private.path()))
 }
 
 /// An interruption while a report folder is being made (`compare --report` rendering its
@@ -796,9 +780,8 @@ fn an_interrupted_report_leaves_the_previous_one_as_it_was_and_no_staging_folder
     for (args, staging) in runs {
         for (signal, code) in [(SIGINT, 130), (SIGTERM, 143)] {
             let envs = [("RTORACLE_CACHE_DIR", cache.path())];
-            let then = Duration::from_millis(300);
-            let (got, left_in_tmp) =
-                interrupted_while_staged(root, args, &envs, staging, then, signal);
+            let wait = until_staged(root, staging, Duration::from_millis(300));
+            let (got, left_in_tmp) = interrupted_when(root, args, &envs, signal, wait);
             assert_eq!(got, Some(code), "{args:?} on signal {signal}");
             assert!(
                 left_in_tmp.is_empty(),
