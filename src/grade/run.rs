@@ -1,4 +1,5 @@
-//! Grading one submission: the result model, the scoring, and writing the reports.
+//! Grading one submission: the result model and the scoring (the reports are written by
+//! [`report`](super::report), into a folder by [`write`](super::write)).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -10,9 +11,8 @@ use super::inputs::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
     ImageVerdict,
 };
-use super::report;
 use super::rubric::{Group, GroupKind, Rubric, SceneSource, Visibility};
-use crate::output::{OutputDir, OutputError, Replaceable};
+use crate::output::OutputError;
 
 /// How many failing vectors of a group the reports show.
 pub const FAILURES_SHOWN: usize = 5;
@@ -193,6 +193,15 @@ pub enum GradeError {
         "--format {0:?}: unknown format; use all or a comma list of json, gradescope, junit, markdown"
     )]
     Format(String),
+}
+
+impl From<OutputError> for GradeError {
+    fn from(e: OutputError) -> Self {
+        GradeError::Output {
+            path: e.path,
+            message: e.message,
+        }
+    }
 }
 
 /// The failure a student should look at first: a definite vector that was run and failed (never
@@ -583,162 +592,6 @@ pub fn grade(
     })
 }
 
-/// The report formats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Format {
-    /// `report.json`.
-    Json,
-    /// `results.json` for Gradescope.
-    Gradescope,
-    /// `junit.xml`.
-    Junit,
-    /// `feedback.md`.
-    Markdown,
-}
-
-impl Format {
-    /// Every format.
-    pub const ALL: [Format; 4] = [
-        Format::Json,
-        Format::Gradescope,
-        Format::Junit,
-        Format::Markdown,
-    ];
-
-    /// Parses `all` or a comma-separated list.
-    pub fn parse_list(text: &str) -> Result<Vec<Format>, GradeError> {
-        let mut out = Vec::new();
-        for part in text.split(',').map(str::trim) {
-            match part {
-                "all" => out.extend(Format::ALL),
-                "json" => out.push(Format::Json),
-                "gradescope" => out.push(Format::Gradescope),
-                "junit" => out.push(Format::Junit),
-                "markdown" | "md" => out.push(Format::Markdown),
-                other => return Err(GradeError::Format(other.to_string())),
-            }
-        }
-        out.sort();
-        out.dedup();
-        Ok(out)
-    }
-
-    /// The file it is written to.
-    pub fn file_name(self) -> &'static str {
-        match self {
-            Format::Json => "report.json",
-            Format::Gradescope => "results.json",
-            Format::Junit => "junit.xml",
-            Format::Markdown => "feedback.md",
-        }
-    }
-}
-
-impl Format {
-    /// `report` in this format.
-    pub fn render(self, report: &GradeReport) -> String {
-        match self {
-            Format::Json => report::json::render(report),
-            Format::Gradescope => report::gradescope::render(report),
-            Format::Junit => report::junit::render(report),
-            Format::Markdown => report::markdown::render(report),
-        }
-    }
-}
-
-/// Writes `report` in each of `formats` into the existing folder `out_dir` (each file whole or
-/// not at all, readable by everyone: reports are read by other users, such as a web server or
-/// Gradescope's harness).
-pub fn write_reports(
-    report: &GradeReport,
-    out_dir: &Path,
-    formats: &[Format],
-) -> Result<(), GradeError> {
-    for &f in formats {
-        let path = out_dir.join(f.file_name());
-        crate::output::write_file(&path, "", f.render(report).as_bytes())?;
-    }
-    Ok(())
-}
-
-/// Whether `name` is a file rtoracle's reports consist of (so an old report folder may be
-/// replaced whole): a report, a heatmap, a batch's gradebook or summary.
-fn is_report_file(name: &str) -> bool {
-    matches!(
-        name,
-        "report.json"
-            | "results.json"
-            | "junit.xml"
-            | "feedback.md"
-            | "gradebook.csv"
-            | "summary.md"
-    ) || (name.starts_with("heatmap-") && name.ends_with(".png"))
-}
-
-/// What a folder may hold to be replaced by grading's reports: only rtoracle's reports (and,
-/// for a batch, folders of them), so no file of the user's is ever removed.
-pub const REPORT_FOLDER: Replaceable = Replaceable {
-    what: "an rtoracle grade report",
-    is_output_file: is_report_file,
-    folders: true,
-};
-
-impl From<OutputError> for GradeError {
-    fn from(e: OutputError) -> Self {
-        GradeError::Output {
-            path: e.path,
-            message: e.message,
-        }
-    }
-}
-
-/// Grades into a fresh staging folder and swaps it in whole as `out_dir` (see [`OutputDir`]):
-/// what `rtoracle grade DIR --out OUT` does. An existing `out_dir` must hold only rtoracle's
-/// reports ([`REPORT_FOLDER`], checked before any work); an interruption leaves no temporary
-/// folder behind and a previous report as it was.
-pub fn grade_to_dir(
-    submission: &Path,
-    rubric: &Rubric,
-    code: &dyn CodeChecker,
-    images: &dyn ImageChecker,
-    out_dir: &Path,
-    formats: &[Format],
-) -> Result<GradeReport, GradeError> {
-    if !submission.is_dir() {
-        return Err(GradeError::NoSubmission(submission.to_path_buf()));
-    }
-    let out = OutputDir::create(out_dir, "", &REPORT_FOLDER)?;
-    let report = grade_into(
-        submission,
-        rubric,
-        code,
-        images,
-        &out,
-        Path::new(""),
-        formats,
-    )?;
-    out.commit()?;
-    Ok(report)
-}
-
-/// Grades and writes the reports into the existing, empty folder `rel` of the staging folder
-/// `out` (`""` for its top).
-pub(crate) fn grade_into(
-    submission: &Path,
-    rubric: &Rubric,
-    code: &dyn CodeChecker,
-    images: &dyn ImageChecker,
-    out: &OutputDir,
-    rel: &Path,
-    formats: &[Format],
-) -> Result<GradeReport, GradeError> {
-    let report = grade(submission, rubric, code, images, &out.path().join(rel))?;
-    for &f in formats {
-        out.write(rel.join(f.file_name()), f.render(&report).as_bytes())?;
-    }
-    Ok(report)
-}
-
 #[cfg(test)]
 pub(crate) mod fakes {
     //! Test doubles of the two interfaces.
@@ -845,7 +698,6 @@ mod tests {
     use super::fakes::*;
     use super::*;
     use crate::grade::rubric::sha256_hex;
-    use crate::output::tests::names;
 
     fn run(rubric: &Rubric, code: &FakeCode, images: &FakeImage) -> GradeReport {
         let sub = tempfile::tempdir().unwrap();
@@ -1011,7 +863,7 @@ mod tests {
     }
 
     #[test]
-    fn a_missing_folder_is_the_only_error_and_formats_parse() {
+    fn a_missing_folder_is_the_only_error() {
         let out = tempfile::tempdir().unwrap();
         let e = grade(
             Path::new("/no/such/dir"),
@@ -1022,102 +874,5 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(e.to_string(), "/no/such/dir: no such submission folder");
-        assert_eq!(Format::parse_list("all").unwrap(), Format::ALL);
-        assert_eq!(
-            Format::parse_list("markdown,json").unwrap(),
-            [Format::Json, Format::Markdown]
-        );
-        assert!(Format::parse_list("json,pdf").is_err());
-    }
-
-    #[test]
-    fn a_report_folder_is_replaced_whole_through_a_link_and_a_users_file_stops_it_first() {
-        let dir = tempfile::tempdir().unwrap();
-        let sub = dir.path().join("sub");
-        std::fs::create_dir(&sub).unwrap();
-        fake_images(&sub);
-        // A previous batch's folder behind a link: replaced whole, the link stays.
-        let real = dir.path().join("real");
-        std::fs::create_dir_all(real.join("old-sub")).unwrap();
-        std::fs::write(real.join("gradebook.csv"), b"old").unwrap();
-        std::fs::write(real.join("old-sub/heatmap-x.png"), b"old").unwrap();
-        let link = dir.path().join("link");
-        std::os::unix::fs::symlink(&real, &link).unwrap();
-        let grade_to_link = |code: &FakeCode| {
-            grade_to_dir(
-                &sub,
-                &Rubric::week04(),
-                code,
-                &all_pass(),
-                &link,
-                &[Format::Json],
-            )
-        };
-        let code = FakeCode::new(counts(2, 1), counts(2, 2));
-        assert_eq!(grade_to_link(&code).unwrap().score, 85.0);
-        assert!(
-            std::fs::symlink_metadata(&link)
-                .unwrap()
-                .file_type()
-                .is_symlink()
-        );
-        assert_eq!(names(&real), ["report.json"]);
-        assert_eq!(names(dir.path()), ["link", "real", "sub"]);
-        // A file of the user's: refused before grading (which would panic here), and kept.
-        std::fs::write(real.join("notes.txt"), b"mine").unwrap();
-        let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
-        code.panic_on = Some("sub".into());
-        let e = grade_to_link(&code).unwrap_err().to_string();
-        assert!(e.contains("holds notes.txt"), "{e}");
-        assert_eq!(names(&real), ["notes.txt", "report.json"]);
-        assert_eq!(names(dir.path()), ["link", "real", "sub"]);
-    }
-
-    #[test]
-    fn a_panicking_submission_does_not_stop_the_batch() {
-        let dir = tempfile::tempdir().unwrap();
-        for name in ["a", "b", "c"] {
-            std::fs::create_dir(dir.path().join(name)).unwrap();
-            fake_images(&dir.path().join(name));
-        }
-        let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
-        code.panic_on = Some("b".into());
-        let out = dir.path().join("out");
-        let entries = crate::grade::batch::grade_batch(
-            dir.path(),
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &out,
-            &[Format::Json],
-        )
-        .unwrap();
-        // The output folder inside the batch folder is not taken for a submission.
-        assert_eq!(
-            entries.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(),
-            ["a", "b", "c"]
-        );
-        assert!(entries[1].result.is_err());
-        let csv = std::fs::read_to_string(out.join("gradebook.csv")).unwrap();
-        let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(
-            lines,
-            [
-                "submission,score,max_score,sphere,quad,image.week04-sphere,image.week04-quad,status",
-                "a,85,100,15,30,20,20,ok",
-                "b,,100,,,,,error: the grader panicked on this submission",
-                "c,85,100,15,30,20,20,ok",
-            ]
-        );
-        assert!(out.join("a/report.json").is_file() && out.join("c/report.json").is_file());
-        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
-        assert!(
-            summary.contains("3 submissions, 2 graded, 1 could not be graded"),
-            "{summary}"
-        );
-        assert!(
-            summary.contains("| `sphere.intersect` Sphere intersection | 2 |"),
-            "{summary}"
-        );
     }
 }
