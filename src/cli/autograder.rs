@@ -109,8 +109,9 @@ fn check_is_rtoracle(binary: &std::path::Path) -> anyhow::Result<()> {
     if !is_elf {
         return Ok(());
     }
-    let dir = tempfile::tempdir().map_err(|e| refuse(format!("cannot run it: {e}")))?;
-    let _cleanup = rtoracle::interrupt::remove_on_interrupt(dir.path());
+    let (dir, _cleanup) =
+        rtoracle::interrupt::create_temporary(tempfile::tempdir, |t: &tempfile::TempDir| t.path())
+            .map_err(|e| refuse(format!("cannot run it: {e}")))?;
     let mut child = Command::new(std::path::absolute(binary)?)
         .arg("--version")
         .current_dir(dir.path())

@@ -4,7 +4,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use rtoracle::compare::{
     CandidateImage, CompareOptions, Comparison, Encoding, Golden, check_size, compare_image,
-    golden_for_scene, report, write_heatmap, write_report,
+    golden_for_scene, report, write_heatmap, write_report_to,
 };
 
 /// `rtoracle compare CANDIDATE (--scene NAME | --golden FILE.exr) [--spp N] [--encoding E]
@@ -114,10 +114,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             );
         }
     }
-    if let Some(r) = &args.report {
-        rtoracle::output::check_output_dir(r, "--report")?;
-        report::check_report_dir(r)?;
-    }
+    // The report's folder is checked and its staging folder made before any work (removed on
+    // Ctrl-C and on an error, swapped in whole at the end).
+    let report_out = args
+        .report
+        .as_deref()
+        .map(|r| report::report_dir(r, "--report"))
+        .transpose()?;
     // The candidate first: a bad candidate is reported before any golden work.
     let candidate = CandidateImage::load(&args.candidate)?;
     let (golden, default_spp): (Box<dyn FnOnce(u32) -> anyhow::Result<Golden>>, u32) =
@@ -151,8 +154,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(h) = &args.heatmap {
         write_heatmap(h, &comparison)?;
     }
-    if let Some(r) = &args.report {
-        write_report(r, &comparison, &candidate, &golden, encoding)?;
+    if let Some(out) = report_out {
+        write_report_to(out, &comparison, &candidate, &golden, encoding)?;
     }
     if args.json {
         outln!("{}", report::to_json(&comparison))?;

@@ -93,7 +93,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(p) = args.python.as_ref().filter(|p| !p.is_file()) {
         anyhow::bail!("--python {}: no such file", p.display());
     }
-    rtoracle::output::check_output_dir(&args.out, "--out")?;
+    // Replaced whole at the end: it may hold only rtoracle's reports.
+    rtoracle::output::check_replaceable(&args.out, "--out", &rtoracle::grade::REPORT_FOLDER)?;
     if let Some(sub) = &args.submission {
         // The reports must not land among the student's files (nor replace them).
         let out = std::path::absolute(&args.out)?;

@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 pub use encoding::{ENCODINGS, Encoding};
 pub use golden::{Golden, golden_for_scene, golden_spp};
 pub use heatmap::write_heatmap;
-pub use report::write_report;
+pub use report::{write_report, write_report_to};
 pub use verdict::{Evaluation, evaluate};
 
 use crate::image_io::ImageError;
@@ -47,6 +47,9 @@ pub enum CompareError {
     /// The golden is unusable.
     #[error("golden: {0}")]
     Golden(String),
+    /// The report folder cannot be written (or may not be replaced).
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }
 
 /// A candidate image: 8-bit codes (from a PNG) or linear values (from an EXR).

@@ -1,13 +1,17 @@
 //! The report folder: `report.json`, `heatmap.png`, side-by-side crops of the worst regions
-//! (candidate, golden, difference) and an `index.html` that shows them.
+//! (candidate, golden, difference) and an `index.html` that shows them. It is an
+//! [`OutputDir`]: checked before any work (an existing folder must hold only a compare report's
+//! files, [`REPORT_FOLDER`]), built beside its place and swapped in whole (see
+//! [`crate::output`]).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::heatmap::heatmap_image;
 use super::{CandidateImage, CompareError, Comparison, Encoding, Golden};
 use crate::escape::html;
-use crate::image_io::{ImageError, Rgb8Image, write_atomically, write_png};
+use crate::image_io::{Rgb8Image, encode_png};
+use crate::output::{OutputDir, OutputError, Replaceable};
 
 /// How many regions get crops.
 const CROPS: usize = 6;
@@ -140,121 +144,21 @@ fn is_report_file(name: &str) -> bool {
             .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
 }
 
-/// Checks, before any work, that `dir` may be replaced by a fresh report folder: missing, or a
-/// folder holding only a compare report's files (so no file of the user's is removed).
-pub fn check_report_dir(dir: &Path) -> Result<(), CompareError> {
-    let dir = &resolve_link(dir);
-    let bad = |message: String| CompareError::Input {
-        path: dir.to_path_buf(),
-        message,
-    };
-    match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(bad(format!("cannot be read ({})", e.kind()))),
-        Ok(m) if !m.is_dir() => Err(bad("exists and is not a folder".into())),
-        Ok(_) => {
-            let entries = std::fs::read_dir(dir)
-                .map_err(|e| bad(format!("cannot be read ({})", e.kind())))?;
-            for e in entries.flatten() {
-                let name = e.file_name().to_string_lossy().to_string();
-                let file = e.file_type().map(|t| t.is_file()).unwrap_or(false);
-                if !(file && is_report_file(&name)) {
-                    return Err(bad(format!(
-                        "holds {}, which is not part of a compare report; the folder is replaced whole, so choose an empty or new one",
-                        crate::escape::terminal_line(&name)
-                    )));
-                }
-            }
-            Ok(())
-        }
-    }
+/// What a folder may hold to be replaced by a compare report: a compare report's files.
+pub const REPORT_FOLDER: Replaceable = Replaceable {
+    what: "a compare report",
+    is_output_file: is_report_file,
+    folders: false,
+};
+
+/// Checks `dir` and creates the staging folder of its report (see [`OutputDir::create`]), before
+/// any work; `option` names the option that gave it, for messages (`"--report"`).
+pub fn report_dir(dir: &Path, option: &str) -> Result<OutputDir, OutputError> {
+    OutputDir::create(dir, option, &REPORT_FOLDER)
 }
 
-/// Puts the finished folder `tmp` where `dest` is, whole: a missing `dest` is a rename; an
-/// existing one is exchanged atomically with `renameat2`'s `RENAME_EXCHANGE` and the old one
-/// removed (with `tmp`), so no file of an earlier run survives. Where the exchange is not
-/// available, the old folder is renamed aside first and removed after.
-pub fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> std::io::Result<()> {
-    use std::os::unix::ffi::OsStrExt;
-    if std::fs::symlink_metadata(dest).is_err() {
-        let path = tmp.keep();
-        return std::fs::rename(&path, dest).inspect_err(|_| {
-            let _ = std::fs::remove_dir_all(&path);
-        });
-    }
-    let c =
-        |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(std::io::Error::other);
-    let (a, b) = (c(tmp.path())?, c(dest)?);
-    // SAFETY: two valid NUL-terminated paths; renameat2 only reads them.
-    let rc = unsafe {
-        libc::renameat2(
-            libc::AT_FDCWD,
-            a.as_ptr(),
-            libc::AT_FDCWD,
-            b.as_ptr(),
-            libc::RENAME_EXCHANGE,
-        )
-    };
-    if rc == 0 {
-        // `tmp` now holds the old folder: dropping it removes it.
-        return Ok(());
-    }
-    let old = tmp.path().with_extension("old");
-    if std::fs::rename(dest, &old).is_err() {
-        // `dest` cannot be renamed (a mount point, say): empty it and copy the new folder in.
-        return copy_into(tmp.path(), dest);
-    }
-    let path = tmp.keep();
-    match std::fs::rename(&path, dest) {
-        Ok(()) => {
-            let _ = std::fs::remove_dir_all(&old);
-            Ok(())
-        }
-        Err(e) => {
-            let _ = std::fs::rename(&old, dest);
-            let _ = std::fs::remove_dir_all(&path);
-            Err(e)
-        }
-    }
-}
-
-/// Empties `dest` (already checked to hold only reports) and copies the files of `src`, and of
-/// its folders one level down, into it.
-fn copy_into(src: &Path, dest: &Path) -> std::io::Result<()> {
-    for e in std::fs::read_dir(dest)?.flatten() {
-        if e.file_type()?.is_dir() {
-            std::fs::remove_dir_all(e.path())?;
-        } else {
-            std::fs::remove_file(e.path())?;
-        }
-    }
-    for e in std::fs::read_dir(src)?.flatten() {
-        let to = dest.join(e.file_name());
-        if e.file_type()?.is_dir() {
-            std::fs::create_dir(&to)?;
-            for f in std::fs::read_dir(e.path())?.flatten() {
-                std::fs::copy(f.path(), to.join(f.file_name()))?;
-            }
-        } else {
-            std::fs::copy(e.path(), &to)?;
-        }
-    }
-    Ok(())
-}
-
-/// `path`, or the folder it links to when it is a symbolic link (so swapping a folder in
-/// replaces the folder, not the link).
-pub fn resolve_link(path: &Path) -> PathBuf {
-    match std::fs::symlink_metadata(path) {
-        Ok(m) if m.file_type().is_symlink() => path.canonicalize().unwrap_or_else(|_| path.into()),
-        _ => path.to_path_buf(),
-    }
-}
-
-/// Writes the report folder: built beside `dir` under a temporary name (removed on Ctrl-C or
-/// SIGTERM) and swapped in whole, so it appears whole or not at all and nothing of an earlier
-/// report (say a stale `region-7.png`) survives. An existing `dir` must pass
-/// [`check_report_dir`].
+/// Writes the report folder `dir` (see [`write_report_to`]). An existing `dir` must hold only a
+/// compare report's files.
 pub fn write_report(
     dir: &Path,
     comparison: &Comparison,
@@ -262,26 +166,29 @@ pub fn write_report(
     golden: &Golden,
     encoding: Encoding,
 ) -> Result<(), CompareError> {
-    let io = |e: std::io::Error| {
-        CompareError::Image(ImageError::Io {
-            path: dir.to_path_buf(),
-            message: e.to_string(),
-        })
+    let out = report_dir(dir, "")?;
+    write_report_to(out, comparison, candidate, golden, encoding)
+}
+
+/// Fills the staging folder `out` (from [`report_dir`]) and swaps it in whole, so the report
+/// appears whole or not at all, nothing of an earlier report (say a stale `region-7.png`)
+/// survives, and Ctrl-C or SIGTERM leaves no temporary folder.
+pub fn write_report_to(
+    out: OutputDir,
+    comparison: &Comparison,
+    candidate: &CandidateImage,
+    golden: &Golden,
+    encoding: Encoding,
+) -> Result<(), CompareError> {
+    let png = |name: &str, img: &Rgb8Image| -> Result<(), CompareError> {
+        let bytes = encode_png(img).map_err(|message| CompareError::Input {
+            path: out.shown(name),
+            message,
+        })?;
+        Ok(out.write(name, &bytes)?)
     };
-    let dir = &resolve_link(dir);
-    check_report_dir(dir)?;
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let tmp = tempfile::Builder::new()
-        .prefix(".rtoracle-report-")
-        .tempdir_in(parent)
-        .map_err(io)?;
-    let _cleanup = crate::interrupt::remove_on_interrupt(tmp.path());
-    let target: PathBuf = tmp.path().to_path_buf();
-    write_atomically(&target.join("report.json"), to_json(comparison).as_bytes())?;
-    write_png(&target.join("heatmap.png"), &heatmap_image(comparison))?;
+    out.write("report.json", to_json(comparison).as_bytes())?;
+    png("heatmap.png", &heatmap_image(comparison))?;
     let cand = candidate.to_rgb8(encoding);
     let gold: Vec<u8> = golden
         .mean
@@ -297,18 +204,11 @@ pub fn write_report(
             comparison.width,
             crop_box(r, comparison.width, comparison.height),
         );
-        write_png(&target.join(&name), &img)?;
+        png(&name, &img)?;
         crops.push((name, r.clone()));
     }
-    write_atomically(
-        &target.join("index.html"),
-        index_html(comparison, &crops).as_bytes(),
-    )?;
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o755));
-    }
-    swap_in(tmp, dir).map_err(io)
+    out.write("index.html", index_html(comparison, &crops).as_bytes())?;
+    Ok(out.commit()?)
 }
 
 #[cfg(test)]
@@ -323,52 +223,6 @@ mod tests {
         t
     }
 
-    fn names(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(dir)
-            .unwrap()
-            .flatten()
-            .map(|e| e.file_name().to_string_lossy().to_string())
-            .collect();
-        v.sort();
-        v
-    }
-
-    #[test]
-    fn swapping_in_replaces_the_old_folder_whole_through_a_link_too() {
-        let root = tempfile::tempdir().unwrap();
-        let dest = root.path().join("rep");
-        std::fs::create_dir(&dest).unwrap();
-        std::fs::write(dest.join("region-7.png"), b"stale").unwrap();
-        swap_in(folder_with(root.path(), &["report.json"]), &dest).unwrap();
-        assert_eq!(names(&dest), ["report.json"]);
-        // Only the new folder is left beside it.
-        assert_eq!(names(root.path()), ["rep"]);
-        // Through a symbolic link, the folder it points to is replaced and the link stays.
-        let link = root.path().join("link");
-        std::os::unix::fs::symlink(&dest, &link).unwrap();
-        let target = resolve_link(&link);
-        swap_in(folder_with(root.path(), &["index.html"]), &target).unwrap();
-        assert!(
-            std::fs::symlink_metadata(&link)
-                .unwrap()
-                .file_type()
-                .is_symlink()
-        );
-        assert_eq!(names(&link), ["index.html"]);
-    }
-
-    #[test]
-    fn copying_into_a_folder_that_cannot_be_renamed_leaves_only_the_new_files() {
-        let root = tempfile::tempdir().unwrap();
-        let dest = folder_with(root.path(), &["heatmap.png", "region-3.png"]);
-        let src = folder_with(root.path(), &["report.json"]);
-        std::fs::create_dir(src.path().join("sub")).unwrap();
-        std::fs::write(src.path().join("sub/feedback.md"), b"x").unwrap();
-        copy_into(src.path(), dest.path()).unwrap();
-        assert_eq!(names(dest.path()), ["report.json", "sub"]);
-        assert_eq!(names(&dest.path().join("sub")), ["feedback.md"]);
-    }
-
     #[test]
     fn only_a_compare_report_may_be_replaced() {
         let root = tempfile::tempdir().unwrap();
@@ -376,10 +230,20 @@ mod tests {
             root.path(),
             &["report.json", "heatmap.png", "region-12.png"],
         );
-        assert!(check_report_dir(ok.path()).is_ok());
-        assert!(check_report_dir(&root.path().join("new")).is_ok());
+        let check = |p: &Path| crate::output::check_replaceable(p, "--report", &REPORT_FOLDER);
+        assert!(check(ok.path()).is_ok());
+        assert!(check(&root.path().join("new")).is_ok());
         let mine = folder_with(root.path(), &["report.json", "region-x.png"]);
-        let e = check_report_dir(mine.path()).unwrap_err().to_string();
-        assert!(e.contains("holds region-x.png"), "{e}");
+        let e = check(mine.path()).unwrap_err().to_string();
+        assert!(e.starts_with("--report "), "{e}");
+        assert!(
+            e.contains("holds region-x.png, which is not part of a compare report"),
+            "{e}"
+        );
+        // Nor a folder inside it: a compare report has none.
+        let nested = folder_with(root.path(), &["report.json"]);
+        std::fs::create_dir(nested.path().join("old")).unwrap();
+        let e = check(nested.path()).unwrap_err().to_string();
+        assert!(e.contains("holds old,"), "{e}");
     }
 }

@@ -255,7 +255,7 @@ pub fn build_package_with(
         zip.write_all(bytes).map_err(|e| write_err(&e))?;
     }
     let cursor = zip.finish().map_err(|e| write_err(&e))?;
-    super::run::write_public(out_zip, &cursor.into_inner()).map_err(|e| write_err(&e))
+    crate::output::write_file(out_zip, "", &cursor.into_inner()).map_err(|e| write_err(&e))
 }
 
 #[cfg(test)]

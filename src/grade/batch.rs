@@ -12,12 +12,13 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use super::inputs::{CodeChecker, FailureKind, ImageChecker};
+use super::report::Format;
 use super::rubric::Rubric;
-use super::run::{
-    Format, GradeError, GradeReport, check_replaceable, grade_into, round2, staging_dir, swap_in,
-};
+use super::run::{GradeError, GradeReport, round2};
+use super::write::{REPORT_FOLDER, grade_into};
 use crate::escape::{csv_cell, markdown_inline};
 use crate::oracle::vectors::ShapeKind;
+use crate::output::OutputDir;
 
 /// One submission of a batch.
 #[derive(Debug)]
@@ -58,12 +59,9 @@ pub fn grade_batch(
     if !dir.is_dir() {
         return Err(GradeError::NoSubmission(dir.to_path_buf()));
     }
-    let out = &crate::compare::report::resolve_link(out);
-    let subs = submissions(dir, Some(out))?;
-    check_replaceable(out)?;
     // Everything is written into a fresh folder beside `out` and swapped in whole at the end.
-    let (tmp, _guard) = staging_dir(out)?;
-    let staging = tmp.path().to_path_buf();
+    let output = OutputDir::create(out, "", &REPORT_FOLDER)?;
+    let subs = submissions(dir, Some(output.target()))?;
     let bar = if std::io::stderr().is_terminal() {
         let bar =
             ProgressBar::with_draw_target(Some(subs.len() as u64), ProgressDrawTarget::stderr());
@@ -82,13 +80,20 @@ pub fn grade_batch(
                 .file_name()
                 .map(|n| n.to_string_lossy().to_string())
                 .unwrap_or_default();
-            let target = staging.join(&name);
             let result = catch_unwind(AssertUnwindSafe(|| {
-                std::fs::create_dir(&target).map_err(|e| GradeError::Output {
-                    path: out.join(&name),
+                std::fs::create_dir(output.path().join(&name)).map_err(|e| GradeError::Output {
+                    path: output.shown(&name),
                     message: e.to_string(),
                 })?;
-                grade_into(sub, rubric, code, images, &target, formats)
+                grade_into(
+                    sub,
+                    rubric,
+                    code,
+                    images,
+                    &output,
+                    Path::new(&name),
+                    formats,
+                )
             }));
             bar.inc(1);
             let result = match result {
@@ -100,17 +105,9 @@ pub fn grade_batch(
         })
         .collect();
     bar.finish_and_clear();
-    let write = |file: &str, text: String| {
-        super::run::write_public(&staging.join(file), text.as_bytes()).map_err(|e| {
-            GradeError::Output {
-                path: out.join(file),
-                message: e.to_string(),
-            }
-        })
-    };
-    write("gradebook.csv", gradebook_csv(rubric, &entries))?;
-    write("summary.md", summary_md(rubric, &entries))?;
-    swap_in(tmp, out)?;
+    output.write("gradebook.csv", gradebook_csv(rubric, &entries).as_bytes())?;
+    output.write("summary.md", summary_md(rubric, &entries).as_bytes())?;
+    output.commit()?;
     Ok(entries)
 }
 
@@ -307,6 +304,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grade::run::fakes::*;
 
     /// Ties are shared between shapes: with ten sphere vectors and two quad vectors all failed
     /// by 3 submissions, the ten listed include both quad ones (alphabetically "quad-" came
@@ -329,5 +327,53 @@ mod tests {
         assert!(listed.contains(&"quad-00".to_string()), "{listed:?}");
         assert!(listed.contains(&"quad-01".to_string()), "{listed:?}");
         assert_eq!(listed.len(), 10);
+    }
+
+    #[test]
+    fn a_panicking_submission_does_not_stop_the_batch() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["a", "b", "c"] {
+            std::fs::create_dir(dir.path().join(name)).unwrap();
+            fake_images(&dir.path().join(name));
+        }
+        let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
+        code.panic_on = Some("b".into());
+        let out = dir.path().join("out");
+        let entries = grade_batch(
+            dir.path(),
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        // The output folder inside the batch folder is not taken for a submission.
+        assert_eq!(
+            entries.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(),
+            ["a", "b", "c"]
+        );
+        assert!(entries[1].result.is_err());
+        let csv = std::fs::read_to_string(out.join("gradebook.csv")).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(
+            lines,
+            [
+                "submission,score,max_score,sphere,quad,image.week04-sphere,image.week04-quad,status",
+                "a,85,100,15,30,20,20,ok",
+                "b,,100,,,,,error: the grader panicked on this submission",
+                "c,85,100,15,30,20,20,ok",
+            ]
+        );
+        assert!(out.join("a/report.json").is_file() && out.join("c/report.json").is_file());
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        assert!(
+            summary.contains("3 submissions, 2 graded, 1 could not be graded"),
+            "{summary}"
+        );
+        assert!(
+            summary.contains("| `sphere.intersect` Sphere intersection | 2 |"),
+            "{summary}"
+        );
     }
 }

@@ -35,6 +35,7 @@ pub mod pack;
 pub mod report;
 pub mod rubric;
 mod run;
+mod write;
 
 pub use checkers::CourseCodeChecker;
 pub use image_checker::CompareImageChecker;
@@ -42,9 +43,10 @@ pub use inputs::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
     ImageVerdict, SceneFile, SceneSource,
 };
+pub use report::{Format, write_reports};
 pub use rubric::{GoldenFile, Group, GroupKind, Rubric, RubricError, Visibility};
 pub use run::{
-    CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, Format, GradeError, GradeReport,
-    ImageResult, Reproducibility, grade, grade_to_dir, round2, smallest_failure, write_public,
-    write_reports,
+    CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, GradeError, GradeReport, ImageResult,
+    Reproducibility, grade, round2, smallest_failure,
 };
+pub use write::{REPORT_FOLDER, grade_to_dir};

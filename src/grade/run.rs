@@ -1,4 +1,5 @@
-//! Grading one submission: the result model, the scoring, and writing the reports.
+//! Grading one submission: the result model and the scoring (the reports are written by
+//! [`report`](super::report), into a folder by [`write`](super::write)).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -10,8 +11,8 @@ use super::inputs::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
     ImageVerdict,
 };
-use super::report;
 use super::rubric::{Group, GroupKind, Rubric, SceneSource, Visibility};
+use crate::output::OutputError;
 
 /// How many failing vectors of a group the reports show.
 pub const FAILURES_SHOWN: usize = 5;
@@ -192,6 +193,15 @@ pub enum GradeError {
         "--format {0:?}: unknown format; use all or a comma list of json, gradescope, junit, markdown"
     )]
     Format(String),
+}
+
+impl From<OutputError> for GradeError {
+    fn from(e: OutputError) -> Self {
+        GradeError::Output {
+            path: e.path,
+            message: e.message,
+        }
+    }
 }
 
 /// The failure a student should look at first: a definite vector that was run and failed (never
@@ -450,11 +460,17 @@ fn check_image(
 ) -> ImageOutcome {
     let rel = g.file.as_deref().expect("validated");
     let scene = g.scene_source().expect("validated");
-    let stage = match tempfile::Builder::new()
-        .prefix(".rtoracle-image-")
-        .tempdir()
-    {
-        Ok(t) => t,
+    // Made and registered in one step: a batch makes these on many threads at once.
+    let made = crate::interrupt::create_temporary(
+        || {
+            tempfile::Builder::new()
+                .prefix(".rtoracle-image-")
+                .tempdir()
+        },
+        |t| t.path(),
+    );
+    let (stage, _cleanup) = match made {
+        Ok(made) => made,
         Err(e) => {
             return ImageOutcome::unusable(format!(
                 "{rel} could not be staged for comparison ({})",
@@ -462,7 +478,6 @@ fn check_image(
             ));
         }
     };
-    let _cleanup = crate::interrupt::remove_on_interrupt(stage.path());
     let staged =
         match super::intake::stage_image(submission, rel, expected_size(&scene), stage.path()) {
             Ok(p) => p,
@@ -575,214 +590,6 @@ pub fn grade(
         r.execution_time = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
         r
     })
-}
-
-/// The report formats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Format {
-    /// `report.json`.
-    Json,
-    /// `results.json` for Gradescope.
-    Gradescope,
-    /// `junit.xml`.
-    Junit,
-    /// `feedback.md`.
-    Markdown,
-}
-
-impl Format {
-    /// Every format.
-    pub const ALL: [Format; 4] = [
-        Format::Json,
-        Format::Gradescope,
-        Format::Junit,
-        Format::Markdown,
-    ];
-
-    /// Parses `all` or a comma-separated list.
-    pub fn parse_list(text: &str) -> Result<Vec<Format>, GradeError> {
-        let mut out = Vec::new();
-        for part in text.split(',').map(str::trim) {
-            match part {
-                "all" => out.extend(Format::ALL),
-                "json" => out.push(Format::Json),
-                "gradescope" => out.push(Format::Gradescope),
-                "junit" => out.push(Format::Junit),
-                "markdown" | "md" => out.push(Format::Markdown),
-                other => return Err(GradeError::Format(other.to_string())),
-            }
-        }
-        out.sort();
-        out.dedup();
-        Ok(out)
-    }
-
-    /// The file it is written to.
-    pub fn file_name(self) -> &'static str {
-        match self {
-            Format::Json => "report.json",
-            Format::Gradescope => "results.json",
-            Format::Junit => "junit.xml",
-            Format::Markdown => "feedback.md",
-        }
-    }
-}
-
-/// Writes `bytes` to `path` atomically, readable by everyone (`0644`: reports are read by other
-/// users, such as a web server or Gradescope's harness).
-pub fn write_public(path: &Path, bytes: &[u8]) -> Result<(), crate::image_io::ImageError> {
-    use std::os::unix::fs::PermissionsExt;
-    crate::image_io::write_atomically(path, bytes)?;
-    let _ = std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o644));
-    Ok(())
-}
-
-/// Writes `report` in each of `formats` into `out_dir` (each file atomically).
-pub fn write_reports(
-    report: &GradeReport,
-    out_dir: &Path,
-    formats: &[Format],
-) -> Result<(), GradeError> {
-    for &f in formats {
-        let text = match f {
-            Format::Json => report::json::render(report),
-            Format::Gradescope => report::gradescope::render(report),
-            Format::Junit => report::junit::render(report),
-            Format::Markdown => report::markdown::render(report),
-        };
-        let path = out_dir.join(f.file_name());
-        write_public(&path, text.as_bytes()).map_err(|e| GradeError::Output {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
-    }
-    Ok(())
-}
-
-/// Whether `name` is a file rtoracle's reports consist of (so an old report folder may be
-/// replaced whole): a report, a heatmap, a batch's gradebook or summary.
-fn is_report_file(name: &str) -> bool {
-    matches!(
-        name,
-        "report.json"
-            | "results.json"
-            | "junit.xml"
-            | "feedback.md"
-            | "gradebook.csv"
-            | "summary.md"
-    ) || (name.starts_with("heatmap-") && name.ends_with(".png"))
-}
-
-/// Checks, before any work, that `out_dir` may be replaced by a fresh report folder: it is
-/// missing, or a folder holding only rtoracle's reports (and, for a batch, folders of them), so
-/// no file of the user's is ever removed.
-pub(crate) fn check_replaceable(out_dir: &Path) -> Result<(), GradeError> {
-    fn walk(dir: &Path, depth: usize) -> Result<(), String> {
-        let entries =
-            std::fs::read_dir(dir).map_err(|e| format!("cannot be read ({})", e.kind()))?;
-        for e in entries.flatten() {
-            let name = e.file_name().to_string_lossy().to_string();
-            let t = e
-                .file_type()
-                .map_err(|e| format!("cannot be read ({})", e.kind()))?;
-            if t.is_file() && is_report_file(&name) {
-                continue;
-            }
-            if t.is_dir() && depth == 0 {
-                walk(&e.path(), 1)
-                    .map_err(|_| format!("holds {name}, which is not an rtoracle report folder"))?;
-                continue;
-            }
-            return Err(format!("holds {name}, which is not an rtoracle report"));
-        }
-        Ok(())
-    }
-    let fail = |message: String| GradeError::Output {
-        path: out_dir.to_path_buf(),
-        message,
-    };
-    match std::fs::symlink_metadata(out_dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(fail(format!("cannot be read ({})", e.kind()))),
-        Ok(m) if !m.is_dir() => Err(fail("exists and is not a folder".into())),
-        Ok(_) => walk(out_dir, 0).map_err(|why| {
-            fail(format!(
-                "{why}; it is replaced whole, so choose an empty or new folder"
-            ))
-        }),
-    }
-}
-
-/// A fresh temporary folder beside `out_dir` (same file system, so it can be renamed into place),
-/// removed on Ctrl-C or SIGTERM while the guard lives and on drop.
-pub(crate) fn staging_dir(
-    out_dir: &Path,
-) -> Result<(tempfile::TempDir, crate::interrupt::CleanupGuard), GradeError> {
-    let parent = match out_dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let name = out_dir
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}.rtoracle-"))
-        .tempdir_in(parent)
-        .map_err(|e| GradeError::Output {
-            path: out_dir.to_path_buf(),
-            message: format!("cannot make a temporary folder beside it: {e}"),
-        })?;
-    let guard = crate::interrupt::remove_on_interrupt(tmp.path());
-    Ok((tmp, guard))
-}
-
-/// Puts the finished folder `tmp` where `dest` is, whole (see
-/// [`crate::compare::report::swap_in`]), readable by everyone (reports are read by other users).
-/// The one place grading swaps folders, so it can later use a shared output helper.
-pub(crate) fn swap_in(tmp: tempfile::TempDir, dest: &Path) -> Result<(), GradeError> {
-    use std::os::unix::fs::PermissionsExt;
-    let _ = std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755));
-    crate::compare::report::swap_in(tmp, dest).map_err(|e| GradeError::Output {
-        path: dest.to_path_buf(),
-        message: e.to_string(),
-    })
-}
-
-/// Grades into a fresh temporary folder and swaps it in whole as `out_dir` (see [`swap_in`]):
-/// what `rtoracle grade DIR --out OUT` does. An existing `out_dir` must hold only rtoracle's
-/// reports (checked before any work); an interruption leaves no temporary folder behind.
-pub fn grade_to_dir(
-    submission: &Path,
-    rubric: &Rubric,
-    code: &dyn CodeChecker,
-    images: &dyn ImageChecker,
-    out_dir: &Path,
-    formats: &[Format],
-) -> Result<GradeReport, GradeError> {
-    if !submission.is_dir() {
-        return Err(GradeError::NoSubmission(submission.to_path_buf()));
-    }
-    let out_dir = &crate::compare::report::resolve_link(out_dir);
-    check_replaceable(out_dir)?;
-    let (tmp, _guard) = staging_dir(out_dir)?;
-    let report = grade_into(submission, rubric, code, images, tmp.path(), formats)?;
-    swap_in(tmp, out_dir)?;
-    Ok(report)
-}
-
-/// Grades and writes the reports into the existing, empty folder `out_dir`.
-pub(crate) fn grade_into(
-    submission: &Path,
-    rubric: &Rubric,
-    code: &dyn CodeChecker,
-    images: &dyn ImageChecker,
-    out_dir: &Path,
-    formats: &[Format],
-) -> Result<GradeReport, GradeError> {
-    let report = grade(submission, rubric, code, images, out_dir)?;
-    write_reports(&report, out_dir, formats)?;
-    Ok(report)
 }
 
 #[cfg(test)]
@@ -1056,7 +863,7 @@ mod tests {
     }
 
     #[test]
-    fn a_missing_folder_is_the_only_error_and_formats_parse() {
+    fn a_missing_folder_is_the_only_error() {
         let out = tempfile::tempdir().unwrap();
         let e = grade(
             Path::new("/no/such/dir"),
@@ -1067,59 +874,5 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(e.to_string(), "/no/such/dir: no such submission folder");
-        assert_eq!(Format::parse_list("all").unwrap(), Format::ALL);
-        assert_eq!(
-            Format::parse_list("markdown,json").unwrap(),
-            [Format::Json, Format::Markdown]
-        );
-        assert!(Format::parse_list("json,pdf").is_err());
-    }
-
-    #[test]
-    fn a_panicking_submission_does_not_stop_the_batch() {
-        let dir = tempfile::tempdir().unwrap();
-        for name in ["a", "b", "c"] {
-            std::fs::create_dir(dir.path().join(name)).unwrap();
-            fake_images(&dir.path().join(name));
-        }
-        let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
-        code.panic_on = Some("b".into());
-        let out = dir.path().join("out");
-        let entries = crate::grade::batch::grade_batch(
-            dir.path(),
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &out,
-            &[Format::Json],
-        )
-        .unwrap();
-        // The output folder inside the batch folder is not taken for a submission.
-        assert_eq!(
-            entries.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(),
-            ["a", "b", "c"]
-        );
-        assert!(entries[1].result.is_err());
-        let csv = std::fs::read_to_string(out.join("gradebook.csv")).unwrap();
-        let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(
-            lines,
-            [
-                "submission,score,max_score,sphere,quad,image.week04-sphere,image.week04-quad,status",
-                "a,85,100,15,30,20,20,ok",
-                "b,,100,,,,,error: the grader panicked on this submission",
-                "c,85,100,15,30,20,20,ok",
-            ]
-        );
-        assert!(out.join("a/report.json").is_file() && out.join("c/report.json").is_file());
-        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
-        assert!(
-            summary.contains("3 submissions, 2 graded, 1 could not be graded"),
-            "{summary}"
-        );
-        assert!(
-            summary.contains("| `sphere.intersect` Sphere intersection | 2 |"),
-            "{summary}"
-        );
     }
 }

@@ -13,8 +13,8 @@ pub struct Rgb8Image {
     pub data: Vec<u8>,
 }
 
-/// Writes an 8-bit RGB PNG atomically.
-pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
+/// The PNG file of an 8-bit RGB image.
+pub fn encode_png(image: &Rgb8Image) -> Result<Vec<u8>, String> {
     let mut bytes = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new(&mut bytes);
     image::ImageEncoder::write_image(
@@ -24,7 +24,13 @@ pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
         image.height as u32,
         image::ExtendedColorType::Rgb8,
     )
-    .map_err(|e| ImageError::format(path, e))?;
+    .map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// Writes an 8-bit RGB PNG atomically.
+pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
+    let bytes = encode_png(image).map_err(|e| ImageError::format(path, e))?;
     write_atomically(path, &bytes)
 }
 

@@ -567,17 +567,30 @@ fn interrupted(
     after: Duration,
     signal: i32,
 ) -> (Option<i32>, Vec<String>) {
+    interrupted_when(dir, args, &[], signal, |_| std::thread::sleep(after))
+}
+
+/// Starts `args` in `dir` with a private `TMPDIR` and `envs`, calls `wait` with the child,
+/// sends `signal`, and returns the exit code and what was left in `TMPDIR`.
+fn interrupted_when(
+    dir: &Path,
+    args: &[&str],
+    envs: &[(&str, &Path)],
+    signal: i32,
+    wait: impl FnOnce(&mut std::process::Child),
+) -> (Option<i32>, Vec<String>) {
     let private = tempfile::tempdir().unwrap();
     let mut child = rtoracle()
         .current_dir(dir)
         .args(args)
         .env("TMPDIR", private.path())
+        .envs(envs.iter().copied())
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    std::thread::sleep(after);
+    wait(&mut child);
     // SAFETY: kill(2) on our own child's pid, which has not been waited for.
     unsafe {
         libc::kill(child.id() as i32, signal);
@@ -653,6 +666,130 @@ fn sigint_during_check_and_grade_leaves_no_sandbox_folder() {
                 "{args:?}: TMPDIR keeps {left_in_tmp:?}"
             );
             assert_eq!(names(root), vec!["sub"], "{args:?} left a report behind");
+        }
+    }
+}
+
+/// Every file below `dir` with its bytes (`sub/name` for files in folders).
+fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    for name in names(dir) {
+        let path = dir.join(&name);
+        if path.is_dir() {
+            out.extend(
+                tree(&path)
+                    .into_iter()
+                    .map(|(n, b)| (format!("{name}/{n}"), b)),
+            );
+        } else {
+            out.push((name, std::fs::read(&path).unwrap()));
+        }
+    }
+    out
+}
+
+/// Waits until a name starting with `staging` stands in `dir` (the child's staging folder), then
+/// `then` more.
+fn until_staged<'a>(
+    dir: &'a Path,
+    staging: &'a str,
+    then: Duration,
+) -> impl FnOnce(&mut std::process::Child) + 'a {
+    move |child| {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while !names(dir).iter().any(|n| n.starts_with(staging)) {
+            if let Some(s) = child.try_wait().unwrap() {
+                panic!("it ended ({s}) before its staging folder {staging}* appeared");
+            }
+            assert!(Instant::now() < deadline, "no {staging}* in 60 s");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        std::thread::sleep(then);
+    }
+}
+
+/// An interruption while a report folder is being made (`compare --report` rendering its
+/// golden, `grade` and `grade --batch` running a submission that hangs) removes the staging
+/// folder, which was there when the signal came, and leaves the previous report folder as it
+/// was, byte for byte.
+#[test]
+fn an_interrupted_report_leaves_the_previous_one_as_it_was_and_no_staging_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let hang = rtoracle::candidate::bench::assemble_fixture("hostile_hang_on_miss").unwrap();
+    for sub in ["sub", "subs/a", "subs/b"] {
+        std::fs::create_dir_all(root.join(sub)).unwrap();
+        for f in std::fs::read_dir(hang.path()).unwrap() {
+            let f = f.unwrap();
+            std::fs::copy(f.path(), root.join(sub).join(f.file_name())).unwrap();
+        }
+    }
+    let camera = rtoracle::scene::builtin("week04-sphere")
+        .unwrap()
+        .camera(None);
+    let (w, h) = (camera.width, camera.height);
+    rtoracle::image_io::write_png(
+        &root.join("cand.png"),
+        &rtoracle::image_io::Rgb8Image {
+            width: w,
+            height: h,
+            data: vec![128; 3 * w * h],
+        },
+    )
+    .unwrap();
+    // The previous reports.
+    let previous: [(&str, &[&str]); 3] = [
+        ("rep", &["report.json", "heatmap.png", "region-7.png"]),
+        ("graded", &["report.json", "feedback.md"]),
+        (
+            "batch",
+            &["gradebook.csv", "a/report.json", "old/feedback.md"],
+        ),
+    ];
+    for (dir, files) in previous {
+        for f in files {
+            let path = root.join(dir).join(f);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(&path, format!("previous {f}")).unwrap();
+        }
+    }
+    let before: Vec<_> = previous.iter().map(|(d, _)| tree(&root.join(d))).collect();
+    let inputs = names(root);
+    // A golden at an spp that is not embedded is rendered, for seconds, into a cache of its own.
+    let cache = tempfile::tempdir().unwrap();
+    let runs: [(&[&str], &str); 3] = [
+        (
+            &[
+                "compare",
+                "cand.png",
+                "--scene",
+                "week04-sphere",
+                "--spp",
+                "50",
+                "--report",
+                "rep",
+            ],
+            ".rep.rtoracle-",
+        ),
+        (&["grade", "sub", "--out", "graded"], ".graded.rtoracle-"),
+        (
+            &["grade", "--batch", "subs", "--out", "batch"],
+            ".batch.rtoracle-",
+        ),
+    ];
+    for (args, staging) in runs {
+        for (signal, code) in [(SIGINT, 130), (SIGTERM, 143)] {
+            let envs = [("RTORACLE_CACHE_DIR", cache.path())];
+            let wait = until_staged(root, staging, Duration::from_millis(300));
+            let (got, left_in_tmp) = interrupted_when(root, args, &envs, signal, wait);
+            assert_eq!(got, Some(code), "{args:?} on signal {signal}");
+            assert!(
+                left_in_tmp.is_empty(),
+                "{args:?}: TMPDIR keeps {left_in_tmp:?}"
+            );
+            assert_eq!(names(root), inputs, "{args:?} on signal {signal}");
+            let after: Vec<_> = previous.iter().map(|(d, _)| tree(&root.join(d))).collect();
+            assert!(after == before, "{args:?} changed a previous report");
         }
     }
 }

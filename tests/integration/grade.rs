@@ -480,6 +480,30 @@ fn grading_that_cannot_run_exits_2_with_one_line_and_writes_nothing() {
     let out = run_in(dir.path(), &["grade", "sub", "--vectors", "bad.jsonl"]);
     assert_bad_input(&out, "bad.jsonl:1: not a valid vector");
     assert!(!dir.path().join("grade-report").exists());
+    // An output folder holding a file of the user's would be replaced whole: refused before any
+    // work, naming the option and the file, which stays; for a batch too.
+    std::fs::create_dir(dir.path().join("mine")).unwrap();
+    std::fs::write(dir.path().join("mine/notes.txt"), b"mine").unwrap();
+    for args in [
+        &["grade", "sub", "--out", "mine"][..],
+        &["grade", "--batch", ".", "--out", "mine"],
+    ] {
+        let out = run_in(dir.path(), args);
+        assert_bad_input(
+            &out,
+            "rtoracle: --out mine: holds notes.txt, which is not part of an rtoracle grade report",
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path().join("mine")).unwrap().count(),
+            1,
+            "{args:?}"
+        );
+        assert_eq!(
+            std::fs::read(dir.path().join("mine/notes.txt")).unwrap(),
+            b"mine"
+        );
+    }
+    std::fs::remove_dir_all(dir.path().join("mine")).unwrap();
     // An empty folder is a submission with nothing in it: graded 0, exit 0.
     let out = run_in(dir.path(), &["grade", "sub"]);
     assert!(
