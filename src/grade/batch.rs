@@ -238,6 +238,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
         // Per vector: its shape, how many submissions failed it (having run it), one message.
         let mut vectors: BTreeMap<String, (ShapeKind, usize, String)> = BTreeMap::new();
+        let mut examples: BTreeMap<String, String> = BTreeMap::new();
         let mut fatal = 0usize;
         for r in &graded {
             if r.code.fatal.is_some() {
@@ -248,17 +249,30 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
                     let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
                     e.1 += 1;
                 }
-                for f in c
-                    .failures
-                    .iter()
-                    .filter(|f| f.definite && f.kind != FailureKind::NotRun)
-                {
-                    let e = vectors
-                        .entry(f.id.clone())
-                        .or_insert((f.shape, 0, f.message.clone()));
-                    e.1 += 1;
+                // The example is a message a student was shown.
+                for f in &c.failures {
+                    examples.entry(f.id.clone()).or_insert(f.message.clone());
                 }
             }
+            // Every vector the submission failed, once (a check shows only its first few).
+            let failed: BTreeMap<&String, ShapeKind> = r
+                .code
+                .failed_vectors
+                .iter()
+                .map(|(id, s)| (id, *s))
+                .collect();
+            for (id, shape) in failed {
+                vectors
+                    .entry(id.clone())
+                    .or_insert((shape, 0, String::new()))
+                    .1 += 1;
+            }
+        }
+        for (id, (_, _, example)) in vectors.iter_mut() {
+            *example = examples
+                .get(id)
+                .cloned()
+                .unwrap_or_else(|| "(not among the failures shown to any student)".to_string());
         }
         md.push_str("\n## Most common failures\n\n");
         if checks.is_empty() {
@@ -304,6 +318,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grade::inputs::FailureSummary;
     use crate::grade::run::fakes::*;
 
     /// Ties are shared between shapes: with ten sphere vectors and two quad vectors all failed
@@ -327,6 +342,55 @@ mod tests {
         assert!(listed.contains(&"quad-00".to_string()), "{listed:?}");
         assert!(listed.contains(&"quad-01".to_string()), "{listed:?}");
         assert_eq!(listed.len(), 10);
+    }
+
+    /// A vector failed by both submissions counts 2 even where no check shows it (each check
+    /// shows its 5 simplest failures; both fail 8 vectors).
+    #[test]
+    fn the_summary_counts_every_failed_vector_not_only_those_shown() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["a", "b"] {
+            std::fs::create_dir(dir.path().join(name)).unwrap();
+            fake_images(&dir.path().join(name));
+        }
+        let mut code = FakeCode::new(counts(10, 2), counts(2, 2));
+        code.failures = (0..8)
+            .map(|i| FailureSummary {
+                id: format!("sphere-x-{i:04}"),
+                shape: ShapeKind::Sphere,
+                tags: vec![],
+                kind: FailureKind::Mismatch,
+                definite: true,
+                expected: serde_json::Value::Null,
+                actual: serde_json::Value::Null,
+                message: format!("missed {i}"),
+                repro: String::new(),
+            })
+            .collect();
+        let out = dir.path().join("out");
+        grade_batch(
+            dir.path(),
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        let report = std::fs::read_to_string(out.join("a/report.json")).unwrap();
+        let shown = report.matches("\"sphere-x-").count();
+        assert!(
+            shown < 8,
+            "the test needs failures a check does not show: {shown}"
+        );
+        for i in 0..8 {
+            assert!(
+                summary.contains(&format!("| `sphere-x-{i:04}` | 2 |")),
+                "sphere-x-{i:04}:\n{summary}"
+            );
+        }
+        assert!(!report.contains("failed_vectors"), "{report}");
     }
 
     #[test]

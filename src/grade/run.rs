@@ -129,6 +129,10 @@ pub struct CodeRun {
     pub diagnosis: Vec<crate::candidate::diagnose::Diagnosis>,
     /// The winding of the submission's triangles, when it has any that hit.
     pub triangle_winding: Option<crate::candidate::check::Winding>,
+    /// Every definite vector it failed (not only the few each check shows), for a batch's
+    /// summary; not written into report.json.
+    #[serde(skip)]
+    pub failed_vectors: Vec<(String, crate::oracle::vectors::ShapeKind)>,
 }
 
 /// The result model every report format is written from.
@@ -570,6 +574,12 @@ pub fn grade(
             sandbox: outcome.sandbox.clone(),
             diagnosis: outcome.diagnosis.clone(),
             triangle_winding: outcome.triangle_winding,
+            failed_vectors: outcome
+                .failures
+                .iter()
+                .filter(|f| f.definite && f.kind != FailureKind::NotRun)
+                .map(|f| (f.id.clone(), f.shape))
+                .collect(),
         },
         reproducibility: Reproducibility {
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -603,6 +613,8 @@ pub(crate) mod fakes {
         pub counts: BTreeMap<ShapeKind, GroupCounts>,
         pub fatal: Option<String>,
         pub panic_on: Option<String>,
+        /// The failures every submission gets.
+        pub failures: Vec<FailureSummary>,
     }
 
     impl FakeCode {
@@ -611,6 +623,7 @@ pub(crate) mod fakes {
                 counts: [(ShapeKind::Sphere, sphere), (ShapeKind::Quad, quad)].into(),
                 fatal: None,
                 panic_on: None,
+                failures: Vec::new(),
             }
         }
     }
@@ -637,7 +650,7 @@ pub(crate) mod fakes {
                     .iter()
                     .map(|g| (*g, self.counts.get(g).cloned().unwrap_or_default()))
                     .collect(),
-                failures: vec![],
+                failures: self.failures.clone(),
                 fatal: self.fatal.clone(),
                 stderr_tail: String::new(),
                 sandbox: serde_json::Value::Null,
