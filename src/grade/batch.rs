@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
-use super::inputs::{CodeChecker, FailureKind, ImageChecker};
+use super::inputs::{CodeChecker, ImageChecker};
 use super::report::Format;
 use super::rubric::Rubric;
 use super::run::{GradeError, GradeReport, round2};
@@ -318,7 +318,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grade::inputs::FailureSummary;
+    use crate::grade::inputs::{FailureKind, FailureSummary};
     use crate::grade::run::fakes::*;
 
     /// Ties are shared between shapes: with ten sphere vectors and two quad vectors all failed
