@@ -104,10 +104,13 @@ fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
         let start = Instant::now();
         let bytes = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
         if created.is_none() && !dir.is_dir() {
-            std::fs::create_dir(dir).map_err(|e| {
-                anyhow::anyhow!("--dir {}: cannot create the folder: {e}", dir.display())
-            })?;
-            created = Some(rtoracle::interrupt::remove_on_interrupt(dir));
+            // Made and registered in one step, so a signal's cleanups cannot miss it.
+            let made = || std::fs::create_dir(dir).map(|()| dir.to_path_buf());
+            let (_, guard) =
+                rtoracle::interrupt::create_temporary(made, |p| p.as_path()).map_err(|e| {
+                    anyhow::anyhow!("--dir {}: cannot create the folder: {e}", dir.display())
+                })?;
+            created = Some(guard);
         }
         write_atomically(&path, &bytes)?;
         outln!(
