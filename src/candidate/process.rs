@@ -7,8 +7,8 @@
 //! candidate, restarts included, through it; when a process is killed or the session ends,
 //! every process the candidate started ends too ([`crate::sandbox::Reaper`]). The course
 //! adapter's submission files (its top-level Python modules, regular files up to
-//! [`MAX_STAGED_FILE_BYTES`] each and [`MAX_STAGED_TOTAL_BYTES`] in all) are copied into that
-//! folder, so the candidate never runs in (or writes to) the submission itself, and the adapter
+//! [`MAX_STAGED_FILE_BYTES`] each and [`MAX_STAGED_TOTAL_BYTES`] in all; those left out are
+//! named, at most [`MAX_SKIPPED_NAMED`] of them) are copied into that folder, so the candidate never runs in (or writes to) the submission itself, and the adapter
 //! is told a neutral name, never the submission's path. The interpreter is chosen by
 //! [`python`](super::python).
 //!
@@ -70,6 +70,9 @@ pub const MAX_STAGED_TOTAL_BYTES: u64 = 8 << 20;
 
 /// Most submission files copied into the sandbox.
 pub const MAX_STAGED_FILES: usize = 200;
+
+/// Most files left out of the sandbox that its facts name (the rest are counted).
+pub const MAX_SKIPPED_NAMED: usize = 20;
 
 /// How many bytes of the candidate's stderr are kept for the report.
 pub const STDERR_TAIL_BYTES: usize = 4096;
@@ -350,7 +353,8 @@ impl CandidateCommand {
     /// The files to copy into the sandbox: the submission's top-level Python modules (a name
     /// that is a Python identifier plus `.py`; regular files only, never a link, FIFO or
     /// device; up to [`MAX_STAGED_FILE_BYTES`] each, [`MAX_STAGED_TOTAL_BYTES`] and
-    /// [`MAX_STAGED_FILES`] in all), and the ones left out, each named (escaped) with why.
+    /// [`MAX_STAGED_FILES`] in all), and the ones left out, each named (escaped) with why, the
+    /// first [`MAX_SKIPPED_NAMED`] of them (a last line counts the others).
     #[allow(clippy::type_complexity)]
     fn staged_files(&self) -> Result<(Vec<(PathBuf, String)>, Vec<String>), HarnessError> {
         let Some(dir) = &self.submission else {
@@ -406,6 +410,11 @@ impl CandidateCommand {
                 Some(why) => skipped.push(format!("{shown} ({why})")),
                 None => files.push((entry.path(), name)),
             }
+        }
+        if skipped.len() > MAX_SKIPPED_NAMED {
+            let more = skipped.len() - MAX_SKIPPED_NAMED;
+            skipped.truncate(MAX_SKIPPED_NAMED);
+            skipped.push(format!("and {more} more files not copied"));
         }
         Ok((files, skipped))
     }
@@ -1535,6 +1544,30 @@ mod tests {
         );
         assert!(message.contains("stderr ends: "), "{message}");
         assert!(message.len() < 500, "{} bytes: {message}", message.len());
+    }
+
+    /// 30,000 empty `.py` files made the sandbox facts name each one left out: at most
+    /// [`MAX_SKIPPED_NAMED`] are named, and the rest counted.
+    #[test]
+    fn a_submission_of_many_files_names_a_bounded_number_of_those_not_copied() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..MAX_STAGED_FILES + 300 {
+            std::fs::write(dir.path().join(format!("m{i:04}.py")), b"").unwrap();
+        }
+        for i in 0..50 {
+            std::fs::write(dir.path().join(format!("bad-{i:02}.py")), b"").unwrap();
+        }
+        let command =
+            CandidateCommand::python_course_with(dir.path(), Some(Path::new("python3")), true)
+                .unwrap();
+        let (files, skipped) = command.staged_files().unwrap();
+        assert_eq!(files.len(), MAX_STAGED_FILES);
+        assert_eq!(skipped.len(), MAX_SKIPPED_NAMED + 1, "{}", skipped.len());
+        assert_eq!(skipped[0], "bad-00.py (not a Python module name)");
+        assert_eq!(
+            skipped[MAX_SKIPPED_NAMED],
+            format!("and {} more files not copied", 350 - MAX_SKIPPED_NAMED)
+        );
     }
 
     #[test]

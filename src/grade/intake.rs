@@ -9,7 +9,9 @@
 //!   `O_NOFOLLOW | O_NONBLOCK` and checked again with `fstat` (same device and inode, still a
 //!   regular file), so swapping it between the check and the open does not help;
 //! - no file is read past its cap ([`MAX_IMAGE_BYTES`] for an image; [`HASH_FILE_CAP`] per file
-//!   and [`HASH_TOTAL_CAP`] in all for the hashes of `report.json`), whatever its size claims;
+//!   and [`HASH_TOTAL_CAP`] in all for the hashes of `report.json`), whatever its size claims,
+//!   and at most [`HASH_MAX_FILES`] files are listed there, so a submission of many files cannot
+//!   make a report of many megabytes;
 //! - a PNG whose header says it is not the expected size, has more than [`MAX_IMAGE_PIXELS`]
 //!   pixels, is grey, uses a palette or has 16-bit channels is reported in plain words, naming
 //!   the file as the student knows it (relative to the submission), without being decoded;
@@ -38,6 +40,11 @@ pub const MAX_EXR_DECODED_BYTES: u64 = 256 << 20;
 pub const HASH_FILE_CAP: u64 = 16 << 20;
 /// The most bytes hashed for `report.json` over the whole submission (64 MiB).
 pub const HASH_TOTAL_CAP: u64 = 64 << 20;
+/// The most files listed in `report.json`'s hashes (the first by name); the rest are counted
+/// under [`MORE_FILES_KEY`].
+pub const HASH_MAX_FILES: usize = 1000;
+/// The key that counts the files past [`HASH_MAX_FILES`] (no file's name holds a `/`).
+pub const MORE_FILES_KEY: &str = "/more";
 
 /// What a file that is not a regular file is, in words.
 fn kind_of(t: &FileType) -> &'static str {
@@ -283,7 +290,8 @@ pub fn stage_image(
 
 /// SHA-256 of each regular file at the top of `dir`, by name: only regular files (never through a
 /// symbolic link), each up to [`HASH_FILE_CAP`] and [`HASH_TOTAL_CAP`] in all (in name order); a
-/// file past a cap or unreadable gets a note instead of a hash.
+/// file past a cap or unreadable gets a note instead of a hash. At most [`HASH_MAX_FILES`] files
+/// are listed; [`MORE_FILES_KEY`] counts the others.
 pub fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
     let mut out = BTreeMap::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -295,6 +303,16 @@ pub fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
         .map(|e| (e.file_name().to_string_lossy().to_string(), e.path()))
         .collect();
     files.sort();
+    if files.len() > HASH_MAX_FILES {
+        out.insert(
+            MORE_FILES_KEY.to_string(),
+            format!(
+                "{} more files, not listed (at most {HASH_MAX_FILES} are)",
+                files.len() - HASH_MAX_FILES
+            ),
+        );
+        files.truncate(HASH_MAX_FILES);
+    }
     let mut total = 0u64;
     for (name, path) in files {
         let cap = HASH_FILE_CAP.min(HASH_TOTAL_CAP - total);
@@ -396,6 +414,25 @@ mod tests {
             e,
             format!("big.bin is 4294967296 bytes, over the limit of {MAX_IMAGE_BYTES} bytes")
         );
+    }
+
+    /// 30,000 empty files (a zip of 3 MB) made report.json 13 MB: only the first files by name
+    /// are listed, and one entry that cannot be a file's name says how many more there are.
+    #[test]
+    fn a_submission_of_many_files_lists_a_bounded_number() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..HASH_MAX_FILES + 500 {
+            std::fs::write(dir.path().join(format!("f{i:05}.py")), b"").unwrap();
+        }
+        let hashes = submission_hashes(dir.path());
+        assert_eq!(hashes.len(), HASH_MAX_FILES + 1);
+        assert_eq!(hashes["f00000.py"], sha256_hex(b""));
+        assert!(!hashes.contains_key(&format!("f{:05}.py", HASH_MAX_FILES)));
+        assert_eq!(
+            hashes[MORE_FILES_KEY],
+            format!("500 more files, not listed (at most {HASH_MAX_FILES} are)")
+        );
+        assert!(MORE_FILES_KEY.contains('/'), "no file name holds a slash");
     }
 
     #[test]
