@@ -8,15 +8,23 @@
 //!   are the sandbox folder; the host's world-writable folders ([`SHARED_ROOTS`]: `/tmp`,
 //!   `/var/tmp`, `/dev/shm`, ...) stay writable, since nothing can hide them without namespaces.
 //! - **Bounded.** [`Watchdog`] measures, every [`TICK`], the blocks the sandbox folder holds and,
-//!   for a per-submission uid, the blocks of everything that uid owns under [`SHARED_ROOTS`]. Past
-//!   the policy's `disk_bytes` (or [`MAX_ENTRIES`] files and folders) it ends the code's processes
-//!   and records why ([`Watchdog::violation`]); the session then says so instead of "killed by
-//!   signal 9", and starts nothing more in that sandbox.
+//!   for a per-submission uid, the blocks of everything that uid owns under [`SHARED_ROOTS`], and
+//!   the code's processes ([`Members`]: those of its uid, of its bubblewrap PID namespaces, or of
+//!   its sessions): the files they hold open that are unlinked (a deleted temporary file, a
+//!   memfd) count as files, and their resident memory (anonymous and shared pages, and a uid's
+//!   System V shared memory) is added up. Past the policy's `disk_bytes` (or [`MAX_ENTRIES`] files
+//!   and folders) or `memory_bytes` for all its processes together (`RLIMIT_AS` bounds each
+//!   alone) it ends the code's processes and records why ([`Watchdog::violation`]); the session
+//!   then says so instead of "killed by signal 9", and starts nothing more in that sandbox. What
+//!   is written or allocated between two ticks can pass the limits for up to a tick.
 //! - **Nothing left behind.** [`sweep`] removes everything a per-submission uid owns under
 //!   [`SHARED_ROOTS`] once none of its processes is left (so nothing can race it): entries are
 //!   unlinked, never followed (a link the code planted pointing at a grader file removes the link
 //!   only), and only world-writable folders not owned by the uid are entered, on the same file
-//!   system, at most [`MAX_DEPTH`] deep. The sandbox folder itself is removed with the sandbox.
+//!   system, at most [`MAX_DEPTH`] deep. [`sweep_ipc`] removes the System V shared memory,
+//!   message queues and semaphores the uid made or owns (they outlive every process; the fallback
+//!   also gives the code an IPC namespace where it can). The sandbox folder itself is removed with
+//!   the sandbox.
 
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
@@ -25,6 +33,201 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use super::Reaper;
+
+/// Which processes are the code's, for the [`Watchdog`].
+#[derive(Clone, Debug)]
+pub enum Members {
+    /// Every process of a per-submission uid (a root harness).
+    Uid(u32),
+    /// Every process in one of these PID namespaces (bubblewrap run by a harness that is not
+    /// root), by the inode of `/proc/<pid>/ns/pid`.
+    PidNamespaces(Arc<Mutex<Vec<u64>>>),
+    /// Every process in one of these sessions (the code's own sessions, without bubblewrap nor
+    /// a uid: a process that leaves its session is not seen).
+    Sessions(Arc<Mutex<Vec<i32>>>),
+}
+
+/// The limits the [`Watchdog`] enforces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Bytes of files (the policy's `disk_bytes`).
+    pub disk_bytes: u64,
+    /// Bytes of resident memory of all the code's processes together (the policy's
+    /// `memory_bytes`).
+    pub memory_bytes: u64,
+}
+
+/// What the code's processes hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ProcessUsage {
+    /// Processes seen.
+    pub processes: u64,
+    /// Resident anonymous and shared memory (`RssAnon + RssShmem`), plus a uid's System V shared
+    /// memory.
+    pub memory: u64,
+    /// Blocks of the unlinked regular files they hold open (each file once).
+    pub unlinked_bytes: u64,
+}
+
+/// The first number of the `/proc/<pid>/status` line starting with `key`.
+fn status_number(status: &str, key: &str) -> Option<u64> {
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix(key))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+}
+
+/// Measures the processes of `members` (see [`ProcessUsage`]).
+pub fn process_usage(members: &Members) -> ProcessUsage {
+    let mut usage = ProcessUsage::default();
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return usage;
+    };
+    let set = |list: &Arc<Mutex<Vec<i32>>>| list.lock().map(|l| l.clone()).unwrap_or_default();
+    let sessions = match members {
+        Members::Sessions(list) => set(list),
+        _ => Vec::new(),
+    };
+    let namespaces = match members {
+        Members::PidNamespaces(list) => list.lock().map(|l| l.clone()).unwrap_or_default(),
+        _ => Vec::new(),
+    };
+    let mut files = std::collections::HashSet::new();
+    for entry in entries.flatten() {
+        let Some(pid) = entry
+            .file_name()
+            .to_str()
+            .and_then(|s| s.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        let proc_dir = entry.path();
+        let member = match members {
+            Members::Uid(_) => true,
+            Members::PidNamespaces(_) => std::fs::read_link(proc_dir.join("ns/pid"))
+                .ok()
+                .and_then(|l| {
+                    let l = l.to_string_lossy().into_owned();
+                    l.split_once('[')?.1.strip_suffix(']')?.parse::<u64>().ok()
+                })
+                .is_some_and(|ns| namespaces.contains(&ns)),
+            Members::Sessions(_) => std::fs::read_to_string(proc_dir.join("stat"))
+                .ok()
+                .and_then(|stat| {
+                    // The fields after the command's closing parenthesis: state, ppid, pgrp,
+                    // session.
+                    let rest = stat.rsplit_once(')')?.1.to_string();
+                    rest.split_whitespace().nth(3)?.parse::<i32>().ok()
+                })
+                .is_some_and(|sid| sessions.contains(&sid)),
+        };
+        if !member {
+            continue;
+        }
+        let Ok(status) = std::fs::read_to_string(proc_dir.join("status")) else {
+            continue;
+        };
+        if let Members::Uid(uid) = members
+            && status_number(&status, "Uid:") != Some(*uid as u64)
+        {
+            continue;
+        }
+        if pid == std::process::id() {
+            continue;
+        }
+        usage.processes += 1;
+        let kb = status_number(&status, "RssAnon:").unwrap_or(0)
+            + status_number(&status, "RssShmem:").unwrap_or(0);
+        usage.memory = usage.memory.saturating_add(kb.saturating_mul(1024));
+        let Ok(fds) = std::fs::read_dir(proc_dir.join("fd")) else {
+            continue;
+        };
+        for fd in fds.flatten() {
+            // Followed: the open file itself (a memfd or a deleted file has no other name).
+            let Ok(meta) = std::fs::metadata(fd.path()) else {
+                continue;
+            };
+            if meta.is_file() && meta.nlink() == 0 && files.insert((meta.dev(), meta.ino())) {
+                usage.unlinked_bytes = usage
+                    .unlinked_bytes
+                    .saturating_add(meta.blocks().saturating_mul(512));
+            }
+        }
+    }
+    if let Members::Uid(uid) = members {
+        usage.memory = usage.memory.saturating_add(
+            ipc_objects(*uid)
+                .iter()
+                .filter(|o| o.table == "shm")
+                .map(|o| o.bytes)
+                .sum(),
+        );
+    }
+    usage
+}
+
+/// A System V IPC object of the harness's IPC namespace.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IpcObject {
+    /// `shm`, `msg` or `sem`.
+    pub table: &'static str,
+    /// Its id.
+    pub id: i32,
+    /// Bytes (a shared memory segment's size, a queue's bytes; 0 for semaphores).
+    pub bytes: u64,
+}
+
+/// The System V objects `uid` owns or made, from `/proc/sysvipc/{shm,msg,sem}`.
+pub fn ipc_objects(uid: u32) -> Vec<IpcObject> {
+    // The columns of the id, the size, the owner and the creator in each table.
+    const TABLES: [(&str, usize, Option<usize>, usize, usize); 3] = [
+        ("shm", 1, Some(3), 7, 9),
+        ("msg", 1, Some(3), 7, 9),
+        ("sem", 1, None, 4, 6),
+    ];
+    let mut found = Vec::new();
+    for (table, id_at, bytes_at, uid_at, cuid_at) in TABLES {
+        let Ok(text) = std::fs::read_to_string(format!("/proc/sysvipc/{table}")) else {
+            continue;
+        };
+        for line in text.lines().skip(1) {
+            let words: Vec<&str> = line.split_whitespace().collect();
+            let number = |i: usize| words.get(i).and_then(|w| w.parse::<u64>().ok());
+            let ours = [uid_at, cuid_at]
+                .iter()
+                .any(|&i| number(i) == Some(uid as u64));
+            if let (true, Some(id)) = (ours, number(id_at)) {
+                found.push(IpcObject {
+                    table,
+                    id: id as i32,
+                    bytes: bytes_at.and_then(number).unwrap_or(0),
+                });
+            }
+        }
+    }
+    found
+}
+
+/// Removes the System V objects `uid` owns or made ([`ipc_objects`]); returns how many. Needs
+/// root (or the uid).
+pub fn sweep_ipc(uid: u32) -> usize {
+    let mut removed = 0;
+    for object in ipc_objects(uid) {
+        // SAFETY: IPC_RMID takes no buffer (a null one is allowed).
+        let done = unsafe {
+            match object.table {
+                "shm" => libc::shmctl(object.id, libc::IPC_RMID, std::ptr::null_mut()),
+                "msg" => libc::msgctl(object.id, libc::IPC_RMID, std::ptr::null_mut()),
+                _ => libc::semctl(object.id, 0, libc::IPC_RMID),
+            }
+        };
+        if done == 0 {
+            removed += 1;
+        }
+    }
+    removed
+}
 
 /// The folder inside the sandbox folder that bubblewrap shows as `/tmp`.
 pub const TMP_DIR: &str = ".tmp";
@@ -185,9 +388,13 @@ pub struct Watchdog {
 }
 
 impl Watchdog {
-    /// Starts measuring `dir` (and what `uid` owns under [`SHARED_ROOTS`], when given) against
-    /// `limit` bytes; `reaper` ends the code on a violation.
-    pub fn start(dir: PathBuf, uid: Option<u32>, limit: u64, reaper: Reaper) -> Watchdog {
+    /// Starts measuring `dir`, the processes of `members` (and, for a uid, what it owns under
+    /// [`SHARED_ROOTS`]) against `limits`; `reaper` ends the code on a violation.
+    pub fn start(dir: PathBuf, members: Members, limits: Limits, reaper: Reaper) -> Watchdog {
+        let uid = match members {
+            Members::Uid(uid) => Some(uid),
+            _ => None,
+        };
         let stop = Arc::new(AtomicBool::new(false));
         let violation = Arc::new(Mutex::new(None));
         let thread = {
@@ -206,7 +413,11 @@ impl Watchdog {
                             usage.bytes = usage.bytes.saturating_add(shared.bytes);
                             usage.entries = usage.entries.saturating_add(shared.entries);
                         }
-                        if let Some(why) = judge(usage, limit) {
+                        let procs = process_usage(&members);
+                        usage.bytes = usage.bytes.saturating_add(procs.unlinked_bytes);
+                        let why = judge(usage, limits.disk_bytes)
+                            .or_else(|| judge_memory(procs.memory, limits.memory_bytes));
+                        if let Some(why) = why {
                             // Recorded before the kill, so the session that sees the code die
                             // finds why.
                             violation
@@ -239,8 +450,8 @@ impl Watchdog {
 pub fn judge(usage: Usage, limit: u64) -> Option<String> {
     if usage.bytes > limit {
         Some(format!(
-            "the sandbox stopped it: it wrote more than {} of files (its folder and /tmp hold at \
-             most that)",
+            "the sandbox stopped it: it wrote more than {} of files (its folder, /tmp and the \
+             unlinked files it holds open hold at most that)",
             human_bytes(limit)
         ))
     } else if usage.entries > MAX_ENTRIES {
@@ -250,6 +461,16 @@ pub fn judge(usage: Usage, limit: u64) -> Option<String> {
     } else {
         None
     }
+}
+
+/// The violation of `limit` by `memory` bytes of all the code's processes, in words, if any.
+pub fn judge_memory(memory: u64, limit: u64) -> Option<String> {
+    (memory > limit).then(|| {
+        format!(
+            "the sandbox stopped it: its processes held more than {} of memory together",
+            human_bytes(limit)
+        )
+    })
 }
 
 /// `64 MiB`, `1.5 GiB`, `512 KiB`, `100 bytes`.
@@ -296,6 +517,45 @@ mod tests {
         assert!(usage.bytes < 2 << 20, "{usage:?}");
     }
 
+    /// Without an IPC namespace a uid's System V objects outlive its processes: they are found
+    /// by owner and removed, and another uid's are not touched.
+    #[test]
+    fn a_uid_s_system_v_objects_are_measured_and_swept() {
+        if !super::super::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
+            eprintln!("skipped: needs root and ipcmk");
+            return;
+        }
+        use std::os::unix::process::CommandExt;
+        let uid = super::super::identity::allocate();
+        let other = super::super::identity::allocate();
+        let make = |uid: u32, args: &[&str]| {
+            let out = std::process::Command::new("/usr/bin/ipcmk")
+                .args(args)
+                .uid(uid)
+                .gid(uid)
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{out:?}");
+        };
+        make(uid, &["-M", "1048576"]);
+        make(uid, &["-Q"]);
+        make(uid, &["-S", "1"]);
+        make(other, &["-M", "4096"]);
+        let mine = ipc_objects(uid);
+        let tables: Vec<&str> = mine.iter().map(|o| o.table).collect();
+        assert_eq!(tables, ["shm", "msg", "sem"], "{mine:?}");
+        assert_eq!(mine[0].bytes, 1 << 20);
+        assert_eq!(
+            process_usage(&Members::Uid(uid)).memory,
+            1 << 20,
+            "no process, the segment alone"
+        );
+        assert_eq!(sweep_ipc(uid), 3);
+        assert!(ipc_objects(uid).is_empty());
+        assert_eq!(ipc_objects(other).len(), 1);
+        assert_eq!(sweep_ipc(other), 1);
+    }
+
     #[test]
     fn judging_names_the_limit() {
         let at = Usage {
@@ -313,6 +573,11 @@ mod tests {
             entries: MAX_ENTRIES + 1,
         };
         assert!(judge(many, 64 << 20).unwrap().contains("10000 files"));
+        assert_eq!(
+            judge_memory((1 << 30) + 1, 1 << 30).unwrap(),
+            "the sandbox stopped it: its processes held more than 1 GiB of memory together"
+        );
+        assert_eq!(judge_memory(1 << 30, 1 << 30), None);
         assert_eq!(human_bytes(1536 << 20), "1.5 GiB");
         assert_eq!(human_bytes(100), "100 bytes");
     }
