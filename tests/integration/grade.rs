@@ -583,6 +583,12 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
     let installed = prefix.join("share/rtoracle-rubric.toml");
     let mode = std::fs::metadata(&installed).unwrap().permissions().mode();
     assert_eq!(mode & 0o777, 0o600);
+    // So is the binary (a submission the sandbox cannot hide it from must not run it).
+    let mode = std::fs::metadata(prefix.join("bin/rtoracle"))
+        .unwrap()
+        .permissions()
+        .mode();
+    assert_eq!(mode & 0o777, 0o700);
     // A student who uploaded their folder instead of its files.
     materialize("sphere-bug", &root.join("submission/my-week4")).unwrap();
     let run = std::process::Command::new("bash")
