@@ -594,9 +594,10 @@ fn copy_regular(source: &Path, target: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Removes a folder the code may have made hard to remove (read-only subfolders).
+/// Removes a folder the code may have made hard to remove (read-only subfolders, thousands of
+/// levels deep: [`scratch::remove_deep`]).
 fn remove_tree(path: &Path) {
-    if std::fs::remove_dir_all(path).is_ok() || !path.exists() {
+    if std::fs::remove_dir_all(path).is_ok() || !path.exists() || scratch::remove_deep(path) {
         return;
     }
     fn open_up(p: &Path) {

@@ -795,3 +795,50 @@ _s.stderr.write("SCANNED\n")
     assert!(!tail.contains("FOUND"), "{tail}");
     assert!(!tail.contains("RAN rc=0"), "{tail}");
 }
+
+/// Files deeper than a path can name were not seen by the watchdog (360 MiB at depth 2100 of a
+/// 256 MiB limit): a tree nested that deep is stopped, and removed, in both modes.
+#[test]
+fn a_tree_nested_past_what_a_path_can_name_is_stopped_and_removed() {
+    if !root("a_tree_nested_past_what_a_path_can_name_is_stopped_and_removed") {
+        return;
+    }
+    let marker = format!("rtoracle-test-deep-{}", std::process::id());
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s, time as _t
+for _root in ("/tmp", "."):
+    _d = _o.open(_root, _o.O_RDONLY)
+    _o.mkdir({marker:?}, dir_fd=_d)
+    _nd = _o.open({marker:?}, _o.O_RDONLY, dir_fd=_d)
+    _o.close(_d)
+    _d = _nd
+    for _i in range(2100):
+        _o.mkdir("a", dir_fd=_d)
+        _nd = _o.open("a", _o.O_RDONLY, dir_fd=_d)
+        _o.close(_d)
+        _d = _nd
+    _f = _o.open("data", _o.O_WRONLY | _o.O_CREAT, 0o644, dir_fd=_d)
+    _o.write(_f, b"x" * (1 << 20))
+    _o.close(_f)
+_s.stderr.write("NESTED\n")
+_t.sleep(3)
+"#
+    ));
+    for mode in ["auto", "uid"] {
+        let (out, json) = check_json_in(mode, sub.path(), &[]);
+        assert_eq!(out.status.code(), Some(1), "{mode}: {}", stderr(&out));
+        let text = json.to_string();
+        assert!(
+            text.contains("the sandbox stopped it: it nested folders more than 100 deep"),
+            "{mode}: {}",
+            &text[..text.len().min(2000)]
+        );
+        let left: Vec<_> = std::fs::read_dir("/tmp")
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().contains(&marker))
+            .collect();
+        assert!(left.is_empty(), "{mode}: left {left:?}");
+    }
+}
