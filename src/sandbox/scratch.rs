@@ -15,7 +15,8 @@
 //!   the code's processes ([`Members`]: those of its uid, of its bubblewrap PID namespaces, or of
 //!   its sessions): the files they hold open that are unlinked (a deleted temporary file, a
 //!   memfd) count as files, and their resident memory (anonymous and shared pages, and a uid's
-//!   System V shared memory) is added up. Past the policy's `disk_bytes` (or [`MAX_ENTRIES`] files
+//!   System V shared memory) is added up, a page shared by forked processes once (proportional
+//!   sets, read when the cheap sum of resident sets is over the limit). Past the policy's `disk_bytes` (or [`MAX_ENTRIES`] files
 //!   and folders) or `memory_bytes` for all its processes together (`RLIMIT_AS` bounds each
 //!   alone) it ends the code's processes and records why ([`Watchdog::violation`]); the session
 //!   then says so instead of "killed by signal 9", and starts nothing more in that sandbox. What
@@ -61,15 +62,39 @@ pub struct Limits {
 }
 
 /// What the code's processes hold.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ProcessUsage {
     /// Processes seen.
     pub processes: u64,
     /// Resident anonymous and shared memory (`RssAnon + RssShmem`), plus a uid's System V shared
-    /// memory.
+    /// memory: cheap to read, and an upper bound (pages shared by forked processes count once
+    /// per process); see [`ProcessUsage::proportional`].
     pub memory: u64,
     /// Blocks of the unlinked regular files they hold open (each file once).
     pub unlinked_bytes: u64,
+    /// The processes seen, with what each counted in `memory`.
+    pub pids: Vec<(u32, u64)>,
+    /// The uid's System V shared memory counted in `memory`.
+    pub ipc_bytes: u64,
+}
+
+impl ProcessUsage {
+    /// The memory counted with each shared page divided among the processes sharing it
+    /// (`Pss_Anon + Pss_Shmem` of `/proc/<pid>/smaps_rollup`, which walks the page tables: read
+    /// only when [`ProcessUsage::memory`] is over a limit), plus the System V shared memory. A
+    /// process whose rollup cannot be read counts its resident set.
+    pub fn proportional(&self) -> u64 {
+        let mut total = self.ipc_bytes;
+        for &(pid, resident) in &self.pids {
+            let rollup = std::fs::read_to_string(format!("/proc/{pid}/smaps_rollup"))
+                .ok()
+                .and_then(|t| {
+                    Some(status_number(&t, "Pss_Anon:")? + status_number(&t, "Pss_Shmem:")?)
+                });
+            total = total.saturating_add(rollup.map_or(resident, |kb| kb.saturating_mul(1024)));
+        }
+        total
+    }
 }
 
 /// The first number of the `/proc/<pid>/status` line starting with `key`.
@@ -142,7 +167,9 @@ pub fn process_usage(members: &Members) -> ProcessUsage {
         usage.processes += 1;
         let kb = status_number(&status, "RssAnon:").unwrap_or(0)
             + status_number(&status, "RssShmem:").unwrap_or(0);
-        usage.memory = usage.memory.saturating_add(kb.saturating_mul(1024));
+        let resident = kb.saturating_mul(1024);
+        usage.memory = usage.memory.saturating_add(resident);
+        usage.pids.push((pid, resident));
         let Ok(fds) = std::fs::read_dir(proc_dir.join("fd")) else {
             continue;
         };
@@ -159,13 +186,12 @@ pub fn process_usage(members: &Members) -> ProcessUsage {
         }
     }
     if let Members::Uid(uid) = members {
-        usage.memory = usage.memory.saturating_add(
-            ipc_objects(*uid)
-                .iter()
-                .filter(|o| o.table == "shm")
-                .map(|o| o.bytes)
-                .sum(),
-        );
+        usage.ipc_bytes = ipc_objects(*uid)
+            .iter()
+            .filter(|o| o.table == "shm")
+            .map(|o| o.bytes)
+            .sum();
+        usage.memory = usage.memory.saturating_add(usage.ipc_bytes);
     }
     usage
 }
@@ -579,8 +605,13 @@ impl Watchdog {
                         }
                         let procs = process_usage(&members);
                         usage.bytes = usage.bytes.saturating_add(procs.unlinked_bytes);
+                        let memory = if procs.memory > limits.memory_bytes {
+                            procs.proportional()
+                        } else {
+                            procs.memory
+                        };
                         let why = judge(usage, limits.disk_bytes)
-                            .or_else(|| judge_memory(procs.memory, limits.memory_bytes));
+                            .or_else(|| judge_memory(memory, limits.memory_bytes));
                         if let Some(why) = why {
                             // Recorded before the kill, so the session that sees the code die
                             // finds why.
@@ -741,6 +772,50 @@ mod tests {
             assert!(remove_deep(&path), "{}", path.display());
             assert!(!path.exists());
         }
+    }
+
+    /// Children forked from a process share its pages until they write them: 20 children of a
+    /// process holding 100 MiB hold about 100 MiB, not 2 GiB (their resident sets, added up,
+    /// made a forking submission "hold more than 1 GiB" that it did not hold).
+    #[test]
+    fn memory_shared_by_forked_children_is_counted_once() {
+        if !super::super::running_as_root() || !Path::new("/usr/bin/python3").exists() {
+            eprintln!("skipped: needs root and /usr/bin/python3");
+            return;
+        }
+        use std::os::unix::process::CommandExt;
+        let uid = super::super::identity::allocate();
+        let mut parent = std::process::Command::new("/usr/bin/python3")
+            .args([
+                "-c",
+                "import os, time\nb = bytearray(b'x' * (100 << 20))\n\
+                 for i in range(20):\n    if os.fork() == 0:\n        time.sleep(30)\n\
+                         os._exit(0)\ntime.sleep(30)\n",
+            ])
+            .uid(uid)
+            .gid(uid)
+            .spawn()
+            .unwrap();
+        let mut seen = ProcessUsage::default();
+        for _ in 0..300 {
+            seen = process_usage(&Members::Uid(uid));
+            if seen.processes == 21 {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        let cheap = process_usage(&Members::Uid(uid));
+        let exact = cheap.proportional();
+        super::super::identity::kill_all(uid);
+        let _ = parent.wait();
+        assert_eq!(seen.processes, 21, "{seen:?}");
+        // Resident sets count the 100 MiB 21 times; proportional sets about once.
+        assert!(cheap.memory > 1 << 30, "{cheap:?}");
+        assert!(
+            exact > 90 << 20 && exact < 250 << 20,
+            "{exact} of {cheap:?}"
+        );
     }
 
     /// Without an IPC namespace a uid's System V objects outlive its processes: they are found
