@@ -10,7 +10,9 @@
 //!   does not work, so no student is ever graded 0 because the grader lacks a package. It
 //!   records the interpreter, which `run_autograder` passes to `grade --python`. It installs the
 //!   binary mode `0700` (only root, the grader, may run it: where Gradescope's container refuses
-//!   namespaces, the sandbox cannot hide it from a submission that would use it as an oracle).
+//!   namespaces, the sandbox cannot hide it from a submission that would use it as an oracle),
+//!   and makes the unpacked package itself (`/autograder/source`: the binary again, and the
+//!   rubric with the secret seed) readable by root only.
 //! - A secret suite: [`secret_seed`] draws the seed from the OS (`/dev/urandom`, no dependency)
 //!   when the rubric's seed is 0 (the public one) and no `--seed` is given; [`with_seed`] writes
 //!   it into the packaged rubric, which `setup.sh` installs readable only by root (mode 600).
@@ -36,6 +38,9 @@ pub const SETUP_SH: &str = r#"#!/usr/bin/env bash
 # PREFIX (default /usr/local) only exists so the package can be tried outside Gradescope.
 set -euo pipefail
 cd "$(dirname "$0")"
+# The package as unpacked (the binary, the rubric with the secret seed) is for root alone: where
+# the sandbox cannot hide the host's files, students' code runs as another uid and could read it.
+chmod -R go-rwx .
 prefix="${PREFIX:-/usr/local}"
 mkdir -p "$prefix/bin" "$prefix/share"
 # The grader runs as root; nobody else may run it (a submission that found it could use it as
