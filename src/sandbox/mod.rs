@@ -144,7 +144,8 @@ impl Mode {
 pub enum Isolation {
     /// bubblewrap: new namespaces, a minimal read-only view.
     Bubblewrap,
-    /// Limits, own session, attempted network namespace, a per-submission uid (root harness).
+    /// Limits, own session, attempted network, IPC and mount namespaces, a per-submission uid
+    /// (root harness).
     FallbackUid,
     /// Limits and own session as the harness's own unprivileged user (no bubblewrap).
     CurrentUser,
@@ -235,7 +236,8 @@ pub struct SandboxFacts {
     /// Which isolation was used.
     pub isolation: Isolation,
     /// The namespaces the candidate was seen in that differ from the harness's (`user`, `pid`,
-    /// `net`, `ipc`, `mount`, `uts`), as verified after it started; empty when not looked at.
+    /// `net`, `ipc`, `mount`, `uts`), as verified after it started; empty when not looked at. In
+    /// the fallback, `mount` is listed only when its `/proc` was also seen mounted `hidepid`.
     #[serde(default)]
     pub namespaces: Vec<String>,
     /// The user id the code ran as, seen from outside any user namespace.
