@@ -7,8 +7,8 @@
 //! candidate, restarts included, through it; when a process is killed or the session ends,
 //! every process the candidate started ends too ([`crate::sandbox::Reaper`]). The course
 //! adapter's submission files (its top-level Python modules, regular files up to
-//! [`MAX_STAGED_FILE_BYTES`] each and [`MAX_STAGED_TOTAL_BYTES`] in all) are copied into that
-//! folder, so the candidate never runs in (or writes to) the submission itself, and the adapter
+//! [`MAX_STAGED_FILE_BYTES`] each and [`MAX_STAGED_TOTAL_BYTES`] in all; those left out are
+//! named, at most [`MAX_SKIPPED_NAMED`] of them) are copied into that folder, so the candidate never runs in (or writes to) the submission itself, and the adapter
 //! is told a neutral name, never the submission's path. The interpreter is chosen by
 //! [`python`](super::python).
 //!
@@ -32,7 +32,11 @@
 //!   [`SMALL_ERROR_BYTES`] without traceback; stray lines are quoted briefly, 8 per case and
 //!   [`RUN_JUNK_BYTES`] per session; stderr keeps its last [`STDERR_TAIL_BYTES`].
 //! - **A time budget** ([`RunOptions::budget`]): past it the cases not answered are `not_run`
-//!   with the reason, and the candidate is killed.
+//!   with the reason, and the candidate is killed; a restart's hello ends with it too, so a
+//!   candidate that is slow to start and dies on every case costs the budget, not more.
+//! - **Short failure messages**: why the candidate could not start quotes at most
+//!   [`STDERR_EXCERPT_CHARS`] of its stderr (the message is repeated for every case it costs, so
+//!   a candidate flooding stderr cannot make a report of megabytes).
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::ffi::OsString;
@@ -67,8 +71,14 @@ pub const MAX_STAGED_TOTAL_BYTES: u64 = 8 << 20;
 /// Most submission files copied into the sandbox.
 pub const MAX_STAGED_FILES: usize = 200;
 
+/// Most files left out of the sandbox that its facts name (the rest are counted).
+pub const MAX_SKIPPED_NAMED: usize = 20;
+
 /// How many bytes of the candidate's stderr are kept for the report.
 pub const STDERR_TAIL_BYTES: usize = 4096;
+
+/// Characters of the candidate's stderr quoted in a start failure's message (its last lines).
+pub const STDERR_EXCERPT_CHARS: usize = 300;
 
 /// Longest answer line accepted: a longer one is a protocol error of the case waiting, and is
 /// skipped up to its newline without being kept (only its first bytes are quoted).
@@ -343,7 +353,8 @@ impl CandidateCommand {
     /// The files to copy into the sandbox: the submission's top-level Python modules (a name
     /// that is a Python identifier plus `.py`; regular files only, never a link, FIFO or
     /// device; up to [`MAX_STAGED_FILE_BYTES`] each, [`MAX_STAGED_TOTAL_BYTES`] and
-    /// [`MAX_STAGED_FILES`] in all), and the ones left out, each named (escaped) with why.
+    /// [`MAX_STAGED_FILES`] in all), and the ones left out, each named (escaped) with why, the
+    /// first [`MAX_SKIPPED_NAMED`] of them (a last line counts the others).
     #[allow(clippy::type_complexity)]
     fn staged_files(&self) -> Result<(Vec<(PathBuf, String)>, Vec<String>), HarnessError> {
         let Some(dir) = &self.submission else {
@@ -399,6 +410,11 @@ impl CandidateCommand {
                 Some(why) => skipped.push(format!("{shown} ({why})")),
                 None => files.push((entry.path(), name)),
             }
+        }
+        if skipped.len() > MAX_SKIPPED_NAMED {
+            let more = skipped.len() - MAX_SKIPPED_NAMED;
+            skipped.truncate(MAX_SKIPPED_NAMED);
+            skipped.push(format!("and {more} more files not copied"));
         }
         Ok((files, skipped))
     }
@@ -763,6 +779,16 @@ fn describe_line(line: ParsedLine) -> String {
     }
 }
 
+/// The last [`STDERR_EXCERPT_CHARS`] characters of `text`, with `...` before them when cut.
+fn excerpt_end(text: &str) -> String {
+    let count = text.chars().count();
+    if count <= STDERR_EXCERPT_CHARS {
+        return text.to_string();
+    }
+    let tail: String = text.chars().skip(count - STDERR_EXCERPT_CHARS).collect();
+    format!("...{tail}")
+}
+
 /// The note that ends a case's stray lines when some were not kept.
 const MORE_JUNK: &str = "(more lines not shown)";
 
@@ -942,7 +968,12 @@ impl Session {
             self.facts = Some(self.sandbox.facts(Some(proc.pid as u32)));
         }
         proc.send(format!("{HELLO_LINE}\n").into_bytes());
-        let deadline = Instant::now() + self.options.hello_timeout;
+        // A restart's hello ends with the budget too, so the budget bounds the whole session.
+        let by_hello = Instant::now() + self.options.hello_timeout;
+        let (deadline, by_budget) = match self.budget_deadline() {
+            Some(b) if b < by_hello => (b, true),
+            _ => (by_hello, false),
+        };
         let mut junk = Vec::new();
         loop {
             let left = deadline.saturating_duration_since(Instant::now());
@@ -986,10 +1017,16 @@ impl Session {
                 }
                 Err(RecvTimeoutError::Timeout) => {
                     let _ = proc.kill();
-                    let what = format!(
-                        "no hello answer within {:.1} s",
-                        self.options.hello_timeout.as_secs_f64()
-                    );
+                    if by_budget {
+                        self.check_budget();
+                    }
+                    let what = match &self.budget_used {
+                        Some(reason) if by_budget => reason.clone(),
+                        _ => format!(
+                            "no hello answer within {:.1} s",
+                            self.options.hello_timeout.as_secs_f64()
+                        ),
+                    };
                     return Ok(Err(self.failure_message(what, &junk)));
                 }
             }
@@ -1006,7 +1043,10 @@ impl Session {
         if !tail.is_empty() {
             let last: Vec<&str> = tail.lines().rev().take(3).collect();
             let last: Vec<&str> = last.into_iter().rev().collect();
-            message.push_str(&format!("; stderr ends: {}", last.join(" | ")));
+            message.push_str(&format!(
+                "; stderr ends: {}",
+                excerpt_end(&last.join(" | "))
+            ));
         }
         message
     }
@@ -1422,6 +1462,111 @@ mod tests {
         assert!(
             !dir.exists(),
             "the sandbox folder is removed with the session"
+        );
+    }
+
+    /// An adapter in a folder the sandbox user may read, run by `/usr/bin/python3`.
+    fn python_adapter(script: &str) -> Option<(tempfile::TempDir, CandidateCommand)> {
+        if !Path::new("/usr/bin/python3").is_file() {
+            eprintln!("skipped: no /usr/bin/python3");
+            return None;
+        }
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o755)).unwrap();
+        let path = dir.path().join("adapter.py");
+        std::fs::write(&path, script).unwrap();
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o644)).unwrap();
+        let command = CandidateCommand::adapter(&format!("/usr/bin/python3 {}", path.display()));
+        Some((dir, command.unwrap()))
+    }
+
+    /// A candidate that takes most of the hello timeout to start and dies on every request
+    /// costs the budget, not the budget plus a last hello: a restart's hello ends with it.
+    #[test]
+    fn a_restart_s_hello_ends_when_the_budget_does() {
+        let Some((_dir, command)) = python_adapter(
+            "import sys, time\nsys.stdin.readline()\ntime.sleep(0.9)\n\
+             print('{\"name\":\"slow\",\"protocol\":1}', flush=True)\n\
+             sys.stdin.readline()\nsys.exit(3)\n",
+        ) else {
+            return;
+        };
+        let options = RunOptions {
+            hello_timeout: Duration::from_secs(3),
+            max_crashes_per_group: 1000,
+            budget: Some(Duration::from_millis(2000)),
+            ..RunOptions::default()
+        };
+        let cases: Vec<Case> = crate::oracle::default_suite(0)
+            .into_iter()
+            .filter(|c| c.shape.kind() == ShapeKind::Sphere)
+            .take(50)
+            .collect();
+        let start = Instant::now();
+        let mut session = Session::start(command, options).unwrap();
+        let outcomes = session.run(&cases).unwrap();
+        let took = start.elapsed();
+        assert!(session.budget_used_up().is_some());
+        assert!(
+            outcomes
+                .iter()
+                .any(|o| matches!(o, Outcome::NotRun { reason } if reason.contains("budget")))
+        );
+        // Each start costs 0.9 s: without the clamp the third hello ran to 2.9 s.
+        assert!(took < Duration::from_millis(2600), "{took:?}");
+    }
+
+    /// A candidate that floods stderr with long lines and never says hello: the message every
+    /// case gets quotes a short excerpt of its stderr (the whole 4 KiB tail made `check --json`
+    /// 17.8 MB for the 2950 cases of the default suite).
+    #[test]
+    fn a_start_failure_quotes_little_of_a_flooded_stderr() {
+        let Some((_dir, command)) = python_adapter(
+            "import sys, time\nfor i in range(3000):\n    sys.stderr.write('e' * 700 + '\\n')\n\
+             sys.stderr.flush()\ntime.sleep(30)\n",
+        ) else {
+            return;
+        };
+        let command = CandidateCommand {
+            hello_failure_is_fatal: false,
+            ..command
+        };
+        let options = RunOptions {
+            hello_timeout: Duration::from_millis(1500),
+            ..RunOptions::default()
+        };
+        let session = Session::start(command, options).unwrap();
+        let message = session.start_failure().unwrap().to_string();
+        assert!(
+            message.starts_with("no hello answer within 1.5 s"),
+            "{message}"
+        );
+        assert!(message.contains("stderr ends: "), "{message}");
+        assert!(message.len() < 500, "{} bytes: {message}", message.len());
+    }
+
+    /// 30,000 empty `.py` files made the sandbox facts name each one left out: at most
+    /// [`MAX_SKIPPED_NAMED`] are named, and the rest counted.
+    #[test]
+    fn a_submission_of_many_files_names_a_bounded_number_of_those_not_copied() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..MAX_STAGED_FILES + 300 {
+            std::fs::write(dir.path().join(format!("m{i:04}.py")), b"").unwrap();
+        }
+        for i in 0..50 {
+            std::fs::write(dir.path().join(format!("bad-{i:02}.py")), b"").unwrap();
+        }
+        let command =
+            CandidateCommand::python_course_with(dir.path(), Some(Path::new("python3")), true)
+                .unwrap();
+        let (files, skipped) = command.staged_files().unwrap();
+        assert_eq!(files.len(), MAX_STAGED_FILES);
+        assert_eq!(skipped.len(), MAX_SKIPPED_NAMED + 1, "{}", skipped.len());
+        assert_eq!(skipped[0], "bad-00.py (not a Python module name)");
+        assert_eq!(
+            skipped[MAX_SKIPPED_NAMED],
+            format!("and {} more files not copied", 350 - MAX_SKIPPED_NAMED)
         );
     }
 

@@ -8,7 +8,11 @@
 //!   `python3 python3-numpy python3-pil` where `apt-get` exists, `python3 -m pip install numpy
 //!   pillow` otherwise, unless one already can. It checks the import and fails loudly when it
 //!   does not work, so no student is ever graded 0 because the grader lacks a package. It
-//!   records the interpreter, which `run_autograder` passes to `grade --python`.
+//!   records the interpreter, which `run_autograder` passes to `grade --python`. It installs the
+//!   binary mode `0700` (only root, the grader, may run it: where Gradescope's container refuses
+//!   namespaces, the sandbox cannot hide it from a submission that would use it as an oracle),
+//!   and makes the unpacked package itself (`/autograder/source`: the binary again, and the
+//!   rubric with the secret seed) readable by root only.
 //! - A secret suite: [`secret_seed`] draws the seed from the OS (`/dev/urandom`, no dependency)
 //!   when the rubric's seed is 0 (the public one) and no `--seed` is given; [`with_seed`] writes
 //!   it into the packaged rubric, which `setup.sh` installs readable only by root (mode 600).
@@ -34,9 +38,14 @@ pub const SETUP_SH: &str = r#"#!/usr/bin/env bash
 # PREFIX (default /usr/local) only exists so the package can be tried outside Gradescope.
 set -euo pipefail
 cd "$(dirname "$0")"
+# The package as unpacked (the binary, the rubric with the secret seed) is for root alone: where
+# the sandbox cannot hide the host's files, students' code runs as another uid and could read it.
+chmod -R go-rwx .
 prefix="${PREFIX:-/usr/local}"
 mkdir -p "$prefix/bin" "$prefix/share"
-install -m 0755 rtoracle "$prefix/bin/rtoracle"
+# The grader runs as root; nobody else may run it (a submission that found it could use it as
+# an oracle where the sandbox cannot hide it).
+install -m 0700 rtoracle "$prefix/bin/rtoracle"
 # The rubric holds the secret seed of the suite: readable by root (the grader) only.
 install -m 0600 rubric.toml "$prefix/share/rtoracle-rubric.toml"
 # The rubric's own scene files and their goldens (rubric.toml names them relative to itself).
@@ -289,6 +298,10 @@ mod tests {
         assert!(a != 0 && b != 0 && a != b, "{a} {b}");
         assert!(a <= i64::MAX as u64 && b <= i64::MAX as u64);
         assert!(SETUP_SH.contains("install -m 0600 rubric.toml"));
+        // The binary runs as root only: where the sandbox falls back to a uid without a mount
+        // namespace (Gradescope's containers may refuse one), a submission that finds it must
+        // not be able to run it as an oracle.
+        assert!(SETUP_SH.contains("install -m 0700 rtoracle \"$prefix/bin/rtoracle\""));
     }
 
     /// The family of a case: its id without the trailing number (`sphere-basic-0003` ->

@@ -9,10 +9,17 @@
 //!   `O_NOFOLLOW | O_NONBLOCK` and checked again with `fstat` (same device and inode, still a
 //!   regular file), so swapping it between the check and the open does not help;
 //! - no file is read past its cap ([`MAX_IMAGE_BYTES`] for an image; [`HASH_FILE_CAP`] per file
-//!   and [`HASH_TOTAL_CAP`] in all for the hashes of `report.json`), whatever its size claims;
+//!   and [`HASH_TOTAL_CAP`] in all for the hashes of `report.json`), whatever its size claims,
+//!   and at most [`HASH_MAX_FILES`] files are listed there, so a submission of many files cannot
+//!   make a report of many megabytes;
 //! - a PNG whose header says it is not the expected size, has more than [`MAX_IMAGE_PIXELS`]
 //!   pixels, is grey, uses a palette or has 16-bit channels is reported in plain words, naming
-//!   the file as the student knows it (relative to the submission), without being decoded.
+//!   the file as the student knows it (relative to the submission), without being decoded;
+//! - so is an OpenEXR file (which the comparison also reads, whatever the file's name says)
+//!   whose header describes a part of another size or of more than [`MAX_IMAGE_PIXELS`], or
+//!   parts that would decode to more than [`MAX_EXR_DECODED_BYTES`]: only its header is read, so
+//!   a decompression bomb (a few MB of deflated zeros claiming 16000 x 16000 pixels) costs
+//!   nothing.
 
 use std::collections::BTreeMap;
 use std::fs::{File, FileType, Metadata};
@@ -26,10 +33,18 @@ use super::rubric::sha256_hex;
 pub const MAX_IMAGE_BYTES: u64 = 64 << 20;
 /// The most pixels an image may have (about 8192 x 8192).
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+/// The most bytes of samples an OpenEXR image of a submission may decode to (256 MiB; a
+/// 400 x 225 image of four 32-bit channels holds 1.4 MB).
+pub const MAX_EXR_DECODED_BYTES: u64 = 256 << 20;
 /// The largest file hashed for `report.json` (16 MiB); larger ones are listed as not hashed.
 pub const HASH_FILE_CAP: u64 = 16 << 20;
 /// The most bytes hashed for `report.json` over the whole submission (64 MiB).
 pub const HASH_TOTAL_CAP: u64 = 64 << 20;
+/// The most files listed in `report.json`'s hashes (the first by name); the rest are counted
+/// under [`MORE_FILES_KEY`].
+pub const HASH_MAX_FILES: usize = 1000;
+/// The key that counts the files past [`HASH_MAX_FILES`] (no file's name holds a `/`).
+pub const MORE_FILES_KEY: &str = "/more";
 
 /// What a file that is not a regular file is, in words.
 fn kind_of(t: &FileType) -> &'static str {
@@ -206,6 +221,54 @@ pub fn check_png(
     }
 }
 
+/// Checks an OpenEXR file's header against what grading needs (see the module's promises),
+/// reading nothing past it; `Ok` for bytes that are not an OpenEXR file.
+pub fn check_exr(
+    shown: &str,
+    bytes: &[u8],
+    expected: Option<(usize, usize)>,
+) -> Result<(), String> {
+    if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        return Ok(());
+    }
+    let parts = crate::image_io::exr_part_sizes(bytes).map_err(|_| {
+        format!("{shown} is not a readable OpenEXR file (its header is cut short or damaged)")
+    })?;
+    let mut decoded = 0u64;
+    for (w, h, bytes_per_pixel) in parts {
+        let (w, h) = (w as u64, h as u64);
+        if w.saturating_mul(h) > MAX_IMAGE_PIXELS {
+            return Err(format!(
+                "{shown} is {w}x{h} pixels, more than the {MAX_IMAGE_PIXELS} allowed"
+            ));
+        }
+        if let Some((ew, eh)) = expected
+            && (w, h) != (ew as u64, eh as u64)
+        {
+            return Err(format!("{shown} is {w}x{h} pixels; expected {ew}x{eh}"));
+        }
+        decoded = decoded.saturating_add((w * h).saturating_mul(bytes_per_pixel as u64));
+    }
+    if decoded > MAX_EXR_DECODED_BYTES {
+        return Err(format!(
+            "{shown} would decode to {decoded} bytes of samples, more than the \
+             {MAX_EXR_DECODED_BYTES} allowed"
+        ));
+    }
+    Ok(())
+}
+
+/// Checks the header of an image grading will decode, a PNG ([`check_png`]) or an OpenEXR file
+/// ([`check_exr`]), before anything is decoded.
+pub fn check_image_header(
+    shown: &str,
+    bytes: &[u8],
+    expected: Option<(usize, usize)>,
+) -> Result<(), String> {
+    check_png(shown, bytes, expected)?;
+    check_exr(shown, bytes, expected)
+}
+
 /// Reads the image `rel` of `submission` with care, checks its header, and writes its bytes to
 /// `stage_dir` under its own file name (the path returned), so whatever reads it next reads a
 /// copy the grader owns. The error is a sentence naming `rel`.
@@ -217,7 +280,7 @@ pub fn stage_image(
 ) -> Result<PathBuf, String> {
     let path = inside(submission, rel)?;
     let bytes = read_regular(&path, rel, MAX_IMAGE_BYTES)?;
-    check_png(rel, &bytes, expected)?;
+    check_image_header(rel, &bytes, expected)?;
     let name = path.file_name().unwrap_or_else(|| "image".as_ref());
     let staged = stage_dir.join(name);
     std::fs::write(&staged, &bytes)
@@ -227,7 +290,8 @@ pub fn stage_image(
 
 /// SHA-256 of each regular file at the top of `dir`, by name: only regular files (never through a
 /// symbolic link), each up to [`HASH_FILE_CAP`] and [`HASH_TOTAL_CAP`] in all (in name order); a
-/// file past a cap or unreadable gets a note instead of a hash.
+/// file past a cap or unreadable gets a note instead of a hash. At most [`HASH_MAX_FILES`] files
+/// are listed; [`MORE_FILES_KEY`] counts the others.
 pub fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
     let mut out = BTreeMap::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -239,6 +303,16 @@ pub fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
         .map(|e| (e.file_name().to_string_lossy().to_string(), e.path()))
         .collect();
     files.sort();
+    if files.len() > HASH_MAX_FILES {
+        out.insert(
+            MORE_FILES_KEY.to_string(),
+            format!(
+                "{} more files, not listed (at most {HASH_MAX_FILES} are)",
+                files.len() - HASH_MAX_FILES
+            ),
+        );
+        files.truncate(HASH_MAX_FILES);
+    }
     let mut total = 0u64;
     for (name, path) in files {
         let cap = HASH_FILE_CAP.min(HASH_TOTAL_CAP - total);
@@ -342,6 +416,25 @@ mod tests {
         );
     }
 
+    /// 30,000 empty files (a zip of 3 MB) made report.json 13 MB: only the first files by name
+    /// are listed, and one entry that cannot be a file's name says how many more there are.
+    #[test]
+    fn a_submission_of_many_files_lists_a_bounded_number() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..HASH_MAX_FILES + 500 {
+            std::fs::write(dir.path().join(format!("f{i:05}.py")), b"").unwrap();
+        }
+        let hashes = submission_hashes(dir.path());
+        assert_eq!(hashes.len(), HASH_MAX_FILES + 1);
+        assert_eq!(hashes["f00000.py"], sha256_hex(b""));
+        assert!(!hashes.contains_key(&format!("f{:05}.py", HASH_MAX_FILES)));
+        assert_eq!(
+            hashes[MORE_FILES_KEY],
+            format!("500 more files, not listed (at most {HASH_MAX_FILES} are)")
+        );
+        assert!(MORE_FILES_KEY.contains('/'), "no file name holds a slash");
+    }
+
     #[test]
     fn png_headers_are_judged_before_decoding() {
         let ok = Some((400, 225));
@@ -373,6 +466,98 @@ mod tests {
             "a.png is not a readable PNG (its header is cut short)"
         );
         assert_eq!(check_png("a.png", b"not a png", None), Ok(()));
+    }
+
+    /// The header of a single-part scan-line EXR (R, G, B halves, ZIP of 16 lines) of `width` x
+    /// `height` pixels with an offset table of zeros and no pixel data: what an EXR
+    /// decompression bomb's header looks like (its blocks would inflate to gigabytes).
+    fn exr_header(width: i32, height: i32) -> Vec<u8> {
+        let mut b = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        let mut attr = |name: &str, kind: &str, value: &[u8]| {
+            b.extend(name.as_bytes());
+            b.push(0);
+            b.extend(kind.as_bytes());
+            b.push(0);
+            b.extend((value.len() as i32).to_le_bytes());
+            b.extend(value);
+        };
+        let mut channels = Vec::new();
+        for c in ["B", "G", "R"] {
+            channels.extend(c.as_bytes());
+            channels.push(0);
+            channels.extend(1i32.to_le_bytes());
+            channels.extend([0, 0, 0, 0]);
+            channels.extend(1i32.to_le_bytes());
+            channels.extend(1i32.to_le_bytes());
+        }
+        channels.push(0);
+        attr("channels", "chlist", &channels);
+        attr("compression", "compression", &[3]);
+        let window: Vec<u8> = [0, 0, width - 1, height - 1]
+            .iter()
+            .flat_map(|v: &i32| v.to_le_bytes())
+            .collect();
+        attr("dataWindow", "box2i", &window);
+        attr("displayWindow", "box2i", &window);
+        attr("lineOrder", "lineOrder", &[0]);
+        attr("pixelAspectRatio", "float", &1f32.to_le_bytes());
+        attr("screenWindowCenter", "v2f", &[0; 8]);
+        attr("screenWindowWidth", "float", &1f32.to_le_bytes());
+        b.push(0);
+        b.extend(vec![0u8; 8 * (height as usize).div_ceil(16)]);
+        b
+    }
+
+    #[test]
+    fn exr_headers_are_judged_before_decoding() {
+        // 8000 x 8000 pixels in 4 KB of header: decoding its blocks (once filled with deflated
+        // zeros) would take gigabytes. A 4.6 MB file of 16000 x 16000 cost 7.5 GB and 110 s.
+        let bomb = exr_header(8000, 8000);
+        assert!(bomb.len() < 8 << 10);
+        let start = Instant::now();
+        assert_eq!(
+            check_image_header("week04_sphere.png", &bomb, Some((400, 225))).unwrap_err(),
+            "week04_sphere.png is 8000x8000 pixels; expected 400x225"
+        );
+        assert_eq!(
+            check_image_header("a.exr", &bomb, None).unwrap_err(),
+            "a.exr would decode to 384000000 bytes of samples, more than the 268435456 allowed"
+        );
+        assert!(
+            check_image_header("a.exr", &exr_header(16000, 16000), None)
+                .unwrap_err()
+                .contains("is 16000x16000 pixels, more than the 67108864 allowed"),
+        );
+        assert!(start.elapsed() < Duration::from_secs(1));
+        // The right size passes the header check (decoding then judges the data).
+        assert_eq!(
+            check_image_header("a.exr", &exr_header(400, 225), Some((400, 225))),
+            Ok(())
+        );
+        // A header that cannot be read is named, not decoded.
+        assert_eq!(
+            check_image_header("a.exr", &exr_header(400, 225)[..30], None).unwrap_err(),
+            "a.exr is not a readable OpenEXR file (its header is cut short or damaged)"
+        );
+        // Through the staging, a bomb is refused with the file named as the student knows it.
+        let dir = tempfile::tempdir().unwrap();
+        let stage = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("week04_sphere.png"), &bomb).unwrap();
+        assert_eq!(
+            stage_image(
+                dir.path(),
+                "week04_sphere.png",
+                Some((400, 225)),
+                stage.path()
+            )
+            .unwrap_err(),
+            "week04_sphere.png is 8000x8000 pixels; expected 400x225"
+        );
+        // PNG headers are judged as before.
+        assert_eq!(
+            check_image_header("a.png", &png(200, 100, 8, 2), Some((400, 225))).unwrap_err(),
+            "a.png is 200x100 pixels; expected 400x225"
+        );
     }
 
     #[test]

@@ -451,6 +451,28 @@ fn check_sizes(bytes: &[u8], name: &Path) -> Result<(), ImageError> {
     Ok(())
 }
 
+/// The parts of an EXR as its header describes them, `(width, height, bytes per pixel)` each
+/// (the largest resolution level), read without decoding anything: for judging an untrusted file
+/// before [`decode_exr`] allocates for it. `Err` says why the header cannot be read.
+pub fn exr_part_sizes(bytes: &[u8]) -> Result<Vec<(usize, usize, usize)>, String> {
+    if bytes.len() < 4 || bytes[..4] != MAGIC {
+        return Err("it does not start with the EXR magic number".into());
+    }
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), true)
+        .map_err(|e| one_line(&e.to_string()))?;
+    Ok(meta
+        .headers
+        .iter()
+        .map(|h| {
+            (
+                h.layer_size.0,
+                h.layer_size.1,
+                h.channels.bytes_per_pixel.max(1),
+            )
+        })
+        .collect())
+}
+
 /// The channel called `label` of `layer`.
 fn find<'a>(
     layer: &'a Layer<AnyChannels<FlatSamples>>,

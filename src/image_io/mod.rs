@@ -4,8 +4,8 @@
 mod exr_file;
 mod png_file;
 
-pub use exr_file::{ExrImage, decode_exr, encode_exr, read_exr, write_exr};
-pub use png_file::{Rgb8Image, encode_png, read_png, write_png};
+pub use exr_file::{ExrImage, decode_exr, encode_exr, exr_part_sizes, read_exr, write_exr};
+pub use png_file::{PNG_DECODE_ALLOWANCE, Rgb8Image, encode_png, read_png, write_png};
 
 use std::path::{Path, PathBuf};
 

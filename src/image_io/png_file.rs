@@ -34,13 +34,39 @@ pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
     write_atomically(path, &bytes)
 }
 
+/// What decoding a PNG may allocate beyond 8 bytes per pixel of its header's size: room for an
+/// ICC profile or text chunks (8 MiB), so a few MB of deflated zeros in such a chunk cannot make
+/// the decoder inflate hundreds of MB (the `image` crate's default allows 512 MiB).
+pub const PNG_DECODE_ALLOWANCE: u64 = 8 << 20;
+
 /// Reads a PNG as 8-bit RGB. 8-bit RGB and RGBA files are accepted (alpha is dropped); anything
-/// else (16-bit, grey, palette) is an error naming the file and what it is.
+/// else (16-bit, grey, palette) is an error naming the file and what it is. The decoder may
+/// allocate at most 8 bytes per pixel plus [`PNG_DECODE_ALLOWANCE`]: a file whose chunks would
+/// inflate past that is not a readable PNG.
 pub fn read_png(path: &Path) -> Result<Rgb8Image, ImageError> {
     let bytes =
         std::fs::read(path).map_err(|e| ImageError::io(path, format!("cannot read: {e}")))?;
-    let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-        .map_err(|e| ImageError::format(path, format!("not a readable PNG: {e}")))?;
+    let unreadable =
+        |e: image::ImageError| ImageError::format(path, format!("not a readable PNG: {e}"));
+    // The size the header claims (IHDR is the first chunk); a bad header fails in the decoder.
+    let pixels = match bytes.get(16..24) {
+        Some(b) => {
+            let w = u32::from_be_bytes([b[0], b[1], b[2], b[3]]) as u64;
+            let h = u32::from_be_bytes([b[4], b[5], b[6], b[7]]) as u64;
+            w.saturating_mul(h)
+        }
+        None => 0,
+    };
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(
+        pixels
+            .saturating_mul(8)
+            .saturating_add(PNG_DECODE_ALLOWANCE),
+    );
+    let decoder =
+        image::codecs::png::PngDecoder::with_limits(std::io::Cursor::new(&bytes[..]), limits)
+            .map_err(unreadable)?;
+    let decoded = image::DynamicImage::from_decoder(decoder).map_err(unreadable)?;
     let (width, height) = (decoded.width() as usize, decoded.height() as usize);
     let data = match decoded {
         image::DynamicImage::ImageRgb8(img) => img.into_raw(),
@@ -64,4 +90,128 @@ pub fn read_png(path: &Path) -> Result<Rgb8Image, ImageError> {
         height,
         data,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// CRC-32 of PNG chunks (bit by bit: small inputs only).
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = !0u32;
+        for &b in bytes {
+            crc ^= b as u32;
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xedb8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+
+    /// A zlib stream of `1 + 258 * repeats` zero bytes, in about `13 * repeats` bits: one
+    /// literal, then back-references of length 258 at distance 1 (fixed Huffman codes).
+    fn zeros_bomb(repeats: usize) -> Vec<u8> {
+        let mut out = vec![0x78, 0x01];
+        let (mut acc, mut n) = (0u64, 0u32);
+        let mut bits = |value: u32, count: u32, out: &mut Vec<u8>| {
+            acc |= (value as u64) << n;
+            n += count;
+            while n >= 8 {
+                out.push(acc as u8);
+                acc >>= 8;
+                n -= 8;
+            }
+        };
+        // Huffman codes go most significant bit first.
+        let code = |value: u32, count: u32| value.reverse_bits() >> (32 - count);
+        bits(1, 1, &mut out); // the last block
+        bits(1, 2, &mut out); // fixed Huffman codes
+        bits(code(0x30, 8), 8, &mut out); // literal 0
+        for _ in 0..repeats {
+            bits(code(0b1100_0101, 8), 8, &mut out); // length 258
+            bits(0, 5, &mut out); // distance 1
+        }
+        bits(0, 7, &mut out); // end of block
+        bits(0, 7, &mut out); // flush
+        let len = 1 + 258 * repeats as u64;
+        let adler = ((len % 65521) << 16) | 1;
+        out.extend((adler as u32).to_be_bytes());
+        out
+    }
+
+    /// A 4 x 4 PNG whose ICC profile inflates to 256 MiB, in 1.7 MB of file.
+    fn iccp_bomb(dir: &Path) -> (std::path::PathBuf, Rgb8Image) {
+        let plain = dir.join("plain.png");
+        let image = Rgb8Image {
+            width: 4,
+            height: 4,
+            data: vec![7; 48],
+        };
+        write_png(&plain, &image).unwrap();
+        let bytes = std::fs::read(&plain).unwrap();
+        let mut chunk = b"iCCP".to_vec();
+        chunk.extend(b"bomb\0\0");
+        chunk.extend(zeros_bomb(1_040_000));
+        let mut bomb = bytes[..33].to_vec();
+        bomb.extend(((chunk.len() - 4) as u32).to_be_bytes());
+        bomb.extend(&chunk);
+        bomb.extend(crc32(&chunk).to_be_bytes());
+        bomb.extend(&bytes[33..]);
+        assert!(bomb.len() < 2 << 20, "{}", bomb.len());
+        let path = dir.join("bomb.png");
+        std::fs::write(&path, &bomb).unwrap();
+        (path, image)
+    }
+
+    /// Run alone in a child process by the test below: decodes the bomb and prints the
+    /// process's peak resident memory.
+    #[test]
+    #[ignore = "run by a_png_s_compressed_chunks_cannot_make_the_decoder_take_hundreds_of_mb"]
+    fn decode_the_iccp_bomb_and_print_the_peak_memory() {
+        let dir = tempfile::tempdir().unwrap();
+        let (path, image) = iccp_bomb(dir.path());
+        assert_eq!(read_png(&path).unwrap(), image);
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let line = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap();
+        println!("peak {line}");
+    }
+
+    /// The pixels of a PNG whose ICC profile inflates to 256 MiB are read within a small
+    /// allowance: the profile is dropped, not inflated (the decoder took over 500 MB for it).
+    #[test]
+    fn a_png_s_compressed_chunks_cannot_make_the_decoder_take_hundreds_of_mb() {
+        if !Path::new("/proc/self/status").exists() {
+            eprintln!("skipped: no /proc to read the peak memory from");
+            return;
+        }
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "image_io::png_file::tests::decode_the_iccp_bomb_and_print_the_peak_memory",
+                "--include-ignored",
+                "--nocapture",
+                "--test-threads",
+                "1",
+            ])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let kb: u64 = text
+            .lines()
+            .find_map(|l| l.split("peak VmHWM:").nth(1))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+            .unwrap_or_else(|| panic!("no peak in {text}"));
+        // The test process itself, the 1.7 MB file twice and the 8 MiB allowance (19 MB here;
+        // 275 MB before the allowance).
+        assert!(kb < 64 << 10, "peak {kb} kB");
+    }
 }

@@ -106,7 +106,8 @@ fn is_home(dir: &Path) -> bool {
 }
 
 /// The arguments of bubblewrap up to (not including) the program: namespaces, the view, the
-/// folder at [`INSIDE`], the identity inside, the environment, and `--info-fd`.
+/// folder at [`INSIDE`], the identity inside, the environment, `--info-fd` and `--block-fd` (the
+/// sandbox's first process waits on it until the harness has set its limits).
 pub fn args(
     dir: &Path,
     uid: u32,
@@ -114,6 +115,7 @@ pub fn args(
     exposed: &[PathBuf],
     env: &[(&str, OsString)],
     info_fd: Option<i32>,
+    block_fd: Option<i32>,
 ) -> Vec<OsString> {
     let mut a: Vec<OsString> = Vec::with_capacity(96);
     let mut push = |words: &[&dyn AsRef<std::ffi::OsStr>]| {
@@ -182,6 +184,9 @@ pub fn args(
     }
     if let Some(fd) = info_fd {
         push(&[&"--info-fd", &fd.to_string()]);
+    }
+    if let Some(fd) = block_fd {
+        push(&[&"--block-fd", &fd.to_string()]);
     }
     a
 }

@@ -23,17 +23,29 @@
 //!   `/root` or `/home`. bubblewrap itself runs as the submission's uid (the switch happens before
 //!   it is executed), so even outside its user namespace the code is that uid.
 //! - **A fallback where no namespace can be made** ([`Isolation::FallbackUid`], root only): the
-//!   limits, its own session, an attempted network namespace (verified, never assumed), and the
-//!   per-submission uid and gid, with the sandbox folder owned by that uid, mode `0700`.
-//!   [`Isolation::CurrentUser`] is the same without the uid switch, for a harness that is not
-//!   root. Without namespaces the code can see the host's world-readable files and processes;
-//!   bubblewrap is what hides them.
+//!   limits, its own session, the per-submission uid and gid, with the sandbox folder owned by
+//!   that uid, mode `0700`, and, each where the kernel allows it (attempted, verified from
+//!   `/proc/<pid>/ns`, never assumed): a network namespace, an IPC namespace (System V objects
+//!   die with it; they are swept by owner where it cannot be made), and a private mount
+//!   namespace whose `/proc` is mounted `hidepid=2` (the code sees only its own processes: not
+//!   the grader's command line, which names its binary, rubric and folders) and whose grader
+//!   binary is covered with `/dev/null` (the code found it in `/proc/*/cmdline` and ran
+//!   `rtoracle explain` as an oracle). [`Isolation::CurrentUser`] is the same without the uid
+//!   switch and the namespaces, for a harness that is not root. Without namespaces the code can
+//!   see the host's world-readable files and processes; bubblewrap is what hides them.
 //! - **Limits** in every mode, set with `setrlimit` between `fork` and `exec` (inherited through
 //!   bubblewrap): CPU time, address space, open files, file size, no core files, and a process
-//!   count for a per-submission uid. File descriptors other than the standard three are closed.
-//! - **Bounded writing, nothing left** ([`scratch`]): a watchdog ends the code once its files
-//!   (its folder, its `/tmp`, and what a per-submission uid owns in the host's world-writable
-//!   folders) pass the policy's `disk_bytes`, and those files are swept when the sandbox goes.
+//!   count (threads included) for a per-submission uid. Under bubblewrap the count holds for any
+//!   harness: bubblewrap's first process waits (`--block-fd`) until the harness has set
+//!   `RLIMIT_NPROC` on it, which inside its own user namespace counts the sandbox's processes
+//!   alone (a harness that is not root gave a fork bomb no limit: 1527 forks in 2 s); where it
+//!   cannot be set, that process is killed. File descriptors other than the standard three are
+//!   closed. The memory of all the code's processes together is bounded by the watchdog (next).
+//! - **Bounded writing and memory, nothing left** ([`scratch`]): a watchdog ends the code once
+//!   its files (its folder, its `/tmp`, what a per-submission uid owns in the host's
+//!   world-writable folders, and the unlinked files and memfds its processes hold open) pass the
+//!   policy's `disk_bytes`, or the resident memory of all its processes together passes
+//!   `memory_bytes`; those files (and a uid's System V objects) are swept when the sandbox goes.
 //! - **Nothing outlives it.** [`Sandbox::reaper`] ends every process the code started: the PID
 //!   namespace dies with bubblewrap (killed with its process group), and a per-submission uid is
 //!   swept with [`identity::kill_all`] (double-forked `setsid` sleepers included). Dropping the
@@ -132,7 +144,8 @@ impl Mode {
 pub enum Isolation {
     /// bubblewrap: new namespaces, a minimal read-only view.
     Bubblewrap,
-    /// Limits, own session, attempted network namespace, a per-submission uid (root harness).
+    /// Limits, own session, attempted network, IPC and mount namespaces, a per-submission uid
+    /// (root harness).
     FallbackUid,
     /// Limits and own session as the harness's own unprivileged user (no bubblewrap).
     CurrentUser,
@@ -158,14 +171,16 @@ impl Isolation {
 pub struct SandboxPolicy {
     /// CPU seconds per process (`RLIMIT_CPU`; a restart starts afresh).
     pub cpu_seconds: u64,
-    /// Address space in bytes (`RLIMIT_AS`).
+    /// Address space of each process in bytes (`RLIMIT_AS`), and the resident memory of all the
+    /// code's processes together ([`scratch::Watchdog`]).
     pub memory_bytes: u64,
     /// Open files (`RLIMIT_NOFILE`).
     pub open_files: u64,
     /// Largest file it may write, in bytes (`RLIMIT_FSIZE`).
     pub file_size_bytes: u64,
-    /// Processes and threads of a per-submission uid (`RLIMIT_NPROC`; set only for such a uid,
-    /// since it counts every process of the user).
+    /// Processes and threads (`RLIMIT_NPROC`): for a per-submission uid, and inside
+    /// bubblewrap's user namespace for any harness (elsewhere it would count every process of
+    /// the harness's user).
     pub processes: u64,
     /// Bytes the code may keep in files, its `/tmp` included ([`scratch::Watchdog`]).
     #[serde(default = "default_disk_bytes")]
@@ -221,7 +236,8 @@ pub struct SandboxFacts {
     /// Which isolation was used.
     pub isolation: Isolation,
     /// The namespaces the candidate was seen in that differ from the harness's (`user`, `pid`,
-    /// `net`, `ipc`, `mount`, `uts`), as verified after it started; empty when not looked at.
+    /// `net`, `ipc`, `mount`, `uts`), as verified after it started; empty when not looked at. In
+    /// the fallback, `mount` is listed only when its `/proc` was also seen mounted `hidepid`.
     #[serde(default)]
     pub namespaces: Vec<String>,
     /// The user id the code ran as, seen from outside any user namespace.
@@ -246,15 +262,19 @@ impl SandboxFacts {
         };
         let mut line = match self.isolation {
             Isolation::Bubblewrap => format!("bubblewrap ({ns}), uid {}", self.uid),
-            Isolation::FallbackUid => format!(
-                "fallback-uid (limits, own session, {}), uid {}",
-                if self.network_isolated == Some(true) {
-                    "net namespace"
-                } else {
-                    "network NOT isolated"
-                },
-                self.uid
-            ),
+            Isolation::FallbackUid => {
+                let mut parts = vec!["limits".to_string(), "own session".to_string()];
+                if self.network_isolated != Some(true) {
+                    parts.push("network NOT isolated".into());
+                }
+                if !self.namespaces.is_empty() {
+                    parts.push(format!("{} namespaces", self.namespaces.join(", ")));
+                }
+                if self.namespaces.iter().any(|n| n == "mount") {
+                    parts.push("/proc shows only its processes".into());
+                }
+                format!("fallback-uid ({}), uid {}", parts.join(", "), self.uid)
+            }
             Isolation::CurrentUser => format!(
                 "current-user (limits, own session, no namespaces), uid {}",
                 self.uid
@@ -459,14 +479,87 @@ pub struct Sandbox {
     switch_to: Option<(u32, u32)>,
     /// Paths shown read-only inside bubblewrap besides the system view.
     exposed: Vec<PathBuf>,
-    /// The read end of the pending `--info-fd` pipe of the last command.
-    info: Mutex<Option<OwnedFd>>,
+    /// What bubblewrap reports (`--info-fd`) for the last command, filled by its admission.
+    info: Mutex<Option<Arc<InfoSlot>>>,
+    /// The PID namespaces of the bubblewrap sandboxes started so far (their processes are the
+    /// code's, for the watchdog).
+    pid_namespaces: Arc<Mutex<Vec<u64>>>,
     reaper: Reaper,
     note: Option<String>,
     skipped: Vec<String>,
     /// Measures what the code writes (dropped, and so stopped, before the folder is removed).
     watchdog: Option<scratch::Watchdog>,
     _cleanup: crate::interrupt::CleanupGuard,
+}
+
+/// What bubblewrap's `--info-fd` said for one command, once its admission has read it.
+#[derive(Debug, Default)]
+struct InfoSlot {
+    text: Mutex<Option<String>>,
+    ready: std::sync::Condvar,
+}
+
+impl InfoSlot {
+    fn set(&self, text: String) {
+        *self.text.lock().unwrap_or_else(|e| e.into_inner()) = Some(text);
+        self.ready.notify_all();
+    }
+
+    /// The text, waiting up to `timeout` for it (empty when it does not come).
+    fn wait(&self, timeout: Duration) -> String {
+        let guard = self.text.lock().unwrap_or_else(|e| e.into_inner());
+        let (guard, _) = self
+            .ready
+            .wait_timeout_while(guard, timeout, |t| t.is_none())
+            .unwrap_or_else(|e| e.into_inner());
+        guard.clone().unwrap_or_default()
+    }
+}
+
+/// Lets a bubblewrap sandbox's first process go on, once it has its limits: reads what
+/// bubblewrap reports (`--info-fd`: the first process's pid and its namespaces), records its PID
+/// namespace, sets `RLIMIT_NPROC` to `processes` on that process when asked (`Some`: a harness
+/// that is not root, whose user the limit cannot be set for before bubblewrap, since it would
+/// count all of that user's processes; inside the sandbox's own user namespace it counts the
+/// sandbox's alone), and only then writes to its `--block-fd`. Where the limit cannot be set the
+/// process is killed (fail closed). A per-submission uid got the limit before bubblewrap (its
+/// processes are the sandbox's alone), and a root harness may lack `CAP_SYS_RESOURCE` (Docker
+/// drops it) to set another uid's.
+fn admit(
+    info: OwnedFd,
+    block: OwnedFd,
+    slot: Arc<InfoSlot>,
+    processes: Option<u64>,
+    namespaces: Arc<Mutex<Vec<u64>>>,
+) {
+    let text = read_with_timeout(info, Duration::from_secs(10));
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+    let child = value["child-pid"]
+        .as_u64()
+        .and_then(|p| libc::pid_t::try_from(p).ok());
+    if let Some(ns) = value["pid-namespace"].as_u64()
+        && let Ok(mut list) = namespaces.lock()
+    {
+        list.push(ns);
+    }
+    if let Some(pid) = child {
+        // SAFETY: plain system calls on a process bubblewrap just made and holds waiting.
+        unsafe {
+            let limited = processes.is_none_or(|n| {
+                let rl = libc::rlimit {
+                    rlim_cur: n as libc::rlim_t,
+                    rlim_max: n as libc::rlim_t,
+                };
+                libc::prlimit(pid, libc::RLIMIT_NPROC, &rl, std::ptr::null_mut()) == 0
+            });
+            if limited {
+                libc::write(block.as_raw_fd(), b"x".as_ptr().cast(), 1);
+            } else {
+                libc::kill(pid, libc::SIGKILL);
+            }
+        }
+    }
+    slot.set(text);
 }
 
 /// A pipe whose both ends close on exec (the child's end is made inheritable in `pre_exec`).
@@ -503,9 +596,10 @@ fn copy_regular(source: &Path, target: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Removes a folder the code may have made hard to remove (read-only subfolders).
+/// Removes a folder the code may have made hard to remove (read-only subfolders, thousands of
+/// levels deep: [`scratch::remove_deep`]).
 fn remove_tree(path: &Path) {
-    if std::fs::remove_dir_all(path).is_ok() || !path.exists() {
+    if std::fs::remove_dir_all(path).is_ok() || !path.exists() || scratch::remove_deep(path) {
         return;
     }
     fn open_up(p: &Path) {
@@ -581,14 +675,26 @@ impl Sandbox {
                 reaper.reap();
                 if let Some(uid) = reaper.uid {
                     scratch::sweep(uid);
+                    scratch::sweep_ipc(uid);
                 }
                 remove_tree(&path);
             })
         };
+        let pid_namespaces = Arc::new(Mutex::new(Vec::new()));
+        let members = match (reaper.uid, isolation) {
+            (Some(uid), _) => scratch::Members::Uid(uid),
+            (None, Isolation::Bubblewrap) => {
+                scratch::Members::PidNamespaces(pid_namespaces.clone())
+            }
+            (None, _) => scratch::Members::Sessions(reaper.groups.clone()),
+        };
         let watchdog = scratch::Watchdog::start(
             dir.path().to_path_buf(),
-            reaper.uid,
-            policy.disk_bytes,
+            members,
+            scratch::Limits {
+                disk_bytes: policy.disk_bytes,
+                memory_bytes: policy.memory_bytes,
+            },
             reaper.clone(),
         );
         Ok(Sandbox {
@@ -598,6 +704,7 @@ impl Sandbox {
             switch_to,
             exposed: Vec::new(),
             info: Mutex::new(None),
+            pid_namespaces,
             reaper,
             note,
             skipped: Vec::new(),
@@ -722,6 +829,7 @@ impl Sandbox {
         let env = self.env();
         let mut info_child: Option<i32> = None;
         let mut args_child: Option<i32> = None;
+        let mut block_child: Option<i32> = None;
         let mut cmd = match self.isolation {
             Isolation::Bubblewrap => {
                 let bwrap = bwrap::program().unwrap_or_else(|| PathBuf::from("/usr/bin/bwrap"));
@@ -736,13 +844,38 @@ impl Sandbox {
                     // SAFETY: getuid and getgid have no preconditions.
                     unsafe { (libc::getuid(), libc::getgid()) }
                 });
+                // bubblewrap reports on one pipe and waits on another until the admission
+                // thread has set the limits of its first process (see `admit`).
                 let mut info_write = None;
-                if let Ok((read, write)) = cloexec_pipe() {
+                let mut block_read = None;
+                if let (Ok((info_read, write)), Ok((read, block_write))) =
+                    (cloexec_pipe(), cloexec_pipe())
+                {
                     info_child = Some(write.as_raw_fd());
-                    *self.info.lock().unwrap_or_else(|e| e.into_inner()) = Some(read);
-                    info_write = Some(write);
+                    block_child = Some(read.as_raw_fd());
+                    let slot = Arc::new(InfoSlot::default());
+                    *self.info.lock().unwrap_or_else(|e| e.into_inner()) = Some(slot.clone());
+                    let processes = self.switch_to.is_none().then_some(self.policy.processes);
+                    let namespaces = self.pid_namespaces.clone();
+                    let admission = std::thread::Builder::new()
+                        .name("sandbox-admit".into())
+                        .spawn(move || admit(info_read, block_write, slot, processes, namespaces));
+                    if admission.is_ok() {
+                        info_write = Some(write);
+                        block_read = Some(read);
+                    } else {
+                        (info_child, block_child) = (None, None);
+                    }
                 }
-                let words = bwrap::args(self.dir(), uid, gid, &exposed, &env, info_child);
+                let words = bwrap::args(
+                    self.dir(),
+                    uid,
+                    gid,
+                    &exposed,
+                    &env,
+                    info_child,
+                    block_child,
+                );
                 // The options go through a pipe (`--args FD`), so the sandbox's `/proc/1/cmdline`
                 // shows none of the host's paths.
                 let mut args_read = None;
@@ -770,12 +903,18 @@ impl Sandbox {
                     }
                 }
                 // The closure owns the parent's copies of the pipes' child ends, so they close
-                // when the command is dropped after the spawn.
-                // SAFETY: the closure does nothing.
+                // when the command is dropped after the spawn. Without the admission's pipes
+                // the processes could not be limited: the command then fails (fail closed).
+                // SAFETY: the closure makes no system call.
                 unsafe {
                     cmd.pre_exec(move || {
                         let _ = (&info_write, &args_read);
-                        Ok(())
+                        match block_read {
+                            Some(_) => Ok(()),
+                            None => Err(std::io::Error::other(
+                                "no pipe to admit the sandbox's first process",
+                            )),
+                        }
                     });
                 }
                 cmd.arg(program);
@@ -793,11 +932,17 @@ impl Sandbox {
         };
         let policy = self.policy.clone();
         let switch_to = self.switch_to;
-        let unshare_net = self.isolation == Isolation::FallbackUid && policy.isolate_network;
+        let fallback = self.isolation == Isolation::FallbackUid;
+        let unshare_net = fallback && policy.isolate_network;
+        // The fallback's own view where a mount namespace can be made: a `/proc` that shows
+        // only the code's processes (`hidepid=2`), and the grader's binary as an empty file.
+        let hide_exe = std::env::current_exe()
+            .ok()
+            .and_then(|p| CString::new(p.into_os_string().into_encoded_bytes()).ok());
         let parent = std::process::id() as libc::pid_t;
-        // SAFETY: the closure only makes async-signal-safe system calls (setsid, unshare,
+        // SAFETY: the closure only makes async-signal-safe system calls (setsid, unshare, mount,
         // setrlimit, setgroups, setgid, setuid, prctl, getppid, fcntl, close_range) and
-        // allocates nothing.
+        // allocates nothing (the paths it mounts are made before the fork).
         unsafe {
             cmd.pre_exec(move || {
                 if libc::setsid() < 0 {
@@ -811,13 +956,47 @@ impl Sandbox {
                     u32::MAX,
                     libc::CLOSE_RANGE_CLOEXEC,
                 );
-                for fd in [info_child, args_child].into_iter().flatten() {
+                for fd in [info_child, args_child, block_child].into_iter().flatten() {
                     libc::fcntl(fd, libc::F_SETFD, 0);
                 }
                 #[cfg(target_os = "linux")]
                 if unshare_net {
                     // Best effort: fails without CAP_SYS_ADMIN, which the facts show.
                     let _ = libc::unshare(libc::CLONE_NEWNET);
+                }
+                #[cfg(target_os = "linux")]
+                if fallback {
+                    // Best effort too, verified by the facts: an IPC namespace (System V objects
+                    // die with it), and a mount namespace whose mounts never reach the host's
+                    // (made private first, or nothing is mounted).
+                    let _ = libc::unshare(libc::CLONE_NEWIPC);
+                    let null = std::ptr::null::<libc::c_char>();
+                    if libc::unshare(libc::CLONE_NEWNS) == 0
+                        && libc::mount(
+                            null,
+                            c"/".as_ptr(),
+                            null,
+                            libc::MS_REC | libc::MS_PRIVATE,
+                            std::ptr::null(),
+                        ) == 0
+                    {
+                        libc::mount(
+                            c"proc".as_ptr(),
+                            c"/proc".as_ptr(),
+                            c"proc".as_ptr(),
+                            libc::MS_NOSUID | libc::MS_NODEV | libc::MS_NOEXEC,
+                            c"hidepid=2".as_ptr().cast(),
+                        );
+                        if let Some(exe) = &hide_exe {
+                            libc::mount(
+                                c"/dev/null".as_ptr(),
+                                exe.as_ptr(),
+                                null,
+                                libc::MS_BIND,
+                                std::ptr::null(),
+                            );
+                        }
+                    }
                 }
                 let limit = |resource, value: u64| {
                     let rl = libc::rlimit {
@@ -959,9 +1138,9 @@ for f; do [ -r "$f" ] || { echo "$f"; exit 1; }; done"#;
         let mut network_isolated = None;
         match (self.isolation, child) {
             (Isolation::Bubblewrap, Some(_)) => {
-                let fd = self.info.lock().unwrap_or_else(|e| e.into_inner()).take();
-                if let Some(fd) = fd {
-                    let text = read_with_timeout(fd, Duration::from_secs(2));
+                let slot = self.info.lock().unwrap_or_else(|e| e.into_inner()).take();
+                if let Some(slot) = slot {
+                    let text = slot.wait(Duration::from_secs(2));
                     namespaces = bwrap::made_namespaces(&text).0;
                     network_isolated = Some(namespaces.iter().any(|n| n == "net"));
                 }
@@ -973,6 +1152,9 @@ for f; do [ -r "$f" ] || { echo "$f"; exit 1; }; done"#;
                     if mine != theirs {
                         namespaces.push("net".into());
                     }
+                }
+                if self.isolation == Isolation::FallbackUid {
+                    namespaces.extend(fallback_namespaces(pid));
                 }
             }
             _ => {}
@@ -994,6 +1176,30 @@ for f; do [ -r "$f" ] || { echo "$f"; exit 1; }; done"#;
             skipped_files: self.skipped.clone(),
         }
     }
+}
+
+/// The IPC and mount namespaces a fallback's process `pid` was seen in, when they differ from
+/// the harness's: `mount` only when its `/proc` is also seen mounted with `hidepid` (what the
+/// mount namespace is for).
+fn fallback_namespaces(pid: u32) -> Vec<String> {
+    let differs = |ns: &str| {
+        let mine = std::fs::read_link(format!("/proc/self/ns/{ns}")).ok();
+        let theirs = std::fs::read_link(format!("/proc/{pid}/ns/{ns}")).ok();
+        mine.is_some() && theirs.is_some() && mine != theirs
+    };
+    let mut made = Vec::new();
+    if differs("ipc") {
+        made.push("ipc".to_string());
+    }
+    let hidden = std::fs::read_to_string(format!("/proc/{pid}/mountinfo"))
+        .unwrap_or_default()
+        .lines()
+        .rfind(|l| l.split(' ').nth(4) == Some("/proc"))
+        .is_some_and(|l| l.contains(" - proc ") && l.contains("hidepid="));
+    if differs("mnt") && hidden {
+        made.push("mount".to_string());
+    }
+    made
 }
 
 /// Reads a pipe to its end or until `timeout`, at most 64 KiB.
@@ -1036,6 +1242,7 @@ impl Drop for Sandbox {
         self.reaper.reap();
         if let Some(uid) = self.reaper.uid {
             scratch::sweep(uid);
+            scratch::sweep_ipc(uid);
         }
         if let Some(dir) = self.dir.take() {
             let path = dir.path().to_path_buf();

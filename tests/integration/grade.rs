@@ -607,6 +607,21 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
     let installed = prefix.join("share/rtoracle-rubric.toml");
     let mode = std::fs::metadata(&installed).unwrap().permissions().mode();
     assert_eq!(mode & 0o777, 0o600);
+    // So is the binary (a submission the sandbox cannot hide it from must not run it).
+    let mode = std::fs::metadata(prefix.join("bin/rtoracle"))
+        .unwrap()
+        .permissions()
+        .mode();
+    assert_eq!(mode & 0o777, 0o700);
+    // And the package as unpacked (its binary, its rubric with the secret seed): where the
+    // sandbox cannot hide the host's files, the students' code could read and run them.
+    for name in ["rtoracle", "rubric.toml", "setup.sh", "run_autograder"] {
+        let mode = std::fs::metadata(source.join(name))
+            .unwrap()
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o077, 0, "{name}: {mode:o}");
+    }
     // A student who uploaded their folder instead of its files.
     materialize("sphere-bug", &root.join("submission/my-week4")).unwrap();
     let run = std::process::Command::new("bash")

@@ -520,3 +520,325 @@ _t.sleep(600)
     assert!(left.is_empty(), "still running: {left:?}");
     assert_eq!(folders(), 0, "a folder was left in TMPDIR");
 }
+
+/// `check --python-course DIR --json` with `RTORACLE_SANDBOX=mode`.
+fn check_json_in(mode: &str, dir: &Path, extra: &[&str]) -> (Output, serde_json::Value) {
+    let out = rtoracle()
+        .current_dir(dir)
+        .env("RTORACLE_SANDBOX", mode)
+        .args(["check", "--python-course", dir.to_str().unwrap(), "--json"])
+        .args(extra)
+        .output()
+        .unwrap();
+    let json = serde_json::from_slice(&out.stdout).unwrap_or(serde_json::Value::Null);
+    (out, json)
+}
+
+/// `grade DIR --out OUT` with `RTORACLE_SANDBOX=mode`; the report.json as text.
+fn grade_in(mode: &str, dir: &Path) -> (Output, String) {
+    grade_as(mode, dir, false)
+}
+
+/// [`grade_in`], by user `nobody` when `as_nobody` (a grader that is not root).
+fn grade_as(mode: &str, dir: &Path, as_nobody: bool) -> (Output, String) {
+    let out_dir = tempfile::tempdir().unwrap();
+    let report = out_dir.path().join("r");
+    let mut cmd = rtoracle();
+    if as_nobody {
+        use std::os::unix::fs::PermissionsExt;
+        use std::os::unix::process::CommandExt;
+        std::fs::set_permissions(out_dir.path(), std::fs::Permissions::from_mode(0o777)).unwrap();
+        cmd.uid(65534).gid(65534).env("HOME", "/nonexistent");
+    }
+    let out = cmd
+        .current_dir(dir)
+        .env("RTORACLE_SANDBOX", mode)
+        .args([
+            "grade",
+            dir.to_str().unwrap(),
+            "--out",
+            report.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let text = std::fs::read_to_string(report.join("report.json")).unwrap_or_default();
+    (out, text)
+}
+
+/// The lines of the candidate's stderr tail that start with `prefix`.
+fn tail_lines(json: &serde_json::Value, prefix: &str) -> Vec<String> {
+    json["stderr_tail"]
+        .as_str()
+        .unwrap_or_default()
+        .lines()
+        .filter(|l| l.starts_with(prefix))
+        .map(str::to_string)
+        .collect()
+}
+
+/// A fork bomb is held to the policy's 64 processes under bubblewrap even when the grader is
+/// not root: RLIMIT_NPROC counts every process of a user, so it was set only for a uid of the
+/// grader's own; bubblewrap's first process now gets it inside its user namespace, where it
+/// counts the sandbox's processes alone (1527 forks in 2 s got through before).
+#[test]
+fn a_fork_bomb_is_held_to_the_process_limit_under_bubblewrap_as_any_user() {
+    if !root("a_fork_bomb_is_held_to_the_process_limit_under_bubblewrap_as_any_user") {
+        return;
+    }
+    let sub = hostile(
+        r#"
+import os as _o, sys as _s, time as _t
+_n, _err = 0, None
+while _n < 400:
+    try:
+        if _o.fork() == 0:
+            _t.sleep(3)
+            _o._exit(0)
+        _n += 1
+    except OSError as _e:
+        _err = _e
+        break
+_s.stderr.write("FORKED %d %r\n" % (_n, _err))
+"#,
+    );
+    // As root (a uid of its own) and as an unprivileged user (nobody) running the grader.
+    for as_nobody in [false, true] {
+        let mut cmd = rtoracle();
+        if as_nobody {
+            use std::os::unix::process::CommandExt;
+            cmd.uid(65534).gid(65534).env("HOME", "/nonexistent");
+        }
+        let out = cmd
+            .current_dir(sub.path())
+            .env("RTORACLE_SANDBOX", "bubblewrap")
+            .args([
+                "check",
+                "--python-course",
+                sub.path().to_str().unwrap(),
+                "--json",
+            ])
+            .output()
+            .unwrap();
+        let json: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or(serde_json::Value::Null);
+        if json["sandbox"]["isolation"] != "bubblewrap" {
+            eprintln!("skipped: bubblewrap does not work here: {}", stderr(&out));
+            return;
+        }
+        let forked = tail_lines(&json, "FORKED");
+        let n: usize = forked
+            .first()
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("nobody={as_nobody}: {json}"));
+        assert!(n < 64, "nobody={as_nobody}: {forked:?}");
+        assert!(
+            forked[0].contains("Resource temporarily unavailable"),
+            "{forked:?}"
+        );
+    }
+}
+
+/// Bytes the code keeps in files it unlinked but holds open, or in memfds, are files like any
+/// other: the watchdog counts them (600 MiB of them went unseen by a 256 MiB limit).
+#[test]
+fn unlinked_files_and_memfds_count_toward_the_disk_limit() {
+    if !root("unlinked_files_and_memfds_count_toward_the_disk_limit") {
+        return;
+    }
+    let sub = hostile(
+        r#"
+import os as _o, sys as _s, time as _t
+_keep = []
+_chunk = b"x" * (1 << 20)
+for _i in range(3):
+    _p = "/tmp/unlinked-%d" % _i
+    _f = open(_p, "wb")
+    for _ in range(15):
+        _f.write(_chunk)
+    _f.flush()
+    _o.unlink(_p)
+    _keep.append(_f)
+    _fd = _o.memfd_create("m%d" % _i)
+    for _ in range(15):
+        _o.write(_fd, _chunk)
+    _keep.append(_fd)
+_s.stderr.write("HELD 90 MiB\n")
+_t.sleep(3)
+"#,
+    );
+    for mode in ["auto", "uid"] {
+        let (out, report) = grade_in(mode, sub.path());
+        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
+        assert!(
+            report.contains("the sandbox stopped it: it wrote more than 64 MiB"),
+            "{mode}: {}",
+            &report[..report.len().min(3000)]
+        );
+    }
+}
+
+/// The memory of all the code's processes together is bounded by the policy's `memory_bytes`
+/// (RLIMIT_AS bounds each process alone: 64 processes could hold 64 GiB), in every mode: a uid
+/// of its own, bubblewrap run by a user that is not root (its PID namespace), and no sandbox
+/// at all for such a user (its sessions).
+#[test]
+fn the_memory_of_all_its_processes_together_is_bounded() {
+    if !root("the_memory_of_all_its_processes_together_is_bounded") {
+        return;
+    }
+    let sub = hostile(
+        r#"
+import os as _o, sys as _s, time as _t
+for _i in range(4):
+    if _o.fork() == 0:
+        _b = b"\x01" * (400 << 20)
+        _t.sleep(4)
+        _o._exit(0)
+_s.stderr.write("FORKED\n")
+_t.sleep(4)
+"#,
+    );
+    for (mode, as_nobody) in [
+        ("auto", false),
+        ("uid", false),
+        ("bubblewrap", true),
+        ("none", true),
+    ] {
+        let (out, report) = grade_as(mode, sub.path(), as_nobody);
+        let mode = format!("{mode} nobody={as_nobody}");
+        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
+        assert!(
+            report.contains("the sandbox stopped it: its processes held more than 1 GiB"),
+            "{mode}: {}",
+            &report[..report.len().min(3000)]
+        );
+    }
+}
+
+/// System V shared memory, message queues and semaphores outlive the processes that made them:
+/// in the fallback (no IPC namespace of bubblewrap) 192 MiB of segments stayed after the grader
+/// exited. Now the fallback makes an IPC namespace where it can, and sweeps the uid's objects.
+#[test]
+fn system_v_ipc_objects_do_not_outlive_the_sandbox() {
+    if !root("system_v_ipc_objects_do_not_outlive_the_sandbox") {
+        return;
+    }
+    let sub = hostile(
+        r#"
+import ctypes as _c, sys as _s
+_libc = _c.CDLL(None, use_errno=True)
+_ids = [_libc.shmget(0, 8 << 20, 0o1666) for _ in range(3)]
+_q = _libc.msgget(0, 0o1666)
+_sem = _libc.semget(0, 1, 0o1666)
+_s.stderr.write("IPC %r %r %r\n" % (_ids, _q, _sem))
+"#,
+    );
+    for mode in ["auto", "uid"] {
+        let (out, json) = check_json_in(mode, sub.path(), &[]);
+        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
+        let made = tail_lines(&json, "IPC");
+        assert!(
+            !made.is_empty() && !made[0].contains("-1"),
+            "{mode}: {made:?}"
+        );
+        let uid = json["sandbox"]["uid"].as_u64().unwrap();
+        for table in ["shm", "msg", "sem"] {
+            let text = std::fs::read_to_string(format!("/proc/sysvipc/{table}")).unwrap();
+            let left: Vec<&str> = text
+                .lines()
+                .skip(1)
+                .filter(|l| l.split_whitespace().any(|w| w == uid.to_string()))
+                .collect();
+            assert!(left.is_empty(), "{mode}: {table} left {left:?}");
+        }
+    }
+}
+
+/// In the fallback the code found the grader's binary in `/proc/*/cmdline` and ran it as an
+/// oracle (`rtoracle explain ...`). Where a mount namespace can be made, its `/proc` shows only
+/// its own processes and the grader's binary is an empty file there.
+#[test]
+fn in_the_fallback_the_grader_s_processes_and_binary_are_hidden() {
+    if !root("in_the_fallback_the_grader_s_processes_and_binary_are_hidden") {
+        return;
+    }
+    let exe = env!("CARGO_BIN_EXE_rtoracle");
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s, subprocess as _sp
+for _p in _o.listdir("/proc"):
+    if _p.isdigit():
+        try:
+            _c = open("/proc/%s/cmdline" % _p, "rb").read()
+        except Exception:
+            continue
+        if b"rtoracle" in _c:
+            _s.stderr.write("FOUND %r\n" % _c)
+try:
+    _r = _sp.run([{exe:?}, "--version"], capture_output=True, timeout=5)
+    _s.stderr.write("RAN rc=%s %r\n" % (_r.returncode, _r.stdout[:80]))
+except Exception as _e:
+    _s.stderr.write("NOT RUN %s\n" % type(_e).__name__)
+_s.stderr.write("SCANNED\n")
+"#
+    ));
+    let (out, json) = check_json_in("uid", sub.path(), &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let namespaces = json["sandbox"]["namespaces"].to_string();
+    if !namespaces.contains("mount") {
+        eprintln!("skipped: no mount namespace here ({namespaces})");
+        return;
+    }
+    let tail = json["stderr_tail"].as_str().unwrap_or_default();
+    assert!(tail.contains("SCANNED"), "{tail}");
+    assert!(!tail.contains("FOUND"), "{tail}");
+    assert!(!tail.contains("RAN rc=0"), "{tail}");
+}
+
+/// Files deeper than a path can name were not seen by the watchdog (360 MiB at depth 2100 of a
+/// 256 MiB limit): a tree nested that deep is stopped, and removed, in both modes.
+#[test]
+fn a_tree_nested_past_what_a_path_can_name_is_stopped_and_removed() {
+    if !root("a_tree_nested_past_what_a_path_can_name_is_stopped_and_removed") {
+        return;
+    }
+    let marker = format!("rtoracle-test-deep-{}", std::process::id());
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s, time as _t
+for _root in ("/tmp", "."):
+    _d = _o.open(_root, _o.O_RDONLY)
+    _o.mkdir({marker:?}, dir_fd=_d)
+    _nd = _o.open({marker:?}, _o.O_RDONLY, dir_fd=_d)
+    _o.close(_d)
+    _d = _nd
+    for _i in range(2100):
+        _o.mkdir("a", dir_fd=_d)
+        _nd = _o.open("a", _o.O_RDONLY, dir_fd=_d)
+        _o.close(_d)
+        _d = _nd
+    _f = _o.open("data", _o.O_WRONLY | _o.O_CREAT, 0o644, dir_fd=_d)
+    _o.write(_f, b"x" * (1 << 20))
+    _o.close(_f)
+_s.stderr.write("NESTED\n")
+_t.sleep(3)
+"#
+    ));
+    for mode in ["auto", "uid"] {
+        let (out, json) = check_json_in(mode, sub.path(), &[]);
+        assert_eq!(out.status.code(), Some(1), "{mode}: {}", stderr(&out));
+        let text = json.to_string();
+        assert!(
+            text.contains("the sandbox stopped it: it nested folders more than 100 deep"),
+            "{mode}: {}",
+            &text[..text.len().min(2000)]
+        );
+        let left: Vec<_> = std::fs::read_dir("/tmp")
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().contains(&marker))
+            .collect();
+        assert!(left.is_empty(), "{mode}: left {left:?}");
+    }
+}
