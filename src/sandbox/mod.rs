@@ -28,9 +28,11 @@
 //!   `/proc/<pid>/ns`, never assumed): a network namespace, an IPC namespace (System V objects
 //!   die with it; they are swept by owner where it cannot be made), and a private mount
 //!   namespace whose `/proc` is mounted `hidepid=2` (the code sees only its own processes: not
-//!   the grader's command line, which names its binary, rubric and folders) and whose grader
+//!   the grader's command line, which names its binary, rubric and folders), whose grader
 //!   binary is covered with `/dev/null` (the code found it in `/proc/*/cmdline` and ran
-//!   `rtoracle explain` as an oracle). [`Isolation::CurrentUser`] is the same without the uid
+//!   `rtoracle explain` as an oracle), and where every mount is read-only but the sandbox
+//!   folder and the shared folders the watchdog measures and the sweep cleans (`/tmp`,
+//!   `/var/tmp`, `/dev/shm`, ...): it could write a classmate's world-writable submission. [`Isolation::CurrentUser`] is the same without the uid
 //!   switch and the namespaces, for a harness that is not root. Without namespaces the code can
 //!   see the host's world-readable files and processes; bubblewrap is what hides them.
 //! - **Limits** in every mode, set with `setrlimit` between `fork` and `exec` (inherited through
@@ -272,6 +274,7 @@ impl SandboxFacts {
                 }
                 if self.namespaces.iter().any(|n| n == "mount") {
                     parts.push("/proc shows only its processes".into());
+                    parts.push("read-only but its folder and /tmp".into());
                 }
                 format!("fallback-uid ({}), uid {}", parts.join(", "), self.uid)
             }
@@ -939,6 +942,21 @@ impl Sandbox {
         let hide_exe = std::env::current_exe()
             .ok()
             .and_then(|p| CString::new(p.into_os_string().into_encoded_bytes()).ok());
+        // ... and the host read-only but the sandbox folder and the shared folders (`/tmp`, ...:
+        // where the watchdog measures and the sweep cleans what the uid writes).
+        let mut writable: Vec<CString> = scratch::SHARED_ROOTS
+            .iter()
+            .filter(|r| Path::new(r).is_dir())
+            .filter_map(|r| CString::new(*r).ok())
+            .collect();
+        let own_dir = CString::new(self.dir().as_os_str().as_encoded_bytes()).ok();
+        if let Some(dir) = &own_dir
+            && !scratch::SHARED_ROOTS
+                .iter()
+                .any(|r| self.dir().starts_with(r))
+        {
+            writable.push(dir.clone());
+        }
         let parent = std::process::id() as libc::pid_t;
         // SAFETY: the closure only makes async-signal-safe system calls (setsid, unshare, mount,
         // setrlimit, setgroups, setgid, setuid, prctl, getppid, fcntl, close_range) and
@@ -995,6 +1013,45 @@ impl Sandbox {
                                 libc::MS_BIND,
                                 std::ptr::null(),
                             );
+                        }
+                        // Every mount read-only (`mount_setattr`, Linux 5.12), then the folder and
+                        // the shared folders writable again at their own paths, and the working
+                        // directory moved onto those mounts.
+                        const MOUNT_ATTR_RDONLY: u64 = 1;
+                        let attr: [u64; 4] = [MOUNT_ATTR_RDONLY, 0, 0, 0];
+                        if let Some(dir) = &own_dir
+                            && libc::syscall(
+                                libc::SYS_mount_setattr,
+                                libc::AT_FDCWD,
+                                c"/".as_ptr(),
+                                libc::AT_RECURSIVE as libc::c_uint,
+                                attr.as_ptr(),
+                                std::mem::size_of_val(&attr),
+                            ) == 0
+                        {
+                            for path in &writable {
+                                let p = path.as_ptr();
+                                let bound = libc::mount(
+                                    p,
+                                    p,
+                                    null,
+                                    libc::MS_BIND | libc::MS_REC,
+                                    std::ptr::null(),
+                                );
+                                if bound == 0 {
+                                    libc::mount(
+                                        null,
+                                        p,
+                                        null,
+                                        libc::MS_REMOUNT
+                                            | libc::MS_BIND
+                                            | libc::MS_NOSUID
+                                            | libc::MS_NODEV,
+                                        std::ptr::null(),
+                                    );
+                                }
+                            }
+                            libc::chdir(dir.as_ptr());
                         }
                     }
                 }
@@ -1179,8 +1236,8 @@ for f; do [ -r "$f" ] || { echo "$f"; exit 1; }; done"#;
 }
 
 /// The IPC and mount namespaces a fallback's process `pid` was seen in, when they differ from
-/// the harness's: `mount` only when its `/proc` is also seen mounted with `hidepid` (what the
-/// mount namespace is for).
+/// the harness's: `mount` only when its `/proc` is also seen mounted with `hidepid` and its `/`
+/// read-only (what the mount namespace is for).
 fn fallback_namespaces(pid: u32) -> Vec<String> {
     let differs = |ns: &str| {
         let mine = std::fs::read_link(format!("/proc/self/ns/{ns}")).ok();
@@ -1191,12 +1248,22 @@ fn fallback_namespaces(pid: u32) -> Vec<String> {
     if differs("ipc") {
         made.push("ipc".to_string());
     }
-    let hidden = std::fs::read_to_string(format!("/proc/{pid}/mountinfo"))
-        .unwrap_or_default()
-        .lines()
-        .rfind(|l| l.split(' ').nth(4) == Some("/proc"))
-        .is_some_and(|l| l.contains(" - proc ") && l.contains("hidepid="));
-    if differs("mnt") && hidden {
+    let mountinfo = std::fs::read_to_string(format!("/proc/{pid}/mountinfo")).unwrap_or_default();
+    // The last mount at a point is the one seen there; field 5 is the point, 6 its options.
+    let at = |point: &str| {
+        mountinfo
+            .lines()
+            .rfind(|l| l.split(' ').nth(4) == Some(point))
+            .unwrap_or_default()
+            .to_string()
+    };
+    let proc_line = at("/proc");
+    let hidden = proc_line.contains(" - proc ") && proc_line.contains("hidepid=");
+    let read_only = at("/")
+        .split(' ')
+        .nth(5)
+        .is_some_and(|o| o.split(',').any(|w| w == "ro"));
+    if differs("mnt") && hidden && read_only {
         made.push("mount".to_string());
     }
     made

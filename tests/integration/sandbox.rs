@@ -842,3 +842,59 @@ _t.sleep(3)
         assert!(left.is_empty(), "{mode}: left {left:?}");
     }
 }
+
+/// In the fallback the code could write wherever the host lets any user write: a classmate's
+/// submission in a world-writable batch folder (found by walking the file system). Where a mount
+/// namespace can be made, everything is read-only but its own folder and the shared folders
+/// (`/tmp`, `/var/tmp`, ...), where what it writes is measured and swept.
+#[test]
+fn in_the_fallback_the_host_is_read_only_but_the_code_s_own_folder() {
+    if !root("in_the_fallback_the_host_is_read_only_but_the_code_s_own_folder") {
+        return;
+    }
+    use std::os::unix::fs::PermissionsExt;
+    let marker = format!("rtoracle-test-ro-{}", std::process::id());
+    // Outside the shared folders, as a batch folder would be.
+    let classmate = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    std::fs::set_permissions(classmate.path(), std::fs::Permissions::from_mode(0o777)).unwrap();
+    let theirs = classmate.path().join("RT_object.py");
+    std::fs::write(&theirs, "# a classmate's work\n").unwrap();
+    std::fs::set_permissions(&theirs, std::fs::Permissions::from_mode(0o666)).unwrap();
+    let sub = hostile(&format!(
+        r#"
+import sys as _s
+for _p in [{theirs:?}, {planted:?}, "/tmp/{marker}", "/var/tmp/{marker}", "scratch-{marker}"]:
+    try:
+        with open(_p, "w") as _f:
+            _f.write("raise SystemExit('sabotaged')\n")
+        _s.stderr.write("WROTE %s\n" % _p)
+    except OSError as _e:
+        _s.stderr.write("REFUSED %s %s\n" % (_p, type(_e).__name__))
+"#,
+        theirs = theirs.display().to_string(),
+        planted = classmate.path().join("planted.py").display().to_string(),
+    ));
+    let (out, json) = check_json_in("uid", sub.path(), &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let namespaces = json["sandbox"]["namespaces"].to_string();
+    if !namespaces.contains("mount") {
+        eprintln!("skipped: no mount namespace here ({namespaces})");
+        return;
+    }
+    let tail = json["stderr_tail"].as_str().unwrap_or_default();
+    assert!(
+        tail.contains(&format!("REFUSED {}", theirs.display())),
+        "{tail}"
+    );
+    // Its folder and the shared folders are writable, and what it left there is swept.
+    for place in ["/tmp/", "/var/tmp/", "scratch-"] {
+        assert!(tail.contains(&format!("WROTE {place}")), "{tail}");
+    }
+    assert!(!Path::new(&format!("/tmp/{marker}")).exists());
+    assert!(!Path::new(&format!("/var/tmp/{marker}")).exists());
+    assert_eq!(
+        std::fs::read_to_string(&theirs).unwrap(),
+        "# a classmate's work\n"
+    );
+    assert!(!classmate.path().join("planted.py").exists());
+}
