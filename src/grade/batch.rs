@@ -46,6 +46,10 @@ pub fn submissions(dir: &Path, skip: Option<&Path>) -> Result<Vec<PathBuf>, Grad
     Ok(out)
 }
 
+/// The batch's own files in its output folder: a submission folder of one of these names is
+/// an error row of the batch, not graded (its reports would take their place).
+pub const BATCH_FILES: [&str; 2] = ["gradebook.csv", "summary.md"];
+
 /// Grades every submission in `dir` into `out/<name>/` and writes `out/gradebook.csv` and
 /// `out/summary.md`.
 pub fn grade_batch(
@@ -81,6 +85,14 @@ pub fn grade_batch(
                 .map(|n| n.to_string_lossy().to_string())
                 .unwrap_or_default();
             let result = catch_unwind(AssertUnwindSafe(|| {
+                if BATCH_FILES.contains(&name.as_str()) {
+                    return Err(GradeError::Output {
+                        path: output.shown(&name),
+                        message: "a submission folder cannot have the name of the batch's own \
+                                  report; rename it to grade it"
+                            .to_string(),
+                    });
+                }
                 std::fs::create_dir(output.path().join(&name)).map_err(|e| GradeError::Output {
                     path: output.shown(&name),
                     message: e.to_string(),
@@ -391,6 +403,46 @@ mod tests {
             );
         }
         assert!(!report.contains("failed_vectors"), "{report}");
+    }
+
+    /// A submission folder named like the batch's own report is an error row; the others are
+    /// graded and the batch's files written.
+    #[test]
+    fn a_submission_named_like_the_batch_s_report_is_an_error_row() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["a", "summary.md", "gradebook.csv"] {
+            std::fs::create_dir(dir.path().join(name)).unwrap();
+            fake_images(&dir.path().join(name));
+        }
+        let code = FakeCode::new(counts(2, 2), counts(2, 2));
+        let out = dir.path().join("out");
+        let entries = grade_batch(
+            dir.path(),
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        assert_eq!(entries.len(), 3);
+        for e in &entries {
+            assert_eq!(
+                e.result.is_ok(),
+                e.name == "a",
+                "{}: {:?}",
+                e.name,
+                e.result
+            );
+        }
+        assert!(out.join("a/report.json").is_file());
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        assert!(
+            summary.contains("3 submissions, 1 graded, 2 could not be graded"),
+            "{summary}"
+        );
+        let csv = std::fs::read_to_string(out.join("gradebook.csv")).unwrap();
+        assert!(csv.contains("summary.md,,100"), "{csv}");
     }
 
     #[test]
