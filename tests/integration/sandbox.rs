@@ -854,8 +854,19 @@ fn in_the_fallback_the_host_is_read_only_but_the_code_s_own_folder() {
     }
     use std::os::unix::fs::PermissionsExt;
     let marker = format!("rtoracle-test-ro-{}", std::process::id());
-    // Outside the shared folders, as a batch folder would be.
-    let classmate = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    // Outside the shared folders, as a batch folder would be (a checkout under /tmp puts the
+    // target folder inside one).
+    let shared = |p: &Path| {
+        rtoracle::sandbox::scratch::SHARED_ROOTS
+            .iter()
+            .any(|root| p.starts_with(root))
+    };
+    let place = [env!("CARGO_TARGET_TMPDIR"), "/var/lib", "/opt", "/srv"]
+        .into_iter()
+        .map(Path::new)
+        .find(|p| p.is_dir() && !shared(&p.canonicalize().unwrap_or(p.to_path_buf())))
+        .expect("a folder outside the shared ones");
+    let classmate = tempfile::tempdir_in(place).unwrap();
     std::fs::set_permissions(classmate.path(), std::fs::Permissions::from_mode(0o777)).unwrap();
     let theirs = classmate.path().join("RT_object.py");
     std::fs::write(&theirs, "# a classmate's work\n").unwrap();
