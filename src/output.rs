@@ -647,6 +647,14 @@ fn copy_tree(from: &Path, to: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Writes `line` and a newline to stderr, losing it quietly when stderr is closed (`2>&1 | head
+/// -1`), where `eprintln!` would panic. For the library's own notes on stderr (the sandbox's
+/// announcement, a golden being rendered); the CLI has `errln!`.
+pub fn stderr_line(line: &str) {
+    use std::io::Write as _;
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

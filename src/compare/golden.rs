@@ -351,12 +351,9 @@ pub fn golden_for_scene(name: &str, candidate_spp: u32) -> Result<Golden, Compar
             }
         }
     }
-    // Not `eprintln!`, which panics on a closed stderr.
-    use std::io::Write as _;
-    let _ = writeln!(
-        std::io::stderr(),
+    crate::output::stderr_line(&format!(
         "rendering the golden of {name} at {spp} spp (once; it is cached)"
-    );
+    ));
     let golden = Golden::render(&description, name, spp, true)?;
     if let Some(path) = &cached {
         // A cache that cannot be written costs time, not correctness.

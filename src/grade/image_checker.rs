@@ -82,7 +82,7 @@ impl CompareImageChecker {
                     .as_ref()
                     .map(|d| crate::golden::cache_file(d, &f.description, spp));
                 if !cache_file.as_ref().is_some_and(|p| p.is_file()) {
-                    eprintln!(
+                    crate::output::stderr_line(&format!(
                         "rendering the golden of {} ({}x{}, {spp} spp), once per cache{}",
                         crate::escape::terminal_line(&f.label),
                         camera.width,
@@ -91,7 +91,7 @@ impl CompareImageChecker {
                             ": {}",
                             crate::escape::terminal_line(&p.display().to_string())
                         ))
-                    );
+                    ));
                 }
                 let made = crate::golden::cached_golden_in(
                     dir.as_deref(),
@@ -102,11 +102,11 @@ impl CompareImageChecker {
                 )
                 .map_err(|e| CompareError::Golden(e.to_string()))?;
                 if let Some(why) = &made.warning {
-                    eprintln!(
+                    crate::output::stderr_line(&format!(
                         "warning: the golden of {} is not cached ({}); it is rendered again next time",
                         crate::escape::terminal_line(&f.label),
                         crate::escape::terminal_line(why)
-                    );
+                    ));
                 }
                 let path = made
                     .path

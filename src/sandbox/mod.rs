@@ -316,10 +316,10 @@ pub fn announce(facts: &SandboxFacts) {
         } else {
             ""
         };
-        eprintln!(
+        crate::output::stderr_line(&format!(
             "rtoracle: sandbox: {}{per}",
             crate::escape::terminal_line(&facts.summary())
-        );
+        ));
     }
 }
 

@@ -539,7 +539,32 @@ fn a_closed_stderr_is_no_panic_either() {
         (&["vectors", "--count", "10", "-o", "v.jsonl"], 0),
         (&["render", "no-such-scene"], 2),
         (&["render", "--spp", "-1", "week04-quad"], 2),
+        // A submission folder: the sandbox announces itself on stderr.
+        (&["check", "--python-course", "sub"], 0),
     ];
+    let sub = tmp.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/python");
+    for f in [
+        "common/RT_utility.py",
+        "common/RT_ray.py",
+        "common/RT_material.py",
+        "common/RT_texture.py",
+    ] {
+        let from = fixtures.join(f);
+        std::fs::copy(&from, sub.join(from.file_name().unwrap())).unwrap();
+    }
+    std::fs::copy(
+        fixtures.join("reference_RT_object.py"),
+        sub.join("RT_object.py"),
+    )
+    .unwrap();
+    {
+        use std::os::unix::fs::PermissionsExt;
+        for d in [tmp.path(), sub.as_path()] {
+            std::fs::set_permissions(d, std::fs::Permissions::from_mode(0o755)).unwrap();
+        }
+    }
     for (args, code) in runs {
         let mut child = rtoracle()
             .current_dir(tmp.path())
