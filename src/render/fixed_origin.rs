@@ -99,6 +99,37 @@ impl PreparedSphere {
         }
     }
 
+    /// Whether every direction of `cone` (whose `d . d` is inside the pre-filter's range) hits
+    /// the sphere within [`Interval::CAMERA`], with margins far above the rounding of the lanes'
+    /// robust roots.
+    ///
+    /// The origin is outside the sphere (`|g| > r`, `g = center - origin`) and every direction is
+    /// within `theta + half_angle < 90` degrees of `g` (`theta` the axis's angle to it), so every
+    /// ray heads towards the centre, and its line passes within `|g| sin(theta + half_angle)` of
+    /// it, below `r`: the discriminant is positive by a wide margin, and the near root's point is
+    /// at least `|g| - r` from the origin, so `t >= (|g| - r) / |d|`, which is asked to be at
+    /// least twice the interval's `1e-6`.
+    fn covers(&self, cone: &Cone) -> bool {
+        if !self.scale.is_finite() {
+            return false;
+        }
+        let g = -self.f;
+        let (distance, r) = (g.length(), self.sphere.radius);
+        // The rounding of `f = origin - center`, against the exact offset.
+        let slack = 4.0
+            * f64::EPSILON
+            * (self.sphere.center.abs() + (self.sphere.center + self.f).abs()).max_element();
+        let r = r - slack;
+        if !(distance.is_finite() && r > 0.0 && distance > r * (1.0 + 1e-9) + slack) {
+            return false;
+        }
+        let theta = cone.axis.cross(g).length().atan2(cone.axis.dot(g));
+        let widest = theta + cone.half_angle + 1e-9;
+        widest < std::f64::consts::FRAC_PI_2 - 1e-9
+            && distance * widest.sin() < r * (1.0 - 1e-9)
+            && (distance - r - slack) / cone.length2_max.sqrt() > 2e-6
+    }
+
     /// [`Self::hit_t`] for each lane's direction, against each lane's interval
     /// `(min, closest[k])`: where it hits, `closest[k]` becomes its `t` and `index[k]` becomes
     /// `me`. The same operations in the same order as the scalar path, so the same bits; `Err`
@@ -305,6 +336,44 @@ impl PreparedTriangle {
         }
     }
 
+    /// Whether every direction of `cone` (whose `d . d` is inside the pre-filter's range) hits
+    /// the triangle within [`Interval::CAMERA`].
+    ///
+    /// A line meets the triangle's inside when its three edge functions `S_i = E_i . d` have one
+    /// strict sign (see above): here, when every direction is more than 90 degrees less the
+    /// margin away from each edge plane's normal `+-E_i`, the margin holding the rounding of the
+    /// computed `E_i` (`2 eps M_i`, turned into an angle by `|E_i|`). The hit's lanes decide it
+    /// exactly, whichever way they go. Its `t = (n . a - n . O) / n . d` has one sign over the cone
+    /// (no direction of it is within `1e-6` radians of the plane `n . d = 0`), the axis's, and
+    /// is at least `|n . a - n . O| / |d|`, asked to be at least twice the interval's `1e-6`; and
+    /// at most that over `|d| sin(1e-6)`, finite.
+    fn covers(&self, cone: &Cone) -> bool {
+        let n = self.triangle.normal;
+        if !(n.is_finite() && self.offset.is_finite() && self.offset != 0.0) {
+            return false;
+        }
+        let angle = |v: DVec3| cone.axis.cross(v).length().atan2(cone.axis.dot(v));
+        let inside = |sign: f64| {
+            self.edges.iter().zip(&self.magnitudes).all(|(&e, &m)| {
+                let length = e.length();
+                let margin = 1e-9 + 4.0 * f64::EPSILON * m.length() / length;
+                length > 0.0
+                    && margin < 1e-3
+                    && angle(sign * e) + cone.half_angle + margin < std::f64::consts::FRAC_PI_2
+            })
+        };
+        if !(inside(1.0) || inside(-1.0)) {
+            return false;
+        }
+        let towards = n.dot(cone.axis);
+        let off_plane = (towards.abs().min(1.0).asin() - cone.half_angle - 1e-9).sin();
+        let (shortest, longest) = (cone.length2_min.sqrt(), cone.length2_max.sqrt());
+        off_plane > 1e-6
+            && (towards > 0.0) == (self.offset > 0.0)
+            && self.offset.abs() / longest * (1.0 - 1e-9) > 2e-6
+            && self.offset.abs() / (shortest * off_plane) < 1e300
+    }
+
     /// [`Triangle::hit_t`] for each lane's direction from `origin`, against each lane's interval
     /// `[min, closest[k]]`: where it hits, `closest[k]` becomes its `t` and `index[k]` becomes
     /// `me`. Lanes the pre-classification decides are done in straight-line code; the others
@@ -415,6 +484,128 @@ enum Layout {
 pub(crate) struct FixedOrigin {
     origin: DVec3,
     layout: Layout,
+    /// Per object, what [`Self::candidates`] may rule out for a whole cone of directions.
+    bounds: Vec<Bound>,
+    /// The objects in order, for [`Self::covering`].
+    objects: Vec<Prepared>,
+}
+
+/// The objects a packet must test: bit `k` for object `k` (objects from 64 on are always
+/// tested).
+pub(crate) type Candidates = u64;
+
+/// Every object a candidate.
+pub(crate) const ALL_CANDIDATES: Candidates = u64::MAX;
+
+/// Whether object `me` is among `candidates`.
+#[inline(always)]
+fn is_candidate(candidates: Candidates, me: usize) -> bool {
+    me >= 64 || (candidates >> me) & 1 == 1
+}
+
+/// A round cone of directions from the origin: every direction within `half_angle` (radians)
+/// of the unit vector `axis`, with `|d|^2` between `length2_min` and `length2_max`. The renderer
+/// builds one per pixel that holds every direction its samples can take, rounding included.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cone {
+    /// The unit axis.
+    pub(crate) axis: DVec3,
+    /// At most 1 radian.
+    pub(crate) half_angle: f64,
+    /// A lower bound of `d . d` over the cone's directions.
+    pub(crate) length2_min: f64,
+    /// An upper bound of `d . d`.
+    pub(crate) length2_max: f64,
+}
+
+/// What rules an object out for a cone of directions: a ball around it, seen from the origin.
+#[derive(Clone, Copy, Debug)]
+enum Bound {
+    /// The object's hit is decided exactly for each ray (a triangle): ruled out when no line
+    /// of the cone meets the ball (`to_center = center - origin`).
+    Line { to_center: DVec3, radius: f64 },
+    /// A sphere with its pre-filter on: ruled out when the pre-filter would find a sure miss
+    /// for every direction of the cone, which needs the lines to clear the sphere by a margin
+    /// far above the pre-filter's and `d . d` inside the pre-filter's range.
+    Prefiltered { to_center: DVec3, radius: f64 },
+    /// Never ruled out (a quad, whose floating-point test can find a hit just off its edges, or
+    /// a sphere without its pre-filter).
+    Always,
+}
+
+impl Bound {
+    /// The bound of `object` for rays from `origin`. The ball's radius is widened by four
+    /// times the rounding of `center - origin`, so the computed offset can stand for the exact
+    /// one.
+    fn of(object: &Prepared, origin: DVec3) -> Self {
+        let widened = |center: DVec3, radius: f64| {
+            radius + 4.0 * f64::EPSILON * (center.abs() + origin.abs()).max_element()
+        };
+        match object {
+            Prepared::Sphere(sphere) if sphere.scale.is_finite() => Bound::Prefiltered {
+                to_center: sphere.sphere.center - origin,
+                radius: widened(sphere.sphere.center, sphere.sphere.radius),
+            },
+            Prepared::Triangle(prepared) => {
+                let t = prepared.triangle;
+                let center = (t.a + t.b + t.c) / 3.0;
+                let radius = [t.a, t.b, t.c]
+                    .map(|v| (v - center).length())
+                    .into_iter()
+                    .fold(0.0, f64::max);
+                if center.is_finite() && radius.is_finite() {
+                    // Rounding in the centre and the distances is far below this slack.
+                    Bound::Line {
+                        to_center: center - origin,
+                        radius: widened(center, radius * (1.0 + 1e-9) + 1e-300),
+                    }
+                } else {
+                    Bound::Always
+                }
+            }
+            _ => Bound::Always,
+        }
+    }
+
+    /// Whether no direction of `cone` can hit the object (`false` when in doubt).
+    ///
+    /// Every direction `d` of the cone is within `half_angle` of the axis, so its line makes an
+    /// angle of at least `psi = min(theta - half_angle, pi - theta - half_angle)` with the
+    /// ball's centre, `theta` being the axis's angle to it; the line clears the ball when
+    /// `|g| sin(psi) > r`. For a sphere the pre-filter's exact value is
+    /// `|d|^2 (r^2 - |g|^2 sin^2 psi)`, so asking for `|g|^2 sin^2 psi > r^2 + 1e-9 (|g|^2 + r^2)`
+    /// leaves it below `-1e-9 a (|f|^2 + r^2)`, a thousand times the pre-filter's margin and far
+    /// beyond its rounding. The angles here are computed to about `1e-15` radians; `1e-9` is
+    /// taken off `psi` for them.
+    fn rules_out(&self, cone: &Cone) -> bool {
+        let (to_center, radius) = match *self {
+            Bound::Line { to_center, radius } => (to_center, radius),
+            Bound::Prefiltered { to_center, radius } => {
+                let sane = |a: f64| (SANE_MIN * 4.0..SANE_MAX / 4.0).contains(&a);
+                if !(sane(cone.length2_min) && sane(cone.length2_max)) {
+                    return false;
+                }
+                (to_center, radius)
+            }
+            Bound::Always => return false,
+        };
+        let distance = to_center.length();
+        if !(distance.is_finite() && distance > radius * (1.0 + 1e-9)) {
+            return false;
+        }
+        let theta = cone
+            .axis
+            .cross(to_center)
+            .length()
+            .atan2(cone.axis.dot(to_center));
+        let psi =
+            (theta - cone.half_angle).min(std::f64::consts::PI - theta - cone.half_angle) - 1e-9;
+        if psi.is_nan() || psi <= 0.0 {
+            return false;
+        }
+        let (g2, r2) = (distance * distance, radius * radius);
+        g2 * psi.sin().powi(2) > r2 + 1e-9 * (g2 + r2)
+    }
 }
 
 impl FixedOrigin {
@@ -453,15 +644,50 @@ impl FixedOrigin {
                     .collect(),
             )
         } else {
-            Layout::Mixed(objects)
+            Layout::Mixed(objects.clone())
         };
-        Self { origin, layout }
+        Self {
+            origin,
+            layout,
+            bounds: objects.iter().map(|o| Bound::of(o, origin)).collect(),
+            objects,
+        }
     }
 
-    /// The origin every ray leaves from.
-    #[inline]
-    pub(crate) fn origin(&self) -> DVec3 {
-        self.origin
+    /// The object every direction of `cone` hits, when `candidates` (from
+    /// [`Self::candidates`]) holds that object alone and it is proved hit (within
+    /// [`Interval::CAMERA`]) by every direction of the cone: then each such ray's closest hit is
+    /// that object.
+    pub(crate) fn covering(&self, cone: &Cone, candidates: Candidates) -> Option<usize> {
+        if self.objects.len() > 64 || candidates.count_ones() != 1 {
+            return None;
+        }
+        let me = candidates.trailing_zeros() as usize;
+        let sane = |a: f64| (SANE_MIN * 4.0..SANE_MAX / 4.0).contains(&a);
+        if !(sane(cone.length2_min) && sane(cone.length2_max)) {
+            return None;
+        }
+        let covered = match &self.objects[me] {
+            Prepared::Sphere(sphere) => sphere.covers(cone),
+            Prepared::Triangle(triangle) => triangle.covers(cone),
+            Prepared::Quad { .. } => false,
+        };
+        covered.then_some(me)
+    }
+
+    /// The objects some direction of `cone` may hit: the others are proved missed by every
+    /// one of them, so leaving them out of [`Self::closest_packet`] changes no answer.
+    pub(crate) fn candidates(&self, cone: &Cone) -> Candidates {
+        let mut candidates = match self.bounds.len() {
+            n @ 0..64 => (1 << n) - 1,
+            _ => ALL_CANDIDATES,
+        };
+        for (me, bound) in self.bounds.iter().enumerate().take(64) {
+            if bound.rules_out(cone) {
+                candidates &= !(1 << me);
+            }
+        }
+        candidates
     }
 
     /// The closest hit's `t` and object index along direction `d`: the same answer as
@@ -482,13 +708,24 @@ impl FixedOrigin {
     #[inline(always)]
     // Lane loops index several arrays in step.
     #[allow(clippy::needless_range_loop)]
-    pub(crate) fn closest_packet(&self, d: &Directions, interval: Interval) -> [u64; WIDTH] {
+    pub(crate) fn closest_packet(
+        &self,
+        d: &Directions,
+        interval: Interval,
+        candidates: Candidates,
+    ) -> [u64; WIDTH] {
         let mut closest = [interval.max; WIDTH];
         let mut index = [NO_HIT; WIDTH];
+        if candidates == 0 {
+            return index;
+        }
         match &self.layout {
             Layout::Spheres(spheres) => {
                 let (a, a_margin) = Self::squared_lengths(d);
                 for (me, sphere) in spheres.iter().enumerate() {
+                    if !is_candidate(candidates, me) {
+                        continue;
+                    }
                     let lanes = sphere.hit_lanes(
                         d,
                         &a,
@@ -505,6 +742,9 @@ impl FixedOrigin {
             }
             Layout::Quads(quads) => {
                 for (me, (quad, offset)) in quads.iter().enumerate() {
+                    if !is_candidate(candidates, me) {
+                        continue;
+                    }
                     quad_hit_lanes(
                         quad,
                         *offset,
@@ -520,6 +760,9 @@ impl FixedOrigin {
             Layout::Mixed(objects) => {
                 let (a, a_margin) = Self::squared_lengths(d);
                 for (me, object) in objects.iter().enumerate() {
+                    if !is_candidate(candidates, me) {
+                        continue;
+                    }
                     let me = me as u64;
                     match object {
                         Prepared::Sphere(sphere) => {
@@ -732,7 +975,7 @@ mod tests {
                 expected_indices[n % WIDTH] = expected.map_or(NO_HIT, |(_, i)| i as u64);
                 if n % WIDTH == WIDTH - 1 {
                     assert_eq!(
-                        fast.closest_packet(&packet, Interval::CAMERA),
+                        fast.closest_packet(&packet, Interval::CAMERA, ALL_CANDIDATES),
                         expected_indices,
                         "{} along {packet:?}",
                         builtin.name
@@ -805,7 +1048,7 @@ mod tests {
                 expected_indices[n % WIDTH] = expected.map_or(NO_HIT, |(_, i)| i as u64);
                 if n % WIDTH == WIDTH - 1 {
                     assert_eq!(
-                        fast.closest_packet(&packet, Interval::CAMERA),
+                        fast.closest_packet(&packet, Interval::CAMERA, ALL_CANDIDATES),
                         expected_indices,
                         "scene {scene_index} along {packet:?}"
                     );
@@ -940,7 +1183,7 @@ mod tests {
                 for k in 0..WIDTH {
                     packet.set(k, if k == slot { d } else { filler });
                 }
-                let got = fast.closest_packet(&packet, Interval::CAMERA);
+                let got = fast.closest_packet(&packet, Interval::CAMERA, ALL_CANDIDATES);
                 assert_eq!(got[slot], answer, "{what} in lane {slot}");
             }
         }
@@ -984,7 +1227,7 @@ mod tests {
                             .map_or(NO_HIT, |(_, i)| i as u64)
                     });
                     assert_eq!(
-                        fast.closest_packet(&packet, Interval::CAMERA),
+                        fast.closest_packet(&packet, Interval::CAMERA, ALL_CANDIDATES),
                         expected,
                         "{name}: {odd} in lane {slot}"
                     );

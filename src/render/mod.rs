@@ -5,6 +5,7 @@ mod film;
 mod fixed_origin;
 mod integrator;
 mod packet;
+mod pinhole;
 mod renderer;
 mod sampler;
 

@@ -36,7 +36,7 @@ impl Directions {
     }
 
     /// Sets lane `k`'s direction.
-    #[inline(always)]
+    #[cfg(test)]
     pub(crate) fn set(&mut self, k: usize, d: DVec3) {
         (self.x[k], self.y[k], self.z[k]) = (d.x, d.y, d.z);
     }

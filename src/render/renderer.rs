@@ -4,11 +4,8 @@ use glam::DVec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
-use super::fixed_origin::FixedOrigin;
-use super::integrator::{sky_at, sky_height};
-use super::packet::{Directions, WIDTH};
+use super::pinhole::Pinhole;
 use super::{Film, PixelSampler, radiance};
-use crate::geometry::{Interval, Ray};
 use crate::scene::{Camera, Scene};
 
 /// How the sample positions inside a pixel are drawn.
@@ -80,69 +77,149 @@ fn strata(n: u32) -> (u32, u32) {
     (n / rows, rows)
 }
 
-/// The colours seen along a packet of primary rays: the course's integrator, through the general
-/// scene or through the fixed-origin fast path (the same values, bit for bit).
-trait Trace: Sync {
-    fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH];
+/// How a renderer draws the rows of a [`Job`]: the general path, one ray at a time through the
+/// scene, or the pinhole fast path ([`Pinhole`]), which gives the same film bit for bit.
+pub(super) trait Trace: Sync + Sized {
+    /// Renders row `j` of `job` into `means` (and `variances` when `VARIANCE`) with the jitter
+    /// `JITTER` (0 uniform, 1 stratified, 2 centre).
+    fn row<const VARIANCE: bool, const JITTER: u8>(
+        job: &Job<'_, Self>,
+        j: usize,
+        means: &mut [DVec3],
+        variances: &mut [DVec3],
+    );
 }
 
 impl Trace for Scene {
-    #[inline]
-    fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH] {
-        rays.map(|ray| radiance(self, &ray))
-    }
-}
-
-/// The fast path with the scene's materials.
-struct Pinhole {
-    prepared: FixedOrigin,
-    /// Each object's albedo.
-    albedos: Vec<DVec3>,
-}
-
-impl Pinhole {
-    /// `scene` prepared for rays leaving `origin`.
-    fn new(scene: &Scene, origin: DVec3) -> Self {
-        Self {
-            prepared: FixedOrigin::new(scene, origin),
-            albedos: (0..scene.objects.len())
-                .map(|index| scene.material_of(index).albedo())
-                .collect(),
-        }
-    }
-}
-
-impl Trace for Pinhole {
+    /// Each sample's ray (with its disk point under defocus) through [`radiance`].
     #[inline(always)]
-    fn trace(&self, rays: &[Ray; WIDTH]) -> [DVec3; WIDTH] {
-        let mut d = Directions::default();
-        for (k, ray) in rays.iter().enumerate() {
-            debug_assert_eq!(ray.origin, self.prepared.origin());
-            d.set(k, ray.direction);
+    fn row<const VARIANCE: bool, const JITTER: u8>(
+        job: &Job<'_, Self>,
+        j: usize,
+        means: &mut [DVec3],
+        variances: &mut [DVec3],
+    ) {
+        let width = job.camera.width;
+        for (i, mean) in means.iter_mut().enumerate() {
+            let mut sampler = PixelSampler::new(job.seed, (j * width + i) as u64);
+            let mut moments = None;
+            for s in 0..job.spp {
+                let (ox, oy) = job.offsets::<JITTER>(&mut sampler, s);
+                let disk = if job.camera.defocus {
+                    sampler.in_unit_disk()
+                } else {
+                    (0.0, 0.0)
+                };
+                let ray = job.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
+                let colour = radiance(job.tracer, &ray);
+                let colour = [colour.x, colour.y, colour.z, 0.0];
+                moments
+                    .get_or_insert_with(|| Moments::new(colour))
+                    .add::<VARIANCE>(colour, s);
+            }
+            if let Some(moments) = moments {
+                moments.store::<VARIANCE>(job.spp, mean, variances.get_mut(i));
+            }
         }
-        let index = self.prepared.closest_packet(&d, Interval::CAMERA);
-        // The sky of every lane, then the albedo where a lane hit: no branch per ray.
-        let height: [f64; WIDTH] = std::array::from_fn(|k| sky_height(d.lane(k)));
-        std::array::from_fn(|k| match self.albedos.get(index[k] as usize) {
-            Some(&albedo) => albedo,
-            None => sky_at(height[k]),
-        })
+    }
+}
+
+/// The running sums of one pixel's samples, one colour per `[f64; 4]` (red, green, blue, and a
+/// lane that stays zero), so each update is one vector operation per step.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Moments {
+    sum: [f64; 4],
+    /// The pixel's first sample.
+    first: [f64; 4],
+    /// Per channel, all ones while every sample so far equals the first (`==`), else zero.
+    same: [u64; 4],
+    running_mean: [f64; 4],
+    m2: [f64; 4],
+}
+
+impl Moments {
+    /// The sums of a pixel whose first sample is `first` (not yet added).
+    #[inline(always)]
+    pub(super) fn new(first: [f64; 4]) -> Self {
+        Self {
+            sum: [0.0; 4],
+            first,
+            same: [u64::MAX; 4],
+            running_mean: [0.0; 4],
+            m2: [0.0; 4],
+        }
+    }
+
+    /// Adds sample number `s` (from 0), in order: the sum, whether it equals the first, and
+    /// (when `VARIANCE`) Welford's update.
+    #[inline(always)]
+    // Lane loops index several arrays in step.
+    #[allow(clippy::needless_range_loop)]
+    pub(super) fn add<const VARIANCE: bool>(&mut self, colour: [f64; 4], s: u32) {
+        let n = (s + 1) as f64;
+        for c in 0..4 {
+            self.sum[c] += colour[c];
+            self.same[c] &= if colour[c] == self.first[c] {
+                u64::MAX
+            } else {
+                0
+            };
+            if VARIANCE {
+                let delta = colour[c] - self.running_mean[c];
+                self.running_mean[c] += delta / n;
+                self.m2[c] += delta * (colour[c] - self.running_mean[c]);
+            }
+        }
+    }
+
+    /// The pixel's mean of `spp` samples into `mean`: the sum over the count, except when every
+    /// sample equals the first (in every channel): then that colour exactly, since a sum of
+    /// equal values over their count can be off by an ulp: (0.2 + 0.2 + 0.2) / 3 =
+    /// 0.20000000000000004. When `VARIANCE`, the unbiased variance into `variance`.
+    #[inline(always)]
+    pub(super) fn store<const VARIANCE: bool>(
+        &self,
+        spp: u32,
+        mean: &mut DVec3,
+        variance: Option<&mut DVec3>,
+    ) {
+        let [fx, fy, fz, _] = self.first;
+        let [sx, sy, sz, _] = self.sum;
+        *mean = if self.same[..3].iter().all(|&same| same != 0) {
+            DVec3::new(fx, fy, fz)
+        } else {
+            DVec3::new(sx, sy, sz) / spp as f64
+        };
+        if let (true, Some(variance)) = (VARIANCE, variance) {
+            let [mx, my, mz, _] = self.m2;
+            *variance = if spp > 1 {
+                DVec3::new(mx, my, mz) / (spp - 1) as f64
+            } else {
+                DVec3::ZERO
+            };
+        }
     }
 }
 
 /// Everything a row needs, shared by all rows.
-struct Job<'a, T> {
-    tracer: &'a T,
-    camera: &'a Camera,
-    spp: u32,
-    seed: u64,
+pub(super) struct Job<'a, T> {
+    pub(super) tracer: &'a T,
+    pub(super) camera: &'a Camera,
+    pub(super) spp: u32,
+    pub(super) seed: u64,
     jitter: PixelJitter,
     strata: (u32, u32),
 }
 
 impl<'a, T: Trace> Job<'a, T> {
     /// A job of `spp` samples per pixel through `tracer`.
-    fn new(tracer: &'a T, camera: &'a Camera, spp: u32, seed: u64, jitter: PixelJitter) -> Self {
+    pub(super) fn new(
+        tracer: &'a T,
+        camera: &'a Camera,
+        spp: u32,
+        seed: u64,
+        jitter: PixelJitter,
+    ) -> Self {
         Self {
             tracer,
             camera,
@@ -150,6 +227,28 @@ impl<'a, T: Trace> Job<'a, T> {
             seed,
             jitter,
             strata: strata(spp),
+        }
+    }
+
+    /// Sample `s`'s offset from its pixel's centre, drawn from `sampler` (x, then y) under the
+    /// jitter `JITTER`.
+    #[inline(always)]
+    pub(super) fn offsets<const JITTER: u8>(
+        &self,
+        sampler: &mut PixelSampler,
+        s: u32,
+    ) -> (f64, f64) {
+        let (columns, rows_of_strata) = self.strata;
+        match JITTER {
+            0 => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
+            1 => {
+                let (cx, cy) = ((s % columns) as f64, (s / columns) as f64);
+                (
+                    (cx + sampler.next_f64()) / columns as f64 - 0.5,
+                    (cy + sampler.next_f64()) / rows_of_strata as f64 - 0.5,
+                )
+            }
+            _ => (0.0, 0.0),
         }
     }
 
@@ -184,7 +283,8 @@ impl<'a, T: Trace> Job<'a, T> {
         self.row_any::<VARIANCE>(j, means, variances);
     }
 
-    /// Renders row `j` with the jitter chosen.
+    /// Renders row `j` with the jitter chosen, fixed at compile time so the per-sample loop has
+    /// no branch on it.
     #[inline(always)]
     fn row_any<const VARIANCE: bool>(
         &self,
@@ -193,88 +293,9 @@ impl<'a, T: Trace> Job<'a, T> {
         variances: &mut [DVec3],
     ) {
         match self.jitter {
-            PixelJitter::Uniform => self.row_with::<VARIANCE, 0>(j, means, variances),
-            PixelJitter::Stratified => self.row_with::<VARIANCE, 1>(j, means, variances),
-            PixelJitter::Centre => self.row_with::<VARIANCE, 2>(j, means, variances),
-        }
-    }
-
-    /// The row with the jitter fixed at compile time (`JITTER` 0 uniform, 1 stratified,
-    /// 2 centre), so the per-sample loop has no branch on it.
-    #[inline(always)]
-    fn row_with<const VARIANCE: bool, const JITTER: u8>(
-        &self,
-        j: usize,
-        means: &mut [DVec3],
-        variances: &mut [DVec3],
-    ) {
-        let width = self.camera.width;
-        let (columns, rows_of_strata) = self.strata;
-        let no_ray = Ray::new(self.camera.center, DVec3::ZERO);
-        for (i, mean) in means.iter_mut().enumerate() {
-            let mut sampler = PixelSampler::new(self.seed, (j * width + i) as u64);
-            let mut sum = DVec3::ZERO;
-            let mut lowest = DVec3::INFINITY;
-            let mut highest = DVec3::NEG_INFINITY;
-            let mut running_mean = DVec3::ZERO;
-            let mut m2 = DVec3::ZERO;
-            // The samples in packets of `WIDTH`, drawn and accumulated in order; the lanes of a
-            // last, partial packet past the count repeat its first ray and are not used.
-            let mut first = 0;
-            while first < self.spp {
-                let count = (self.spp - first).min(WIDTH as u32) as usize;
-                let mut rays = [no_ray; WIDTH];
-                for (k, ray) in rays.iter_mut().enumerate().take(count) {
-                    let s = first + k as u32;
-                    let (ox, oy) = match JITTER {
-                        0 => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
-                        1 => {
-                            let (cx, cy) = ((s % columns) as f64, (s / columns) as f64);
-                            (
-                                (cx + sampler.next_f64()) / columns as f64 - 0.5,
-                                (cy + sampler.next_f64()) / rows_of_strata as f64 - 0.5,
-                            )
-                        }
-                        _ => (0.0, 0.0),
-                    };
-                    let disk = if self.camera.defocus {
-                        sampler.in_unit_disk()
-                    } else {
-                        (0.0, 0.0)
-                    };
-                    *ray = self.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
-                }
-                for k in count..WIDTH {
-                    rays[k] = rays[0];
-                }
-                let colours = self.tracer.trace(&rays);
-                for (k, &colour) in colours.iter().enumerate().take(count) {
-                    sum += colour;
-                    lowest = lowest.min(colour);
-                    highest = highest.max(colour);
-                    if VARIANCE {
-                        let delta = colour - running_mean;
-                        running_mean += delta / (first + k as u32 + 1) as f64;
-                        m2 += delta * (colour - running_mean);
-                    }
-                }
-                first += count as u32;
-            }
-            // The sum over the count, except when every sample saw the same colour: then that
-            // colour exactly (a sum of equal values over their count can be off by an ulp:
-            // (0.2 + 0.2 + 0.2) / 3 = 0.20000000000000004).
-            *mean = if lowest == highest {
-                lowest
-            } else {
-                sum / self.spp as f64
-            };
-            if VARIANCE {
-                variances[i] = if self.spp > 1 {
-                    m2 / (self.spp - 1) as f64
-                } else {
-                    DVec3::ZERO
-                };
-            }
+            PixelJitter::Uniform => T::row::<VARIANCE, 0>(self, j, means, variances),
+            PixelJitter::Stratified => T::row::<VARIANCE, 1>(self, j, means, variances),
+            PixelJitter::Centre => T::row::<VARIANCE, 2>(self, j, means, variances),
         }
     }
 
@@ -370,9 +391,30 @@ pub fn render(
     })
 }
 
+/// The film of `job`, row by row on this thread (the dispatch's path), as the bits of its means
+/// then its variances.
+#[cfg(test)]
+pub(super) fn film_bits<T: Trace>(job: &Job<'_, T>) -> Vec<u64> {
+    let (width, height) = (job.camera.width, job.camera.height);
+    let mut mean = vec![DVec3::ZERO; width * height];
+    let mut variance = vec![DVec3::ZERO; width * height];
+    for (j, (means, variances)) in mean
+        .chunks_mut(width)
+        .zip(variance.chunks_mut(width))
+        .enumerate()
+    {
+        job.row::<true>(j, means, variances);
+    }
+    mean.iter()
+        .chain(&variance)
+        .flat_map(|c| c.to_array().map(f64::to_bits))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::packet::WIDTH;
 
     /// Renders every row of `job` with `row` (one of the dispatch's paths).
     fn film_of<T: Trace>(
