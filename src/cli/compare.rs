@@ -4,23 +4,26 @@ use std::process::ExitCode;
 use anyhow::Context;
 use rtoracle::compare::{
     CandidateImage, CompareOptions, Comparison, Encoding, Golden, check_size, compare_image,
-    golden_for_scene, report, write_heatmap, write_report_to,
+    golden_for_scene, golden_spp, report, write_heatmap, write_report_to,
 };
+use rtoracle::image_io::decode_exr;
 
-/// `rtoracle compare CANDIDATE (--scene NAME | --golden FILE.exr) [--spp N] [--encoding E]
+/// `rtoracle compare CANDIDATE (--scene NAME|FILE.toml | --golden FILE.exr) [--spp N] [--encoding E]
 /// [--json] [--heatmap OUT.png] [--report DIR]`
 #[derive(Debug, clap::Args)]
 #[command(group(clap::ArgGroup::new("reference").required(true).args(["scene", "golden"])))]
 pub struct Args {
     /// The image to judge: a PNG (8-bit RGB or RGBA) or an EXR.
     candidate: PathBuf,
-    /// Compare with the golden of this built-in scene (see `rtoracle scenes`).
-    #[arg(long, value_name = "NAME")]
+    /// Compare with the golden of this built-in scene (see `rtoracle scenes`), or of this scene
+    /// file (`.toml`; its golden rendered once and cached, as grading does).
+    #[arg(long, value_name = "NAME|FILE.toml")]
     scene: Option<String>,
     /// Compare with this golden EXR (mean and a `variance` layer).
     #[arg(long, value_name = "FILE.exr")]
     golden: Option<PathBuf>,
-    /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes).
+    /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes; 20 with
+    /// --golden).
     #[arg(long, value_name = "N", value_parser = super::num::spp)]
     spp: Option<u32>,
     /// How the candidate's 8-bit codes encode linear values.
@@ -126,14 +129,41 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (golden, default_spp): (Box<dyn FnOnce(u32) -> anyhow::Result<Golden>>, u32) =
         match (&args.scene, &args.golden) {
             (Some(name), _) => {
-                let description = rtoracle::scene::builtin(name)?;
+                let (_, description) = super::render::load_scene(name)?;
                 let camera = description.camera(None);
                 check_size(&args.candidate, &candidate, camera.width, camera.height)?;
-                let name = name.clone();
-                (
-                    Box::new(move |spp| Ok(golden_for_scene(&name, spp)?)),
-                    description.image.samples_per_pixel,
-                )
+                let default_spp = description.image.samples_per_pixel;
+                if rtoracle::scene::builtin(name).is_ok() {
+                    let name = name.clone();
+                    (
+                        Box::new(move |spp| Ok(golden_for_scene(&name, spp)?)),
+                        default_spp,
+                    )
+                } else {
+                    // A scene file: its golden from the cache, as grading gets it.
+                    let label = Path::new(name)
+                        .file_name()
+                        .map_or_else(|| name.clone(), |n| n.to_string_lossy().to_string());
+                    (
+                        Box::new(move |spp| {
+                            let spp = golden_spp(spp);
+                            let cached = rtoracle::golden::cache_dir()
+                                .map(|d| rtoracle::golden::cache_file(&d, &description, spp));
+                            if !cached.is_some_and(|p| p.is_file()) {
+                                errln!(
+                                    "rendering the golden of {} at {spp} spp (once; it is cached)",
+                                    rtoracle::escape::terminal_line(&label)
+                                );
+                            }
+                            let made =
+                                rtoracle::golden::cached_golden(&description, &label, spp, true)?;
+                            let path = made.path.unwrap_or_else(|| PathBuf::from(&label));
+                            let image = decode_exr(&made.bytes, &path)?;
+                            Ok(Golden::from_exr_image(image, &path)?)
+                        }),
+                        default_spp,
+                    )
+                }
             }
             (None, Some(path)) => {
                 let g = Golden::from_exr(path)?;

@@ -2,6 +2,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use rtoracle::compare::golden_spp;
 use rtoracle::golden::{
     GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_bytes_of,
     golden_file_name,
@@ -28,19 +29,20 @@ pub struct Args {
     /// The folder of the goldens (created when writing).
     #[arg(long, value_name = "DIR", default_value = "golden")]
     dir: PathBuf,
-    /// Samples per pixel.
-    #[arg(long, value_name = "N", default_value_t = GOLDEN_SPP, value_parser = super::num::spp)]
-    spp: u32,
+    /// Samples per pixel (default: 4096 for the built-in scenes; for a scene file, the golden
+    /// its grading uses: max(4096, 100 x the scene's samples_per_pixel)).
+    #[arg(long, value_name = "N", value_parser = super::num::spp)]
+    spp: Option<u32>,
     /// Only these built-in scenes (comma-separated; default: all of them).
     #[arg(long, value_name = "A,B", value_delimiter = ',')]
     scenes: Vec<String>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let spp = args.spp;
     if let (Some(file), Some(out)) = (&args.scene_file, &args.out) {
-        return write_scene_file(file, out, spp);
+        return write_scene_file(file, out, args.spp);
     }
+    let spp = args.spp.unwrap_or(GOLDEN_SPP);
     let scenes: Vec<String> = if args.scenes.is_empty() {
         builtin_names().into_iter().map(String::from).collect()
     } else {
@@ -73,8 +75,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
 }
 
-fn write_scene_file(file: &Path, out: &Path, spp: u32) -> anyhow::Result<ExitCode> {
+fn write_scene_file(file: &Path, out: &Path, spp: Option<u32>) -> anyhow::Result<ExitCode> {
     let description = SceneDescription::from_file(file)?;
+    // The grader's golden of this scene, so that the bytes are the cache's.
+    let spp = spp.unwrap_or_else(|| golden_spp(description.image.samples_per_pixel));
     if out.extension().and_then(|e| e.to_str()) != Some("exr") {
         anyhow::bail!("-o {}: the golden must be an .exr file", out.display());
     }

@@ -6,7 +6,10 @@
 //! It promises: each golden is obtained once per checker (a batch shares one checker) and kept
 //! in memory; a scene file's golden is the rubric's `golden` when it names one, else the one in
 //! the cache ([`crate::golden::cached_golden`]), rendered there the first time (one line on
-//! stderr says so, and indicatif's bar shows the progress when stderr is a terminal).
+//! stderr says so, and indicatif's bar shows the progress when stderr is a terminal). An image
+//! of a scene file is judged as a render of the scene's own `samples_per_pixel` (the count its
+//! students are told to use), with a golden of [`golden_spp`] of it; built-in scenes use the
+//! options' count (20, the course's).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -26,7 +29,9 @@ use crate::image_io::decode_exr;
 /// the cached one; each golden is kept in memory for the whole batch.
 #[derive(Debug, Default)]
 pub struct CompareImageChecker {
-    /// How to compare (samples per pixel, encoding, false-failure rate).
+    /// How to compare (samples per pixel, encoding, false-failure rate). Its samples per pixel
+    /// are the built-in scenes' candidates'; a scene file's candidates are judged at the scene's
+    /// own `samples_per_pixel` instead.
     pub options: CompareOptions,
     /// The golden cache folder for scene files; `None`: [`crate::golden::cache_dir`].
     pub cache_dir: Option<PathBuf>,
@@ -71,11 +76,19 @@ impl CompareImageChecker {
         Ok((golden, sha))
     }
 
+    /// The candidate's samples per pixel for `scene`: a scene file's own, else the options'.
+    fn candidate_spp(&self, scene: &SceneSource) -> u32 {
+        match scene {
+            SceneSource::Builtin(_) => self.options.samples_per_pixel,
+            SceneSource::File(f) => f.description.image.samples_per_pixel,
+        }
+    }
+
     fn file_golden(&self, f: &SceneFile) -> Result<(Golden, String), CompareError> {
         let (bytes, path) = match &f.golden {
             Some(g) => (g.bytes.clone(), g.path.clone()),
             None => {
-                let spp = golden_spp(self.options.samples_per_pixel);
+                let spp = golden_spp(f.description.image.samples_per_pixel);
                 let camera = f.description.camera(None);
                 let dir = self.cache_dir.clone().or_else(crate::golden::cache_dir);
                 let cache_file = dir
@@ -134,7 +147,7 @@ fn file_name(path: &Path) -> String {
 impl ImageChecker for CompareImageChecker {
     fn describe(&self) -> String {
         format!(
-            "noise-aware comparison (rtoracle compare): golden of {} spp, candidate {} spp, {} encoding, per-image false-failure rate {}",
+            "noise-aware comparison (rtoracle compare): golden of {} spp, candidate {} spp (a scene file's: its samples_per_pixel, golden max(4096, 100 x that)), {} encoding, per-image false-failure rate {}",
             golden_spp(self.options.samples_per_pixel),
             self.options.samples_per_pixel,
             self.options.encoding,
@@ -193,7 +206,11 @@ impl ImageChecker for CompareImageChecker {
                 .replace(&format!("{}: ", candidate_png.display()), "");
             return ImageOutcome::unusable(format!("{name} {why}"));
         }
-        let comparison = match compare_image(&candidate, &golden, &self.options) {
+        let options = CompareOptions {
+            samples_per_pixel: self.candidate_spp(scene),
+            ..self.options
+        };
+        let comparison = match compare_image(&candidate, &golden, &options) {
             Ok(c) => c,
             Err(e) => return ImageOutcome::unusable(format!("{name}: {e}")),
         };

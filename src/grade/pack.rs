@@ -10,7 +10,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::rubric::{GroupKind, Rubric};
-use crate::compare::{CompareOptions, golden_spp};
+use crate::compare::golden_spp;
 
 /// The folder of the package (beside `rubric.toml`) holding the scene files and goldens.
 pub const PACKED_SCENES: &str = "rtoracle-scenes";
@@ -38,8 +38,8 @@ pub enum PackError {
 }
 
 /// Packs `rubric` (loaded from `rubric_text`): see the module docs. Missing goldens are rendered
-/// for candidates of the image checker's default samples per pixel, with a progress bar when
-/// stderr is a terminal.
+/// (as the image checker would: for candidates of the scene's own samples per pixel), with a
+/// progress bar when stderr is a terminal.
 pub fn pack_rubric(rubric: &Rubric, rubric_text: &str) -> Result<PackedRubric, PackError> {
     let rewrite = |e: String| PackError::Rewrite(rubric.source.clone(), e);
     let mut table: toml::Table = toml::from_str(rubric_text).map_err(|e| rewrite(e.to_string()))?;
@@ -50,7 +50,6 @@ pub fn pack_rubric(rubric: &Rubric, rubric_text: &str) -> Result<PackedRubric, P
     if groups.len() != rubric.groups.len() {
         return Err(rewrite("its groups differ from the loaded rubric's".into()));
     }
-    let spp = golden_spp(CompareOptions::default().samples_per_pixel);
     let mut files = Vec::new();
     let mut used = BTreeSet::new();
     let mut rendered = 0;
@@ -85,6 +84,7 @@ pub fn pack_rubric(rubric: &Rubric, rubric_text: &str) -> Result<PackedRubric, P
         let golden = match &scene.golden {
             Some(g) => g.bytes.clone(),
             None => {
+                let spp = golden_spp(scene.description.image.samples_per_pixel);
                 let made =
                     crate::golden::cached_golden(&scene.description, &scene.label, spp, true)
                         .map_err(|e| {

@@ -488,3 +488,146 @@ fn check_with_no_argument_checks_the_submission_in_the_current_folder() {
     assert_bad_input(&out, "no RT_object.py in");
     assert!(stderr(&out).contains("--python-course DIR"));
 }
+
+/// A scene file as an instructor writes one: a triangle and a sphere, `spp` samples per pixel.
+fn own_scene(width: usize, aspect_ratio: f64, spp: u32, albedo: [f64; 3]) -> String {
+    format!(
+        "[image]\nwidth = {width}\naspect_ratio = {aspect_ratio:?}\nsamples_per_pixel = {spp}\n\n\
+         [camera]\nlook_from = [0.3, 0.4, 1.0]\nlook_at = [0.0, 0.0, -1.5]\nup = [0.0, 1.0, 0.0]\n\
+         vfov = 60.0\nfocus_distance = 2.5\n\n\
+         [[materials]]\nname = \"tri\"\ntype = \"lambertian\"\nalbedo = {albedo:?}\n\n\
+         [[materials]]\nname = \"ball\"\ntype = \"lambertian\"\nalbedo = [0.2, 0.5, 0.9]\n\n\
+         [[objects]]\ntype = \"triangle\"\na = [-1.0, -0.6, -1.8]\nb = [0.3, -0.7, -1.6]\n\
+         c = [-0.5, 0.8, -1.7]\nmaterial = \"tri\"\n\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0.6, 0.1, -1.4]\nradius = 0.45\n\
+         material = \"ball\"\n"
+    )
+}
+
+/// The image group of `scene` (a file beside the rubric).
+fn image_group(id: &str, scene: &str, points: u32) -> String {
+    format!(
+        "[[group]]\nid = \"image.{id}\"\nname = \"{id}\"\nkind = \"image\"\nscene = \"{scene}\"\n\
+         points = {points}\n\n"
+    )
+}
+
+/// Renders `scene` (a TOML file) into `out` with `tests/fixtures/python/independent_render.py`:
+/// numpy's random numbers and the course's formulas, none of rtoracle's renderer.
+fn independent_render(python: &Path, scene: &Path, out: &Path, seed: u64, flip: bool) {
+    let d = SceneDescription::from_file(scene).unwrap();
+    let json = out.with_extension("json");
+    std::fs::write(&json, serde_json::to_string(&d).unwrap()).unwrap();
+    let mut cmd = std::process::Command::new(python);
+    cmd.arg(crate_dir().join("tests/fixtures/python/independent_render.py"))
+        .arg(&json)
+        .arg(out)
+        .arg(seed.to_string());
+    if flip {
+        cmd.arg("flip-y");
+    }
+    let done = cmd.output().unwrap();
+    assert!(done.status.success(), "{}", stderr(&done));
+    std::fs::remove_file(json).unwrap();
+}
+
+/// Image groups on scene files whose `samples_per_pixel` is not 20 (1 and 50): each image is
+/// compared as a render of its scene's sample count with a golden of `max(4096, 100 N)`
+/// samples, so an honest render made by another program gets full marks (at 1 spp too: judged
+/// as 20 spp, its noise failed every one), a flipped one zero, and `rtoracle golden FILE.toml`
+/// writes by default the golden the cache holds.
+#[test]
+fn honest_independent_renders_of_scene_files_at_1_and_50_spp_get_full_marks_flipped_zero() {
+    let Some(python) =
+        rtoracle::candidate::bench::course_python_or_skip("the independent-render grading test")
+    else {
+        return;
+    };
+    let root = tempfile::tempdir().unwrap();
+    let p = root.path();
+    std::fs::write(p.join("one.toml"), own_scene(120, 1.5, 1, [0.9, 0.3, 0.1])).unwrap();
+    std::fs::write(
+        p.join("fifty.toml"),
+        own_scene(72, 0.75, 50, [0.1, 0.8, 0.3]),
+    )
+    .unwrap();
+    std::fs::write(
+        p.join("r.toml"),
+        format!(
+            "name = \"own\"\nseed = 3\n\n{}{}",
+            image_group("one", "one.toml", 50),
+            image_group("fifty", "fifty.toml", 50)
+        ),
+    )
+    .unwrap();
+    let subs = p.join("subs");
+    for (name, seed, flip) in [
+        ("honest-1", 1, false),
+        ("honest-2", 2, false),
+        ("honest-3", 3, false),
+        ("flipped", 4, true),
+    ] {
+        let dir = subs.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        for scene in ["one", "fifty"] {
+            let toml = p.join(format!("{scene}.toml"));
+            independent_render(
+                &python,
+                &toml,
+                &dir.join(format!("{scene}.png")),
+                seed,
+                flip,
+            );
+        }
+    }
+    let cache = p.join("cache");
+    let out = rtoracle()
+        .current_dir(p)
+        .env("RTORACLE_CACHE_DIR", &cache)
+        .args([
+            "grade", "--batch", "subs", "--rubric", "r.toml", "--out", "out",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("(120x80, 4096 spp)") && stderr(&out).contains("(72x96, 5000 spp)"),
+        "{}",
+        stderr(&out)
+    );
+    for name in ["honest-1", "honest-2", "honest-3", "flipped"] {
+        let report = read_json(&p.join("out").join(name).join("report.json"));
+        let want = if name == "flipped" { 0.0 } else { 50.0 };
+        let s = scores(&report);
+        assert_eq!(
+            s,
+            [
+                ("image.one".to_string(), want, 50.0),
+                ("image.fifty".to_string(), want, 50.0)
+            ],
+            "{name}: {s:?}"
+        );
+        let checks = report["checks"].as_array().unwrap();
+        for (check, spp, golden_spp) in [(&checks[0], 1, 4096), (&checks[1], 50, 5000)] {
+            let m = &check["image"]["metrics"];
+            assert_eq!(
+                (m["candidate_spp"].as_u64(), m["golden_spp"].as_u64()),
+                (Some(spp), Some(golden_spp)),
+                "{name}"
+            );
+        }
+    }
+    // `golden FILE.toml` with no --spp makes the golden a grading of that scene uses.
+    let made = run_in(p, &["golden", "fifty.toml", "-o", "fifty.exr"]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    assert!(
+        String::from_utf8_lossy(&made.stdout).contains("(5000 spp, seed 0,"),
+        "{}",
+        String::from_utf8_lossy(&made.stdout)
+    );
+    let d = SceneDescription::from_file(&p.join("fifty.toml")).unwrap();
+    assert_eq!(
+        std::fs::read(p.join("fifty.exr")).unwrap(),
+        std::fs::read(rtoracle::golden::cache_file(&cache, &d, 5000)).unwrap()
+    );
+}

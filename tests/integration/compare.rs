@@ -643,3 +643,49 @@ fn a_fail_points_to_the_pictures_and_a_reused_report_folder_keeps_nothing_stale(
     assert_bad_input(&out, "notes.txt");
     assert_eq!(std::fs::read(report.join("notes.txt")).unwrap(), b"mine");
 }
+
+/// `--scene FILE.toml` compares with the golden of an instructor's scene file (cached), judging
+/// the candidate at the scene's own samples per pixel: here 1, where a 20-spp claim fails an
+/// honest render. A missing or broken scene file is bad input naming it.
+#[test]
+fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    d.image.width = 64;
+    d.image.samples_per_pixel = 1;
+    std::fs::write(dir.path().join("mine.toml"), d.to_toml()).unwrap();
+    std::fs::write(dir.path().join("broken.toml"), "[image]\nwidth = \n").unwrap();
+    write(
+        dir.path(),
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 1, 5),
+    );
+    write(
+        dir.path(),
+        "flipped.png",
+        &render_with_mistake(&d, Mistake::YFlipped, 1, 5),
+    );
+    let out = compare_cli(dir.path(), &["honest.png", "--scene", "mine.toml"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.starts_with("PASS honest.png: 64x36, 1 spp against a 4096 spp golden of mine.toml"),
+        "{text}"
+    );
+    let out = compare_cli(dir.path(), &["flipped.png", "--scene", "mine.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("y flipped"));
+    assert_bad_input(
+        &compare_cli(dir.path(), &["honest.png", "--scene", "nope.toml"]),
+        "nope.toml",
+    );
+    assert_bad_input(
+        &compare_cli(dir.path(), &["honest.png", "--scene", "broken.toml"]),
+        "broken.toml: malformed scene file",
+    );
+}
