@@ -18,6 +18,12 @@
 //! clearly outside misses, and only lanes too close to an edge to tell run the triangle's own
 //! watertight test. Lanes whose intermediates over- or underflow take the scalar path, lane by
 //! lane.
+//!
+//! For a whole cone of directions (a pixel's footprint, [`Cone`]), [`FixedOrigin::candidates`]
+//! leaves out the spheres and triangles it proves no direction of the cone hits, so that leaving
+//! them out of [`FixedOrigin::closest_packet`] changes no lane's answer, and
+//! [`FixedOrigin::covering`] names the object every direction of the cone is proved to hit when
+//! it is the only candidate left. Both err on the side of "cannot tell".
 
 use glam::DVec3;
 
