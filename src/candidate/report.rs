@@ -51,7 +51,7 @@ pub struct Counts {
     pub not_run: usize,
     /// `ambiguous` vectors (not scored).
     pub ambiguous: usize,
-    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`]).
+    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`](crate::candidate::check::judge_exact)).
     pub ambiguous_passed: usize,
     /// `any` vectors: degenerate or non-finite inputs, where any answer (or an error) is
     /// accepted (not scored).
