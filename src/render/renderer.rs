@@ -395,6 +395,17 @@ pub fn render(
 /// then its variances.
 #[cfg(test)]
 pub(super) fn film_bits<T: Trace>(job: &Job<'_, T>) -> Vec<u64> {
+    film_bits_with(job, |job, j, means, variances| {
+        job.row::<true>(j, means, variances)
+    })
+}
+
+/// [`film_bits`] with each row rendered by `row` (one of the dispatch's paths).
+#[cfg(test)]
+fn film_bits_with<T: Trace>(
+    job: &Job<'_, T>,
+    row: impl Fn(&Job<'_, T>, usize, &mut [DVec3], &mut [DVec3]),
+) -> Vec<u64> {
     let (width, height) = (job.camera.width, job.camera.height);
     let mut mean = vec![DVec3::ZERO; width * height];
     let mut variance = vec![DVec3::ZERO; width * height];
@@ -403,7 +414,7 @@ pub(super) fn film_bits<T: Trace>(job: &Job<'_, T>) -> Vec<u64> {
         .zip(variance.chunks_mut(width))
         .enumerate()
     {
-        job.row::<true>(j, means, variances);
+        row(job, j, means, variances);
     }
     mean.iter()
         .chain(&variance)
@@ -415,29 +426,6 @@ pub(super) fn film_bits<T: Trace>(job: &Job<'_, T>) -> Vec<u64> {
 mod tests {
     use super::*;
     use crate::render::packet::WIDTH;
-
-    /// Renders every row of `job` with `row` (one of the dispatch's paths).
-    fn film_of<T: Trace>(
-        job: &Job<'_, T>,
-        row: impl Fn(&Job<'_, T>, usize, &mut [DVec3], &mut [DVec3]),
-    ) -> (Vec<u64>, Vec<u64>) {
-        let (width, height) = (job.camera.width, job.camera.height);
-        let mut mean = vec![DVec3::ZERO; width * height];
-        let mut variance = vec![DVec3::ZERO; width * height];
-        for (j, (means, variances)) in mean
-            .chunks_mut(width)
-            .zip(variance.chunks_mut(width))
-            .enumerate()
-        {
-            row(job, j, means, variances);
-        }
-        let bits = |v: &[DVec3]| {
-            v.iter()
-                .flat_map(|c| c.to_array().map(f64::to_bits))
-                .collect()
-        };
-        (bits(&mean), bits(&variance))
-    }
 
     /// The pinhole fast path (ray packets, with and without AVX2) renders the film the general
     /// path renders one ray at a time through `Scene::closest`, bit for bit: every built-in scene,
@@ -462,17 +450,18 @@ mod tests {
                 for spp in [1, 3, WIDTH as u32, 7, 20] {
                     let general = Job::new(&scene, &camera, spp, 5, jitter);
                     let fast = Job::new(&pinhole, &camera, spp, 5, jitter);
-                    let expected = film_of(&general, |job, j, m, v| job.row_any::<true>(j, m, v));
+                    let expected =
+                        film_bits_with(&general, |job, j, m, v| job.row_any::<true>(j, m, v));
                     let what = format!("{} {jitter:?} {spp} spp", builtin.name);
                     assert_eq!(
-                        film_of(&fast, |job, j, m, v| job.row_any::<true>(j, m, v)),
+                        film_bits_with(&fast, |job, j, m, v| job.row_any::<true>(j, m, v)),
                         expected,
                         "{what}"
                     );
                     #[cfg(target_arch = "x86_64")]
                     if std::arch::is_x86_feature_detected!("avx2") {
                         assert_eq!(
-                            film_of(&fast, |job, j, m, v| unsafe {
+                            film_bits_with(&fast, |job, j, m, v| unsafe {
                                 job.row_avx2::<true>(j, m, v)
                             }),
                             expected,
