@@ -114,7 +114,8 @@ impl PreparedSphere {
     /// ray heads towards the centre, and its line passes within `|g| sin(theta + half_angle)` of
     /// it, below `r`: the discriminant is positive by a wide margin, and the near root's point is
     /// at least `|g| - r` from the origin, so `t >= (|g| - r) / |d|`, which is asked to be at
-    /// least twice the interval's `1e-6`.
+    /// least twice the interval's `1e-6`. A negative radius is refused (less the slack it stays
+    /// negative), which is safe.
     fn covers(&self, cone: &Cone) -> bool {
         if !self.scale.is_finite() {
             return false;
@@ -540,12 +541,15 @@ enum Bound {
 }
 
 impl Bound {
-    /// The bound of `object` for rays from `origin`. The ball's radius is widened by four
-    /// times the rounding of `center - origin`, so the computed offset can stand for the exact
-    /// one.
+    /// The bound of `object` for rays from `origin`. The ball's radius is the magnitude of the
+    /// object's (a sphere's negative radius is the same surface with its normal flipped: the
+    /// slack added to the signed radius shrank the ball, far from the world's origin below the
+    /// distance of an eye inside the sphere, which every ray hits, and the sphere was ruled out),
+    /// widened by four times the rounding of `center - origin`, so the computed offset can stand
+    /// for the exact one.
     fn of(object: &Prepared, origin: DVec3) -> Self {
         let widened = |center: DVec3, radius: f64| {
-            radius + 4.0 * f64::EPSILON * (center.abs() + origin.abs()).max_element()
+            radius.abs() + 4.0 * f64::EPSILON * (center.abs() + origin.abs()).max_element()
         };
         match object {
             Prepared::Sphere(sphere) if sphere.scale.is_finite() => Bound::Prefiltered {
@@ -578,9 +582,10 @@ impl Bound {
     /// Every direction `d` of the cone is within `half_angle` of the axis, so its line makes an
     /// angle of at least `psi = min(theta - half_angle, pi - theta - half_angle)` with the
     /// ball's centre, `theta` being the axis's angle to it; the line clears the ball when
-    /// `|g| sin(psi) > r`. For a sphere the pre-filter's exact value is
-    /// `|d|^2 (r^2 - |g|^2 sin^2 psi)`, so asking for `|g|^2 sin^2 psi > r^2 + 1e-9 (|g|^2 + r^2)`
-    /// leaves it below `-1e-9 a (|f|^2 + r^2)`, a thousand times the pre-filter's margin and far
+    /// `|g| sin(psi) > r`. For a sphere the pre-filter's exact value is at most
+    /// `|d|^2 (r^2 - |g|^2 sin^2 psi)` (it squares the sphere's radius, whose magnitude is at
+    /// most the ball's `r`: the radius's sign does not matter), so asking for
+    /// `|g|^2 sin^2 psi > r^2 + 1e-9 (|g|^2 + r^2)` leaves it below `-1e-9 a (|f|^2 + r^2)`, a thousand times the pre-filter's margin and far
     /// beyond its rounding. The angles here are computed to about `1e-15` radians; `1e-9` is
     /// taken off `psi` for them.
     fn rules_out(&self, cone: &Cone) -> bool {

@@ -491,4 +491,442 @@ mod tests {
             }
         }
     }
+
+    /// A scene of `shapes`, object `k` with its own albedo.
+    fn scene_of(shapes: Vec<Object>) -> Scene {
+        let n = shapes.len();
+        Scene {
+            objects: shapes
+                .into_iter()
+                .enumerate()
+                .map(|(k, shape)| SceneObject { shape, material: k })
+                .collect(),
+            materials: (0..n)
+                .map(|k| Material::Lambertian {
+                    albedo: DVec3::new(0.01 * (k % 100) as f64, 0.3, 0.9),
+                })
+                .collect(),
+        }
+    }
+
+    /// Whether the pinhole path renders the general path's film, bit for bit.
+    fn same_film(scene: &Scene, camera: &Camera, spp: u32, seed: u64, jitter: PixelJitter) -> bool {
+        let pinhole = Pinhole::new(scene, camera.center);
+        let general = Job::new(scene, camera, spp, seed, jitter);
+        let fast = Job::new(&pinhole, camera, spp, seed, jitter);
+        film_bits(&fast) == film_bits(&general)
+    }
+
+    /// A counterexample found by search: the eye inside a sphere of negative radius (the same
+    /// surface as the positive one, the normal flipped), far from the world's origin. The ball
+    /// that rules a sphere out was its signed radius plus the rounding slack of
+    /// `center - origin`, which shrank it (to 0.28e-3 here, below the eye's 1e-3 from the
+    /// centre): the sphere was ruled out for every pixel and the image was sky, where every
+    /// ray hits the sphere's far side (at `t` about `(1.5e-3 + 1e-3) / |d|`, above `1e-6`).
+    #[test]
+    fn a_negative_sphere_around_the_eye_is_never_ruled_out() {
+        for (eye, offset, radius, focus) in [
+            (DVec3::new(1e12, 0.0, 0.0), 1e-3, -1.5e-3, 100.0),
+            (DVec3::new(1e6, 0.0, 0.0), 1e-9, -1.5e-9, 1e-4),
+        ] {
+            let settings = CameraSettings {
+                look_from: eye.to_array(),
+                look_at: (eye - DVec3::Z).to_array(),
+                up: [0.0, 1.0, 0.0],
+                vfov: 20.0,
+                focus_distance: focus,
+                defocus_angle: 0.0,
+            };
+            let camera = Camera::new(&settings, 8, 1.0);
+            let sphere = Sphere::new(eye + DVec3::new(0.0, offset, 0.0), radius);
+            let scene = scene_of(vec![Object::Sphere(sphere)]);
+            // The general path's own answer: the sphere, for every pixel's centre ray.
+            for (i, j) in [(0, 0), (7, 7), (3, 4)] {
+                let ray = camera.ray_through(i as f64, j as f64, (0.0, 0.0));
+                let hit = scene.closest(&ray, Interval::CAMERA).map(|(_, k)| k);
+                assert_eq!(hit, Some(0), "{eye}: pixel ({i}, {j})");
+            }
+            let pinhole = Pinhole::new(&scene, camera.center);
+            assert!(footprint(&camera, 3, 4).is_some(), "{eye}: no footprint");
+            assert_eq!(pinhole.pixel(&camera, 3, 4).candidates & 1, 1, "{eye}");
+            for jitter in [PixelJitter::Uniform, PixelJitter::Centre] {
+                assert!(same_film(&scene, &camera, 3, 1, jitter), "{eye} {jitter:?}");
+            }
+        }
+    }
+
+    /// A uniform number in `[lo, hi)` from `sampler`.
+    fn uniform(sampler: &mut PixelSampler, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * sampler.next_f64()
+    }
+
+    /// One of `choices`, uniformly.
+    fn one_of<T: Copy>(sampler: &mut PixelSampler, choices: &[T]) -> T {
+        choices[((sampler.next_f64() * choices.len() as f64) as usize).min(choices.len() - 1)]
+    }
+
+    /// A camera at an extreme: up to 1e12 from the world's origin, fields of view from 0.001
+    /// to 179.9 degrees, focus distances from 1e-3 to 1e5, up vectors within 1e-12 of the view
+    /// direction, images of one pixel, tall and narrow, or thousands of pixels in one row.
+    fn extreme_camera(sampler: &mut PixelSampler, widest: usize) -> Camera {
+        let far = one_of(sampler, &[0.0, 1e3, 1e6, 1e9, 1e12]) * one_of(sampler, &[1.0, -1.0]);
+        let mut u = |lo: f64, hi: f64| uniform(sampler, lo, hi);
+        let look_from = DVec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0))
+            + DVec3::new(far, far * u(-1.0, 1.0), far * u(0.0, 1.0));
+        let forward = DVec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize();
+        let near_forward = u(0.0, 1.0) < 0.2;
+        let jiggle = DVec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+        let (distance, focus) = (u(0.1, 10.0), 10f64.powf(u(-3.0, 5.0)));
+        let shape = u(0.0, 5.0) as usize;
+        let (long, short, aspect) = (u(500.0, widest as f64), u(1.0, 40.0), u(0.1, 8.0));
+        let up = if near_forward {
+            let tilt = one_of(sampler, &[1e-3, 1e-6, 1e-9, 1e-12]);
+            (forward + jiggle * tilt).to_array()
+        } else {
+            [jiggle.x * 0.3, 1.0, jiggle.z * 0.3]
+        };
+        let vfov = one_of(
+            sampler,
+            &[
+                0.001, 0.01, 1.0, 30.0, 90.0, 120.0, 170.0, 175.0, 179.0, 179.9,
+            ],
+        );
+        let settings = CameraSettings {
+            look_from: look_from.to_array(),
+            look_at: (look_from + forward * distance).to_array(),
+            up,
+            vfov,
+            focus_distance: focus,
+            defocus_angle: 0.0,
+        };
+        let (width, aspect) = match shape {
+            0 => (long as usize, 1e9),
+            1 => (1, aspect.min(1.0) * 0.2),
+            _ => (short as usize, aspect),
+        };
+        Camera::new(&settings, width, aspect)
+    }
+
+    /// A random scene at the extremes, seen by [`extreme_camera`]: spheres (a third of them
+    /// with negative radii) and triangles from 1e-9 to 1e9 across, some around or tangent to a
+    /// pixel's corner ray, behind the eye or around it; degenerate triangles (collinear, a
+    /// repeated vertex), triangles edge-on to the eye (within 0 to 1e-6 of its plane), big ones
+    /// near the eye; quads; and now and then more than 64 objects.
+    fn extreme_scene(sampler: &mut PixelSampler, widest: usize) -> (Scene, Camera) {
+        let camera = extreme_camera(sampler, widest);
+        let through = |x: f64, y: f64, depth: f64| {
+            let on_plane = camera.pixel00 + x * camera.pixel_delta_u + y * camera.pixel_delta_v;
+            camera.center + (on_plane - camera.center) * depth
+        };
+        let pixel = camera.pixel_delta_u.length();
+        let facing = camera.pixel_delta_u.cross(camera.pixel_delta_v).normalize();
+        let (w, h) = (camera.width as f64, camera.height as f64);
+        let count = if sampler.next_f64() < 0.15 {
+            uniform(sampler, 60.0, 80.0) as usize
+        } else {
+            uniform(sampler, 1.0, 5.0) as usize
+        };
+        let mut objects = Vec::new();
+        for _ in 0..count {
+            let mut u = |lo: f64, hi: f64| uniform(sampler, lo, hi);
+            let (x, y) = (u(-2.0, w + 2.0), u(-2.0, h + 2.0));
+            // Often exactly on a pixel's corner or edge.
+            let (x, y) = if u(0.0, 1.0) < 0.5 {
+                (x.round() - 0.5, y.round() - 0.5)
+            } else {
+                (x, y)
+            };
+            let depth = if u(0.0, 1.0) < 0.1 {
+                -u(0.2, 3.0)
+            } else {
+                10f64.powf(u(-2.0, 2.0))
+            };
+            let size = match u(0.0, 8.0) as usize {
+                0 => 1e-9,
+                1 => 1e9,
+                _ => pixel * depth.abs() * 10f64.powf(u(-3.0, 3.0)),
+            };
+            let sign = if u(0.0, 1.0) < 0.3 { -1.0 } else { 1.0 };
+            let centre = through(x, y, depth);
+            let shape = match u(0.0, 10.0) as usize {
+                0 => Object::Quad(Quad::new(
+                    centre,
+                    camera.pixel_delta_u * u(0.5, 6.0) * depth,
+                    camera.pixel_delta_v * u(0.5, 6.0) * depth,
+                )),
+                1 | 2 => Object::Sphere(Sphere::new(centre, sign * size)),
+                3 if u(0.0, 1.0) < 0.5 => {
+                    // Around the eye.
+                    let off = DVec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)) * size * 0.5;
+                    Object::Sphere(Sphere::new(camera.center + off, sign * size))
+                }
+                3 => {
+                    // Tangent to a pixel corner's ray.
+                    let corner = through(x.round() - 0.5, y.round() - 0.5, 1.0) - camera.center;
+                    let side = corner.cross(camera.pixel_delta_u).normalize();
+                    let c = camera.center + corner * depth.abs() + side * size;
+                    Object::Sphere(Sphere::new(c, sign * size))
+                }
+                4 => {
+                    // Degenerate: collinear, or a repeated vertex.
+                    let b = through(x + u(-3.0, 3.0), y + u(-3.0, 3.0), depth);
+                    let c = if u(0.0, 1.0) < 0.5 {
+                        centre + (b - centre) * u(-1.0, 2.0)
+                    } else {
+                        b
+                    };
+                    Object::Triangle(Triangle::new(centre, b, c))
+                }
+                5 => {
+                    // Edge-on: the eye on, or nearly on, its plane.
+                    let b = through(x + u(-3.0, 3.0), y + u(-3.0, 3.0), depth * u(0.5, 2.0));
+                    let (p, q) = (u(0.1, 3.0), u(0.1, 3.0));
+                    let tilt = one_of(sampler, &[0.0, 1e-12, 1e-9, 1e-6]);
+                    let c = camera.center
+                        + (centre - camera.center) * p
+                        + (b - camera.center) * q
+                        + facing * tilt * (centre - camera.center).length();
+                    Object::Triangle(Triangle::new(centre, b, c))
+                }
+                6 => {
+                    // A big triangle whose plane passes at or near the eye.
+                    let s = size * 100.0;
+                    let n = DVec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                    let base = camera.center + n * one_of(sampler, &[0.0, 1e-9, 1e-3, 1.0]) * s;
+                    Object::Triangle(Triangle::new(
+                        base + DVec3::new(s, 0.0, 0.0).cross(n),
+                        base + DVec3::new(0.0, s, 0.0).cross(n),
+                        base + DVec3::new(0.0, 0.0, s).cross(n),
+                    ))
+                }
+                _ => {
+                    let spread = 10f64.powf(u(-1.0, 2.0));
+                    let mut corner = || {
+                        through(
+                            x + u(-1.0, 1.0) * spread,
+                            y + u(-1.0, 1.0) * spread,
+                            depth * (1.0 + 0.2 * u(-1.0, 1.0)),
+                        )
+                    };
+                    Object::Triangle(Triangle::new(corner(), corner(), corner()))
+                }
+            };
+            objects.push(shape);
+        }
+        (scene_of(objects), camera)
+    }
+
+    /// `scenes` extreme scenes ([`extreme_scene`]) from stream `seed`: the pinhole path renders
+    /// the general path's film bit for bit (spp 1 to 20, every jitter), and every footprint
+    /// holds its pixel's samples (the corners and random offsets, as the renderer computes
+    /// them). Returns the pixels counted, culled and covered.
+    fn extreme_films(scenes: usize, seed: u64, widest: usize) -> (usize, usize, usize) {
+        let mut sampler = PixelSampler::new(seed, 77);
+        let (mut pixels, mut culled, mut covered) = (0, 0, 0);
+        for number in 0..scenes {
+            let (scene, camera) = extreme_scene(&mut sampler, widest);
+            let spp = uniform(&mut sampler, 1.0, 21.0) as u32;
+            let jitter = one_of(
+                &mut sampler,
+                &[
+                    PixelJitter::Uniform,
+                    PixelJitter::Stratified,
+                    PixelJitter::Centre,
+                ],
+            );
+            let pinhole = Pinhole::new(&scene, camera.center);
+            let all = match scene.objects.len() {
+                n @ 0..64 => (1 << n) - 1,
+                _ => u64::MAX,
+            };
+            for j in 0..camera.height {
+                for i in 0..camera.width {
+                    let pixel = pinhole.pixel(&camera, i, j);
+                    culled += usize::from(pixel.candidates & all != all);
+                    covered += usize::from(pixel.covering.is_some());
+                    pixels += 1;
+                    let Some(cone) = footprint(&camera, i, j) else {
+                        continue;
+                    };
+                    for k in 0..8 {
+                        let (ox, oy) = match k {
+                            0..4 => ((k % 2) as f64 - 0.5, (k / 2) as f64 - 0.5),
+                            _ => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
+                        };
+                        let d = camera
+                            .ray_through(i as f64 + ox, j as f64 + oy, (0.0, 0.0))
+                            .direction;
+                        let angle = cone.axis.cross(d).length().atan2(cone.axis.dot(d));
+                        let a = d.dot(d);
+                        assert!(
+                            angle <= cone.half_angle
+                                && (cone.length2_min..=cone.length2_max).contains(&a),
+                            "scene {number}, pixel ({i}, {j}): {d} outside {cone:?} {camera:?}"
+                        );
+                    }
+                }
+            }
+            assert!(
+                same_film(&scene, &camera, spp, number as u64, jitter),
+                "scene {number} ({spp} spp, {jitter:?}): {scene:?} {camera:?}"
+            );
+        }
+        (pixels, culled, covered)
+    }
+
+    /// The pinhole path keeps the general path's film at the extremes (see [`extreme_films`]),
+    /// and the scenes do exercise the culling and the covering.
+    #[test]
+    fn footprints_keep_the_film_in_extreme_scenes() {
+        let (pixels, culled, covered) = extreme_films(150, 1, 1200);
+        assert!(culled * 10 > pixels, "{culled} of {pixels} pixels culled");
+        assert!(covered > 20, "{covered} of {pixels} pixels covered");
+    }
+
+    /// [`footprints_keep_the_film_in_extreme_scenes`] at length (about a minute in release):
+    /// `cargo test --release --lib extreme_scenes_at_length -- --ignored`.
+    #[test]
+    #[ignore]
+    fn footprints_keep_the_film_in_extreme_scenes_at_length() {
+        for seed in 2..8 {
+            extreme_films(500, seed, 3000);
+        }
+    }
+
+    /// The directions of samples on the border of pixel `(i, j)`'s square, as the renderer
+    /// computes them.
+    fn border(camera: &Camera, i: usize, j: usize) -> Vec<DVec3> {
+        let n = 24;
+        (0..=n)
+            .flat_map(|k| {
+                let t = k as f64 / n as f64 - 0.5;
+                [(t, -0.5), (t, 0.5), (-0.5, t), (0.5, t)]
+            })
+            .map(|(ox, oy)| {
+                camera
+                    .ray_through(i as f64 + ox, j as f64 + oy, (0.0, 0.0))
+                    .direction
+            })
+            .collect()
+    }
+
+    /// `cameras` extreme cameras, each with a sphere (of either sign) or a triangle facing it
+    /// near one pixel, grown from 1e-12 to 1e12 times its distance: at each size where the
+    /// object starts or stops being ruled out, or covering the pixel (found by bisection, to
+    /// the last bit), the general path agrees with the claim on the pixel's border (where a
+    /// round or convex object's hits and misses change). Returns the thresholds checked.
+    fn thresholds(cameras: usize, seed: u64) -> (usize, usize) {
+        let mut sampler = PixelSampler::new(seed, 78);
+        let (mut ruled, mut covered) = (0, 0);
+        for number in 0..cameras {
+            let camera = extreme_camera(&mut sampler, 3000);
+            let mut u = |lo: f64, hi: f64| uniform(&mut sampler, lo, hi);
+            let i = (u(0.0, 1.0) * camera.width as f64) as usize;
+            let j = (u(0.0, 1.0) * camera.height as f64) as usize;
+            let depth = 10f64.powf(u(-3.0, 3.0));
+            let (dx, dy) = (u(-3.0, 3.0), u(-3.0, 3.0));
+            let sign = if u(0.0, 1.0) < 0.3 { -1.0 } else { 1.0 };
+            let sphere = u(0.0, 1.0) < 0.5;
+            let Some(cone) = footprint(&camera, i, j) else {
+                continue;
+            };
+            let target = camera.ray_through(i as f64 + dx, j as f64 + dy, (0.0, 0.0));
+            let centre = camera.center + target.direction * depth;
+            let object = |size: f64| {
+                if sphere {
+                    return Object::Sphere(Sphere::new(centre, sign * size));
+                }
+                let (a, b) = (
+                    camera.pixel_delta_u.normalize() * size,
+                    camera.pixel_delta_v.normalize() * size,
+                );
+                let k = 0.75f64.sqrt();
+                Object::Triangle(Triangle::new(
+                    centre + a,
+                    centre - a * 0.5 + b * k,
+                    centre - a * 0.5 - b * k,
+                ))
+            };
+            // (ruled out, covering) at `size`.
+            let claims = |size: f64| {
+                let scene = scene_of(vec![object(size)]);
+                let prepared = FixedOrigin::new(&scene, camera.center);
+                let candidates = prepared.candidates(&cone);
+                [
+                    candidates & 1 == 0,
+                    prepared.covering(&cone, candidates).is_some(),
+                ]
+            };
+            let directions = border(&camera, i, j);
+            let hits = |size: f64| {
+                let scene = scene_of(vec![object(size)]);
+                directions
+                    .iter()
+                    .map(|&d| {
+                        let ray = crate::geometry::Ray::new(camera.center, d);
+                        scene.closest(&ray, Interval::CAMERA).is_some()
+                    })
+                    .collect::<Vec<bool>>()
+            };
+            let sizes: Vec<f64> = (0..=96)
+                .map(|k| depth * 10f64.powf(-12.0 + 24.0 * k as f64 / 96.0))
+                .collect();
+            let states: Vec<[bool; 2]> = sizes.iter().map(|&s| claims(s)).collect();
+            for step in 0..sizes.len() - 1 {
+                for which in 0..2 {
+                    let before = states[step][which];
+                    if before == states[step + 1][which] {
+                        continue;
+                    }
+                    let (mut lo, mut hi) = (sizes[step], sizes[step + 1]);
+                    loop {
+                        let middle = 0.5 * (lo + hi);
+                        if middle == lo || middle == hi {
+                            break;
+                        }
+                        if claims(middle)[which] == before {
+                            lo = middle;
+                        } else {
+                            hi = middle;
+                        }
+                    }
+                    let size = if before { lo } else { hi };
+                    let hits = hits(size);
+                    let wrong = if which == 0 {
+                        ruled += 1;
+                        hits.iter().any(|&hit| hit)
+                    } else {
+                        covered += 1;
+                        !hits.iter().all(|&hit| hit)
+                    };
+                    assert!(
+                        !wrong,
+                        "camera {number}, pixel ({i}, {j}): {} at size {size}: {:?} {camera:?}",
+                        ["ruled out", "covering"][which],
+                        object(size)
+                    );
+                }
+            }
+        }
+        (ruled, covered)
+    }
+
+    /// Ruling out and covering hold at their very thresholds (see [`thresholds`]).
+    #[test]
+    fn culling_holds_at_its_thresholds() {
+        let (ruled, covered) = thresholds(150, 1);
+        assert!(
+            ruled > 40 && covered > 40,
+            "{ruled} and {covered} thresholds"
+        );
+    }
+
+    /// [`culling_holds_at_its_thresholds`] at length (about a minute in release).
+    #[test]
+    #[ignore]
+    fn culling_holds_at_its_thresholds_at_length() {
+        for seed in 2..6 {
+            thresholds(4000, seed);
+        }
+    }
 }
