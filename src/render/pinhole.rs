@@ -474,21 +474,38 @@ mod tests {
                     let Some(cone) = footprint(&camera, i, j) else {
                         continue;
                     };
-                    for k in 0..12 {
-                        let (ox, oy) = match k {
-                            0..4 => ((k % 2) as f64 - 0.5, (k / 2) as f64 - 0.5),
-                            _ => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
-                        };
-                        let d = camera
-                            .ray_through(i as f64 + ox, j as f64 + oy, (0.0, 0.0))
-                            .direction;
-                        let angle = cone.axis.cross(d).length().atan2(cone.axis.dot(d));
-                        assert!(angle <= cone.half_angle, "{angle} > {}", cone.half_angle);
-                        let a = d.dot(d);
-                        assert!((cone.length2_min..=cone.length2_max).contains(&a));
-                    }
+                    assert_cone_holds_samples(&camera, (i, j), &cone, &mut sampler, 8, "");
                 }
             }
+        }
+    }
+
+    /// Asserts that `cone` holds the directions of pixel `(i, j)`'s samples as the renderer
+    /// computes them: at the four corners of its square, then at `random` offsets drawn from
+    /// `sampler`. `what` names the case in the message.
+    fn assert_cone_holds_samples(
+        camera: &Camera,
+        (i, j): (usize, usize),
+        cone: &Cone,
+        sampler: &mut PixelSampler,
+        random: usize,
+        what: &str,
+    ) {
+        for k in 0..4 + random {
+            let (ox, oy) = match k {
+                0..4 => ((k % 2) as f64 - 0.5, (k / 2) as f64 - 0.5),
+                _ => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
+            };
+            let d = camera
+                .ray_through(i as f64 + ox, j as f64 + oy, (0.0, 0.0))
+                .direction;
+            let angle = cone.axis.cross(d).length().atan2(cone.axis.dot(d));
+            let a = d.dot(d);
+            assert!(
+                angle <= cone.half_angle && (cone.length2_min..=cone.length2_max).contains(&a),
+                "{what} pixel ({i}, {j}): {d} (at {angle} rad, length^2 {a}) outside {cone:?} \
+                 {camera:?}"
+            );
         }
     }
 
@@ -748,22 +765,8 @@ mod tests {
                     let Some(cone) = footprint(&camera, i, j) else {
                         continue;
                     };
-                    for k in 0..8 {
-                        let (ox, oy) = match k {
-                            0..4 => ((k % 2) as f64 - 0.5, (k / 2) as f64 - 0.5),
-                            _ => (sampler.next_f64() - 0.5, sampler.next_f64() - 0.5),
-                        };
-                        let d = camera
-                            .ray_through(i as f64 + ox, j as f64 + oy, (0.0, 0.0))
-                            .direction;
-                        let angle = cone.axis.cross(d).length().atan2(cone.axis.dot(d));
-                        let a = d.dot(d);
-                        assert!(
-                            angle <= cone.half_angle
-                                && (cone.length2_min..=cone.length2_max).contains(&a),
-                            "scene {number}, pixel ({i}, {j}): {d} outside {cone:?} {camera:?}"
-                        );
-                    }
+                    let what = format!("scene {number}");
+                    assert_cone_holds_samples(&camera, (i, j), &cone, &mut sampler, 4, &what);
                 }
             }
             assert!(
