@@ -333,6 +333,28 @@ mod tests {
     use crate::grade::inputs::{FailureKind, FailureSummary};
     use crate::grade::run::fakes::*;
 
+    /// Makes a submission folder with fake images for each of `names` in a new temporary
+    /// folder and grades them as a batch with `code` (JSON reports into its `out`). Returns the
+    /// folder (kept alive), the output folder and the entries.
+    fn batch_of(names: &[&str], code: &FakeCode) -> (tempfile::TempDir, PathBuf, Vec<BatchEntry>) {
+        let dir = tempfile::tempdir().unwrap();
+        for name in names {
+            std::fs::create_dir(dir.path().join(name)).unwrap();
+            fake_images(&dir.path().join(name));
+        }
+        let out = dir.path().join("out");
+        let entries = grade_batch(
+            dir.path(),
+            &Rubric::week04(),
+            code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        (dir, out, entries)
+    }
+
     /// Ties are shared between shapes: with ten sphere vectors and two quad vectors all failed
     /// by 3 submissions, the ten listed include both quad ones (alphabetically "quad-" came
     /// after every "a-sphere-" id and was never listed).
@@ -360,11 +382,6 @@ mod tests {
     /// shows its 5 simplest failures; both fail 8 vectors).
     #[test]
     fn the_summary_counts_every_failed_vector_not_only_those_shown() {
-        let dir = tempfile::tempdir().unwrap();
-        for name in ["a", "b"] {
-            std::fs::create_dir(dir.path().join(name)).unwrap();
-            fake_images(&dir.path().join(name));
-        }
         let mut code = FakeCode::new(counts(10, 2), counts(2, 2));
         code.failures = (0..8)
             .map(|i| FailureSummary {
@@ -379,16 +396,7 @@ mod tests {
                 repro: String::new(),
             })
             .collect();
-        let out = dir.path().join("out");
-        grade_batch(
-            dir.path(),
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &out,
-            &[Format::Json],
-        )
-        .unwrap();
+        let (_dir, out, _) = batch_of(&["a", "b"], &code);
         let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
         let report = std::fs::read_to_string(out.join("a/report.json")).unwrap();
         let shown = report.matches("\"sphere-x-").count();
@@ -409,22 +417,8 @@ mod tests {
     /// graded and the batch's files written.
     #[test]
     fn a_submission_named_like_the_batch_s_report_is_an_error_row() {
-        let dir = tempfile::tempdir().unwrap();
-        for name in ["a", "summary.md", "gradebook.csv"] {
-            std::fs::create_dir(dir.path().join(name)).unwrap();
-            fake_images(&dir.path().join(name));
-        }
         let code = FakeCode::new(counts(2, 2), counts(2, 2));
-        let out = dir.path().join("out");
-        let entries = grade_batch(
-            dir.path(),
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &out,
-            &[Format::Json],
-        )
-        .unwrap();
+        let (_dir, out, entries) = batch_of(&["a", "summary.md", "gradebook.csv"], &code);
         assert_eq!(entries.len(), 3);
         for e in &entries {
             assert_eq!(
@@ -447,23 +441,9 @@ mod tests {
 
     #[test]
     fn a_panicking_submission_does_not_stop_the_batch() {
-        let dir = tempfile::tempdir().unwrap();
-        for name in ["a", "b", "c"] {
-            std::fs::create_dir(dir.path().join(name)).unwrap();
-            fake_images(&dir.path().join(name));
-        }
         let mut code = FakeCode::new(counts(2, 1), counts(2, 2));
         code.panic_on = Some("b".into());
-        let out = dir.path().join("out");
-        let entries = grade_batch(
-            dir.path(),
-            &Rubric::week04(),
-            &code,
-            &all_pass(),
-            &out,
-            &[Format::Json],
-        )
-        .unwrap();
+        let (_dir, out, entries) = batch_of(&["a", "b", "c"], &code);
         // The output folder inside the batch folder is not taken for a submission.
         assert_eq!(
             entries.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(),
