@@ -42,21 +42,24 @@ pub fn allocate() -> u32 {
     uid
 }
 
+/// Every process `/proc` lists now: its id and its `/proc/<pid>` folder (none when `/proc`
+/// cannot be read).
+pub(crate) fn proc_entries() -> impl Iterator<Item = (u32, std::path::PathBuf)> {
+    std::fs::read_dir("/proc")
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|entry| {
+            let pid = entry.file_name().to_str()?.parse::<u32>().ok()?;
+            Some((pid, entry.path()))
+        })
+}
+
 /// The ids of the running (not zombie) processes whose real uid is `uid`.
 pub fn processes_of(uid: u32) -> Vec<u32> {
-    let Ok(entries) = std::fs::read_dir("/proc") else {
-        return Vec::new();
-    };
     let mut found = Vec::new();
-    for entry in entries.flatten() {
-        let Some(pid) = entry
-            .file_name()
-            .to_str()
-            .and_then(|s| s.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        let Ok(status) = std::fs::read_to_string(entry.path().join("status")) else {
+    for (pid, proc_dir) in proc_entries() {
+        let Ok(status) = std::fs::read_to_string(proc_dir.join("status")) else {
             continue;
         };
         let mut real = None;

@@ -109,9 +109,6 @@ fn status_number(status: &str, key: &str) -> Option<u64> {
 /// Measures the processes of `members` (see [`ProcessUsage`]).
 pub fn process_usage(members: &Members) -> ProcessUsage {
     let mut usage = ProcessUsage::default();
-    let Ok(entries) = std::fs::read_dir("/proc") else {
-        return usage;
-    };
     let set = |list: &Arc<Mutex<Vec<i32>>>| list.lock().map(|l| l.clone()).unwrap_or_default();
     let sessions = match members {
         Members::Sessions(list) => set(list),
@@ -122,15 +119,7 @@ pub fn process_usage(members: &Members) -> ProcessUsage {
         _ => Vec::new(),
     };
     let mut files = std::collections::HashSet::new();
-    for entry in entries.flatten() {
-        let Some(pid) = entry
-            .file_name()
-            .to_str()
-            .and_then(|s| s.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        let proc_dir = entry.path();
+    for (pid, proc_dir) in super::identity::proc_entries() {
         let member = match members {
             Members::Uid(_) => true,
             Members::PidNamespaces(_) => std::fs::read_link(proc_dir.join("ns/pid"))
