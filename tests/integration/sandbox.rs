@@ -539,6 +539,17 @@ fn grade_in(mode: &str, dir: &Path) -> (Output, String) {
     grade_as(mode, dir, false)
 }
 
+/// Asserts that grading in `mode` ended with exit 0 and a report that says `why` (the
+/// sandbox's message to the student), showing the start of the report otherwise.
+fn assert_stopped(mode: &str, out: &Output, report: &str, why: &str) {
+    assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(out));
+    assert!(
+        report.contains(why),
+        "{mode}: no {why:?} in {}",
+        report.chars().take(3000).collect::<String>()
+    );
+}
+
 /// [`grade_in`], by user `nobody` when `as_nobody` (a grader that is not root).
 fn grade_as(mode: &str, dir: &Path, as_nobody: bool) -> (Output, String) {
     let out_dir = tempfile::tempdir().unwrap();
@@ -669,11 +680,11 @@ _t.sleep(3)
     );
     for mode in ["auto", "uid"] {
         let (out, report) = grade_in(mode, sub.path());
-        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
-        assert!(
-            report.contains("the sandbox stopped it: it wrote more than 64 MiB"),
-            "{mode}: {}",
-            &report[..report.len().min(3000)]
+        assert_stopped(
+            mode,
+            &out,
+            &report,
+            "the sandbox stopped it: it wrote more than 64 MiB",
         );
     }
 }
@@ -707,11 +718,11 @@ _t.sleep(4)
     ] {
         let (out, report) = grade_as(mode, sub.path(), as_nobody);
         let mode = format!("{mode} nobody={as_nobody}");
-        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
-        assert!(
-            report.contains("the sandbox stopped it: its processes held more than 1 GiB"),
-            "{mode}: {}",
-            &report[..report.len().min(3000)]
+        assert_stopped(
+            &mode,
+            &out,
+            &report,
+            "the sandbox stopped it: its processes held more than 1 GiB",
         );
     }
 }
