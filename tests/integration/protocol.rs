@@ -51,9 +51,11 @@ fn misses() -> Vec<Case> {
         .collect()
 }
 
+/// A case timeout far above what any answer here takes, even on a loaded machine: a test
+/// that finishes well under it was decided when the line came, not by a timeout.
 fn options() -> RunOptions {
     RunOptions {
-        timeout: Duration::from_millis(1500),
+        timeout: Duration::from_secs(10),
         hello_timeout: Duration::from_secs(5),
         ..RunOptions::default()
     }
@@ -91,8 +93,8 @@ fn assert_protocol_errors(mode: &str, blamed: &[usize], needle: &str) {
         "{mode}: {}",
         r.failures[0].message
     );
-    // Decided when the line came, not after a timeout of 1.5 s.
-    assert!(took < Duration::from_millis(1400), "{mode} took {took:?}");
+    // Decided when the line came, not after the 10 s case timeout.
+    assert!(took < Duration::from_secs(8), "{mode} took {took:?}");
 }
 
 #[test]
@@ -247,22 +249,23 @@ fn past_the_time_budget_the_rest_is_not_run_and_the_report_says_why() {
         return;
     }
     let cases = misses();
-    // Each answer takes 0.3 s, under the 1.5 s case timeout; the budget allows about 5.
+    // Each answer takes 0.3 s, under the case timeout; the budget allows about 10, where all
+    // 60 would take 18 s.
     let options = RunOptions {
-        budget: Some(Duration::from_millis(1500)),
+        budget: Some(Duration::from_secs(3)),
         ..options()
     };
     let start = Instant::now();
     let r = check_command(adapter("slow '*' 0.3"), &cases, options).unwrap();
     let took = start.elapsed();
-    assert!(took < Duration::from_secs(4), "took {took:?}");
+    assert!(took < Duration::from_secs(8), "took {took:?}");
     let c = r.counts;
-    assert!(c.passed >= 1 && c.passed <= 5, "{}", r.to_text(3));
+    assert!(c.passed >= 1 && c.passed <= 10, "{}", r.to_text(3));
     assert_eq!(c.not_run, cases.len() - c.passed);
     assert_eq!((c.timeouts, c.errors, c.failed), (0, 0, 0));
     let text = r.to_text(3);
     assert!(
-        text.contains("the submission's 1.5 s budget for code checks was used up"),
+        text.contains("the submission's 3 s budget for code checks was used up"),
         "{text}"
     );
 }
