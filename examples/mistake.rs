@@ -1,6 +1,7 @@
 //! Renders a built-in scene with one of the common mistakes injected, as a course-encoded PNG:
 //! `cargo run --release --example mistake -- SCENE MISTAKE OUT.png [SEED]`.
-//! MISTAKE is one of: honest, no-gamma, gamma22, albedo, half-pixel, jitter01, flip-y, bgr,
+//! MISTAKE is one of: honest, no-gamma, gamma22, albedo, half-pixel, jitter01, flip-y, flip-x,
+//! bgr,
 //! fov, missing, sky.
 
 use rtoracle::compare::mistakes::{Mistake, render_with_mistake};
@@ -18,6 +19,7 @@ fn main() -> anyhow::Result<()> {
         "half-pixel" => Mistake::HalfPixelShift,
         "jitter01" => Mistake::JitterZeroOne,
         "flip-y" => Mistake::YFlipped,
+        "flip-x" => Mistake::XFlipped,
         "bgr" => Mistake::Bgr,
         "fov" => Mistake::WiderFov,
         "missing" => Mistake::ObjectMissing,

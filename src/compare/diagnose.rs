@@ -21,6 +21,7 @@ fn encoding_mistake(e: Encoding, asked: Encoding) -> String {
     }
 }
 
+/// The image with its rows in reverse order.
 fn flip_y(c: &CandidateImage) -> CandidateImage {
     match c {
         CandidateImage::Rgb8 {
@@ -45,6 +46,38 @@ fn flip_y(c: &CandidateImage) -> CandidateImage {
             width: *width,
             height: *height,
             data: data.chunks_exact(*width).rev().flatten().copied().collect(),
+        },
+    }
+}
+
+/// The image with each row's pixels in reverse order (mirrored left to right).
+fn flip_x(c: &CandidateImage) -> CandidateImage {
+    match c {
+        CandidateImage::Rgb8 {
+            width,
+            height,
+            data,
+        } => CandidateImage::Rgb8 {
+            width: *width,
+            height: *height,
+            data: data
+                .chunks_exact(3 * width)
+                .flat_map(|row| row.chunks_exact(3).rev().flatten())
+                .copied()
+                .collect(),
+        },
+        CandidateImage::Linear {
+            width,
+            height,
+            data,
+        } => CandidateImage::Linear {
+            width: *width,
+            height: *height,
+            data: data
+                .chunks_exact(*width)
+                .flat_map(|row| row.iter().rev())
+                .copied()
+                .collect(),
         },
     }
 }
@@ -78,6 +111,7 @@ fn bgr(c: &CandidateImage) -> CandidateImage {
 enum Try {
     Encoding(Encoding),
     FlipY,
+    FlipX,
     Bgr,
     Shift(i32),
 }
@@ -97,7 +131,13 @@ pub fn diagnose(
             tries.push(Try::Encoding(e));
         }
     }
-    tries.extend([Try::FlipY, Try::Bgr, Try::Shift(1), Try::Shift(-1)]);
+    tries.extend([
+        Try::FlipY,
+        Try::FlipX,
+        Try::Bgr,
+        Try::Shift(1),
+        Try::Shift(-1),
+    ]);
     // The hypotheses are independent: evaluate them in parallel (each is deterministic).
     let mut scores: Vec<HypothesisScore> = tries
         .par_iter()
@@ -113,6 +153,12 @@ pub fn diagnose(
                     "fits the golden upside down: rows written bottom to top (y flipped)"
                         .to_string(),
                     evaluate(&flip_y(candidate), golden, asked, options),
+                ),
+                Try::FlipX => (
+                    "flip-x".to_string(),
+                    "fits the golden mirrored left to right: columns written right to left, or the camera's horizontal axis reversed (x flipped)"
+                        .to_string(),
+                    evaluate(&flip_x(candidate), golden, asked, options),
                 ),
                 Try::Bgr => (
                     "bgr".to_string(),
@@ -159,7 +205,7 @@ pub fn diagnose(
             s.mistake,
             100.0 * (1.0 - s.misfit_ratio)
         ),
-        None => "no common mistake explains the image (tried other encodings, y flipped, BGR, half-pixel shifts): look at the failing regions".into(),
+        None => "no common mistake explains the image (tried other encodings, y flipped, x flipped, BGR, half-pixel shifts): look at the failing regions".into(),
     };
     Diagnosis {
         summary,

@@ -26,6 +26,11 @@ pub enum Mistake {
     JitterZeroOne,
     /// Rows written bottom to top.
     YFlipped,
+    /// Each row written right to left: the image mirrored left to right, as a camera whose
+    /// horizontal axis points the wrong way (`u = cross(w, vup)`) renders it. Not in
+    /// [`MUST_FAIL`]: a scene symmetric about its vertical midline (the course's sphere scene)
+    /// looks the same mirrored, and rightly passes.
+    XFlipped,
     /// Channels written in BGR order.
     Bgr,
     /// The vertical field of view 5% wider.
@@ -61,6 +66,7 @@ impl Mistake {
             Mistake::HalfPixelShift => "half-pixel camera shift",
             Mistake::JitterZeroOne => "jitter in [0, 1)",
             Mistake::YFlipped => "y flipped",
+            Mistake::XFlipped => "x flipped",
             Mistake::Bgr => "BGR order",
             Mistake::WiderFov => "field of view +5%",
             Mistake::ObjectMissing => "one object missing",
@@ -153,6 +159,12 @@ pub fn render_with_mistake(
     if mistake == Mistake::YFlipped {
         rows.reverse();
     }
+    if mistake == Mistake::XFlipped {
+        for row in &mut rows {
+            let mirrored: Vec<u8> = row.chunks_exact(3).rev().flatten().copied().collect();
+            *row = mirrored;
+        }
+    }
     let mut data: Vec<u8> = rows.into_iter().flatten().collect();
     if mistake == Mistake::Bgr {
         for p in data.chunks_exact_mut(3) {
@@ -200,5 +212,13 @@ mod tests {
         assert_eq!(honest.data[..row], flipped.data[flipped.data.len() - row..]);
         assert_eq!(honest.data[0], bgr.data[2]);
         assert_eq!(honest.data[2], bgr.data[0]);
+        // Mirrored: pixel i of each row is pixel 15 - i of the honest row, every channel kept.
+        let mirrored = render_with_mistake(&d, Mistake::XFlipped, 2, 1);
+        for (h, m) in honest.data.chunks_exact(row).zip(mirrored.data.chunks_exact(row)) {
+            for i in 0..16 {
+                assert_eq!(h[3 * i..3 * i + 3], m[3 * (15 - i)..3 * (15 - i) + 3]);
+            }
+        }
+        assert_ne!(honest.data, mirrored.data, "the quad scene is not symmetric");
     }
 }

@@ -250,7 +250,7 @@ pub struct NoiseCheck {
 /// One alternative hypothesis the diagnosis tried.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HypothesisScore {
-    /// Short name (`encoding:linear`, `flip-y`, `bgr`, `shift:+0.5`, `shift:-0.5`).
+    /// Short name (`encoding:linear`, `flip-y`, `flip-x`, `bgr`, `shift:+0.5`, `shift:-0.5`).
     pub name: String,
     /// The mistake it stands for, in words.
     pub mistake: String,

@@ -172,6 +172,48 @@ fn every_must_fail_mistake_fails_and_is_diagnosed() {
     }
 }
 
+/// A render mirrored left to right is named "x flipped" where the scene is not symmetric, and
+/// passes where it is. The course's sphere scene looks the same in a mirror (a metamorphic
+/// relation, not a value from our own output): its spheres at x = -1 and x = 1 have the same
+/// albedo, the others are centred on x = 0, the camera looks down -z with y up, and the only
+/// asymmetry, the hollow inside the left sphere, is behind a diffuse surface no ray crosses.
+/// The quad scene's left and right quads are red and blue.
+#[test]
+fn a_mirrored_render_is_diagnosed_x_flipped_unless_the_scene_is_symmetric() {
+    for scene in COURSE_SCENES {
+        let d = rtoracle::scene::builtin(scene).unwrap();
+        let c = compare(scene, render_with_mistake(&d, Mistake::XFlipped, 20, 41));
+        if scene == "week04-sphere" {
+            assert!(
+                c.passed(),
+                "{scene}: a mirror image of a symmetric scene failed"
+            );
+            continue;
+        }
+        assert!(!c.passed(), "{scene}: a mirrored render passed");
+        let diagnosis = c.diagnosis.as_ref().unwrap();
+        assert_eq!(
+            diagnosis.best.as_deref(),
+            Some("flip-x"),
+            "{scene}: {}",
+            diagnosis.summary
+        );
+        assert!(diagnosis.hypotheses[0].passes, "{scene}");
+        assert!(
+            diagnosis.summary.contains("x flipped"),
+            "{}",
+            diagnosis.summary
+        );
+    }
+    // And a y-flipped render is not taken for a mirrored one.
+    let d = rtoracle::scene::builtin("week04-quad").unwrap();
+    let c = compare(
+        "week04-quad",
+        render_with_mistake(&d, Mistake::YFlipped, 20, 41),
+    );
+    assert_eq!(c.diagnosis.unwrap().best.as_deref(), Some("flip-y"));
+}
+
 /// The half-pixel shift is found where it is: in boxes along the objects' edges, not over the
 /// flat inside of the back quad, and by the tiles (edge pixels at 20 spp are too noisy for the
 /// pixel scale alone).
