@@ -304,4 +304,38 @@ mod tests {
             assert_eq!(back, d, "{}", s.name);
         }
     }
+
+    /// `up`, `focus_distance` and `defocus_angle` may be left out of a scene file: the scene is
+    /// then the one with the book's values (`vup = (0, 1, 0)`, `focus_dist = 10`,
+    /// `defocus_angle = 0`), which every built-in states explicitly.
+    #[test]
+    fn a_scene_file_may_leave_out_the_book_s_camera_defaults() {
+        for s in BUILTIN_SCENES {
+            let d = s.description();
+            assert_eq!(
+                (d.camera.up, d.camera.focus_distance, d.camera.defocus_angle),
+                ([0.0, 1.0, 0.0], 10.0, 0.0),
+                "{}",
+                s.name
+            );
+            let text = d.to_toml();
+            let short: String = text
+                .lines()
+                .filter(|l| {
+                    !["up ", "up=", "focus_distance", "defocus_angle"]
+                        .iter()
+                        .any(|k| l.trim_start().starts_with(k))
+                })
+                .map(|l| format!("{l}\n"))
+                .collect();
+            assert_eq!(
+                text.lines().count() - short.lines().count(),
+                3,
+                "{}: the three lines are left out",
+                s.name
+            );
+            let back = SceneDescription::from_toml(&short, s.name).unwrap();
+            assert_eq!(back, d, "{}", s.name);
+        }
+    }
 }

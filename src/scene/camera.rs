@@ -11,15 +11,30 @@ pub struct CameraSettings {
     pub look_from: [f64; 3],
     /// The point looked at.
     pub look_at: [f64; 3],
-    /// The "up" direction (need not be orthogonal to the view direction).
+    /// The "up" direction (need not be orthogonal to the view direction). Optional in a scene
+    /// file: `[0, 1, 0]` by default, the book's and the course's `vup`.
+    #[serde(default = "default_up")]
     pub up: [f64; 3],
     /// Vertical field of view in degrees, in `(0, 180)`.
     pub vfov: f64,
-    /// Distance from `look_from` to the plane in focus (the viewport lies there).
+    /// Distance from `look_from` to the plane in focus (the viewport lies there). Optional in a
+    /// scene file: 10 by default, the book's and the course's `focus_dist` (with a pinhole it
+    /// only scales the viewport, so the image does not depend on it).
+    #[serde(default = "default_focus_distance")]
     pub focus_distance: f64,
     /// Angle of the cone of rays through each pixel, in degrees; 0 is a pinhole.
     #[serde(default)]
     pub defocus_angle: f64,
+}
+
+/// `up` when a scene file leaves it out: the book's `vup`.
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// `focus_distance` when a scene file leaves it out: the book's `focus_dist`.
+fn default_focus_distance() -> f64 {
+    10.0
 }
 
 /// The course's camera (after *Ray Tracing in One Weekend*, 4th edition), with every derived

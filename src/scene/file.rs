@@ -9,9 +9,9 @@
 //! [camera]
 //! look_from = [0.0, 0.0, 1.0]
 //! look_at = [0.0, 0.0, -1.0]
-//! up = [0.0, 1.0, 0.0]
+//! up = [0.0, 1.0, 0.0]     # optional, [0, 1, 0] by default (the book's vup)
 //! vfov = 90.0              # degrees
-//! focus_distance = 10.0
+//! focus_distance = 10.0    # optional, 10 by default (the book's focus_dist)
 //! defocus_angle = 0.0      # degrees; optional, 0 is a pinhole
 //!
 //! [[materials]]
