@@ -116,26 +116,36 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => None,
     };
     // Before grading anything: a sandbox that keeps the code from running as root (fail
-    // closed), and a Python with the rubric's modules that the sandbox user can run.
+    // closed), and a Python with the rubric's modules that the sandbox user can run. A rubric
+    // of images only runs no code, so it needs neither.
+    let runs_code = rubric
+        .groups
+        .iter()
+        .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
     let policy = rtoracle::sandbox::SandboxPolicy::grading();
-    let python = rtoracle::candidate::python::choose(
-        args.python.as_deref(),
-        &rubric.python_requires,
-        &policy,
-    )?;
-    rtoracle::sandbox::announce_on_stderr();
+    let python = if runs_code {
+        let python = rtoracle::candidate::python::choose(
+            args.python.as_deref(),
+            &rubric.python_requires,
+            &policy,
+        )?;
+        rtoracle::sandbox::announce_on_stderr();
+        Some(python)
+    } else {
+        None
+    };
     let code = CourseCodeChecker {
         seed: rubric.seed,
         vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
         time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
         policy,
-        python: Some(python),
+        python,
         python_requires: rubric.python_requires.clone(),
         ..Default::default()
     };
     // Said once the grading is done, so bad input stays one line on stderr.
-    let public_seed = (code.vectors.is_none() && rubric.seed == 0).then_some(
+    let public_seed = (runs_code && code.vectors.is_none() && rubric.seed == 0).then_some(
         "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
     );
     let images = rtoracle::grade::CompareImageChecker::default();

@@ -631,3 +631,62 @@ fn honest_independent_renders_of_scene_files_at_1_and_50_spp_get_full_marks_flip
         std::fs::read(rtoracle::golden::cache_file(&cache, &d, 5000)).unwrap()
     );
 }
+
+/// A rubric of images only runs no code: it grades with no Python fit for the course (here
+/// `--python /bin/true`) and no warning about a public seed of vectors it never runs, where a
+/// rubric with a code group refuses that Python up front. Its scene file leaves out the camera's
+/// `up` and `focus_distance`, which take the book's values.
+#[test]
+fn a_rubric_of_images_only_needs_no_python_and_no_seed() {
+    let root = tempfile::tempdir().unwrap();
+    let p = root.path();
+    let scene = own_scene(64, 1.0, 4, [0.9, 0.3, 0.1])
+        .replace("up = [0.0, 1.0, 0.0]\n", "")
+        .replace("focus_distance = 2.5\n", "");
+    assert!(!scene.contains("up =") && !scene.contains("focus_distance"));
+    std::fs::write(p.join("mine.toml"), &scene).unwrap();
+    std::fs::write(
+        p.join("images.toml"),
+        format!(
+            "name = \"images\"\n\n{}",
+            image_group("mine", "mine.toml", 10)
+        ),
+    )
+    .unwrap();
+    std::fs::create_dir(p.join("sub")).unwrap();
+    let rendered = run_in(
+        p,
+        &["render", "mine.toml", "--seed", "5", "-o", "sub/mine.png"],
+    );
+    assert!(rendered.status.success(), "{}", stderr(&rendered));
+    let cache = p.join("cache");
+    let grade = |rubric: &str, out: &str| {
+        rtoracle()
+            .current_dir(p)
+            .env("RTORACLE_CACHE_DIR", &cache)
+            .args(["grade", "sub", "--rubric", rubric, "--out", out])
+            .args(["--python", "/bin/true"])
+            .output()
+            .unwrap()
+    };
+    let out = grade("images.toml", "out");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("seed"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("sandbox"), "{}", stderr(&out));
+    let report = read_json(&p.join("out/report.json"));
+    assert_eq!(scores(&report), [("image.mine".to_string(), 10.0, 10.0)]);
+    // With a code group the same Python is refused before any grading.
+    std::fs::write(
+        p.join("code.toml"),
+        format!(
+            "name = \"code\"\nseed = 4\n\n{}[[group]]\nid = \"sphere\"\nname = \"Spheres\"\n\
+             kind = \"code\"\nshape = \"sphere\"\npoints = 10\n",
+            image_group("mine", "mine.toml", 10)
+        ),
+    )
+    .unwrap();
+    let out = grade("code.toml", "out2");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("/bin/true"), "{}", stderr(&out));
+    assert!(!p.join("out2").exists());
+}
