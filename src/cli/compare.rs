@@ -11,7 +11,7 @@ use rtoracle::image_io::decode_exr;
 /// `rtoracle compare CANDIDATE (--scene NAME|FILE.toml | --golden FILE.exr) [--spp N] [--encoding E]
 /// [--json] [--heatmap OUT.png] [--report DIR]`
 #[derive(Debug, clap::Args)]
-#[command(group(clap::ArgGroup::new("reference").required(true).args(["scene", "golden"])))]
+#[command(group(clap::ArgGroup::new("reference").required(true).multiple(true).args(["scene", "golden"])))]
 pub struct Args {
     /// The image to judge: a PNG (8-bit RGB or RGBA) or an EXR.
     candidate: PathBuf,
@@ -19,11 +19,13 @@ pub struct Args {
     /// file (`.toml`; its golden rendered once and cached, as grading does).
     #[arg(long, value_name = "NAME|FILE.toml")]
     scene: Option<String>,
-    /// Compare with this golden EXR (mean and a `variance` layer).
+    /// Compare with this golden EXR (mean and a `variance` layer). With --scene, the golden must
+    /// have been made from that scene (`rtoracle golden FILE.toml -o FILE.exr`), and the scene
+    /// gives the candidate's default spp.
     #[arg(long, value_name = "FILE.exr")]
     golden: Option<PathBuf>,
     /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes; 20 with
-    /// --golden).
+    /// --golden alone, which does not say the scene's).
     #[arg(long, value_name = "N", value_parser = super::num::spp)]
     spp: Option<u32>,
     /// How the candidate's 8-bit codes encode linear values.
@@ -128,7 +130,33 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let candidate = CandidateImage::load(&args.candidate)?;
     let (golden, default_spp): (Box<dyn FnOnce(u32) -> anyhow::Result<Golden>>, u32) =
         match (&args.scene, &args.golden) {
-            (Some(name), _) => {
+            (Some(name), Some(path)) => {
+                // The golden given, checked against the scene (as a rubric's `golden` is).
+                let (_, description) = super::render::load_scene(name)?;
+                let bytes = std::fs::read(path).map_err(|e| {
+                    let why = match e.kind() {
+                        std::io::ErrorKind::NotFound => "no such file".to_string(),
+                        std::io::ErrorKind::IsADirectory => "is a folder".to_string(),
+                        _ => e.to_string(),
+                    };
+                    anyhow::anyhow!("--golden {}: {why}", path.display())
+                })?;
+                let image =
+                    rtoracle::golden::golden_fits(&bytes, path, &description).map_err(|why| {
+                        anyhow::anyhow!(
+                            "--golden {}: {why}; make it with `rtoracle golden {name} -o {}`",
+                            path.display(),
+                            path.display()
+                        )
+                    })?;
+                let g = Golden::from_exr_image(image, path)?;
+                check_size(&args.candidate, &candidate, g.width, g.height)?;
+                (
+                    Box::new(move |_| Ok(g)),
+                    description.image.samples_per_pixel,
+                )
+            }
+            (Some(name), None) => {
                 let (_, description) = super::render::load_scene(name)?;
                 let camera = description.camera(None);
                 check_size(&args.candidate, &candidate, camera.width, camera.height)?;

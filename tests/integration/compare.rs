@@ -730,4 +730,42 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
         &compare_cli(dir.path(), &["honest.png", "--scene", "broken.toml"]),
         "broken.toml: malformed scene file",
     );
+    // A golden made ahead of time, given with its scene: judged at the scene's 1 spp, as with
+    // the cached golden (alone, --golden cannot know the scene's spp and takes 20, which the
+    // honest 1-spp render fails).
+    let made = rtoracle()
+        .current_dir(dir.path())
+        .args(["golden", "mine.toml", "-o", "mine.exr"])
+        .output()
+        .unwrap();
+    assert!(made.status.success());
+    let with_scene = |image: &str, golden: &str, scene: &str| {
+        compare_cli(dir.path(), &[image, "--scene", scene, "--golden", golden])
+    };
+    let out = with_scene("honest.png", "mine.exr", "mine.toml");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(
+        text.starts_with("PASS honest.png: 64x36, 1 spp against a 4096 spp golden of mine.toml"),
+        "{text}"
+    );
+    assert_eq!(
+        with_scene("flipped.png", "mine.exr", "mine.toml").status.code(),
+        Some(1)
+    );
+    let alone = compare_cli(dir.path(), &["honest.png", "--golden", "mine.exr"]);
+    assert_eq!(alone.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&alone.stdout).contains(", 20 spp against"));
+    // A golden of another scene, or none, is refused before any work.
+    let mut other = d.clone();
+    other.materials[0].albedo[0] += 0.1;
+    std::fs::write(dir.path().join("other.toml"), other.to_toml()).unwrap();
+    assert_bad_input(
+        &with_scene("honest.png", "mine.exr", "other.toml"),
+        "--golden mine.exr: was made from another scene",
+    );
+    assert_bad_input(
+        &with_scene("honest.png", "none.exr", "mine.toml"),
+        "--golden none.exr: no such file",
+    );
 }
