@@ -214,11 +214,18 @@ mod tests {
         assert_eq!(honest.data[2], bgr.data[0]);
         // Mirrored: pixel i of each row is pixel 15 - i of the honest row, every channel kept.
         let mirrored = render_with_mistake(&d, Mistake::XFlipped, 2, 1);
-        for (h, m) in honest.data.chunks_exact(row).zip(mirrored.data.chunks_exact(row)) {
+        for (h, m) in honest
+            .data
+            .chunks_exact(row)
+            .zip(mirrored.data.chunks_exact(row))
+        {
             for i in 0..16 {
                 assert_eq!(h[3 * i..3 * i + 3], m[3 * (15 - i)..3 * (15 - i) + 3]);
             }
         }
-        assert_ne!(honest.data, mirrored.data, "the quad scene is not symmetric");
+        assert_ne!(
+            honest.data, mirrored.data,
+            "the quad scene is not symmetric"
+        );
     }
 }
