@@ -34,8 +34,9 @@
 //! - `<!-- no-run: REASON -->` says why a block marked `console,no-run` cannot run in the tests
 //!   (every such block must say it; the test prints how many were skipped).
 //!
-//! A shell transcript (a line starting `$ `) in a fenced block of any other kind (bare, `text`,
-//! ...) fails the test: every transcript is a `console` block, or `console,no-run` with a reason.
+//! A shell transcript (a line starting `$ `, indented or not) in a fenced block of any other
+//! kind (bare, `text`, fenced with `~~~`, indented in a list...) fails the test: every transcript
+//! is a `console` block, or `console,no-run` with a reason.
 //!
 //! `RTORACLE_UPDATE_README=1 cargo test --test integration -- readme::` writes the real outputs
 //! of the examples that differ into `docs/sections/` instead of comparing (the others keep their
@@ -242,12 +243,13 @@ fn blocks(text: &str) -> Vec<Block> {
     parse(text).blocks
 }
 
-/// The line after the fenced block whose body starts at `start`, opened by `ticks` backticks:
-/// the index of its closing fence (a line of as many or more backticks only), or the end.
-fn closing_fence(lines: &[&str], start: usize, ticks: usize) -> usize {
+/// The closing fence of the block whose body starts at `start`, opened by `len` of `mark`
+/// (`` ` `` or `~`): the index of the first line of as many or more of them only (indented or
+/// not), or the end.
+fn closing_fence(lines: &[&str], start: usize, mark: char, len: usize) -> usize {
     let closes = |line: &str| {
-        let line = line.trim_end();
-        line.len() >= ticks && line.bytes().all(|b| b == b'`')
+        let line = line.trim();
+        line.len() >= len && line.chars().all(|c| c == mark)
     };
     (start..lines.len())
         .find(|&i| closes(lines[i]))
@@ -261,21 +263,34 @@ fn parse(text: &str) -> Parsed {
     let mut stray_transcripts = Vec::new();
     let mut i = 0;
     while i < lines.len() {
-        // A fence of 3 or more backticks (4 when the output holds fences of 3), closed by a
-        // line of as many or more backticks only.
-        let ticks = lines[i].len() - lines[i].trim_start_matches('`').len();
+        // A fence of 3 or more backticks (4 when the output holds fences of 3) or tildes,
+        // closed by a line of as many or more of them only. A console block's fence is of
+        // backticks and starts its line.
+        let fence = lines[i].trim_start();
+        let mark = match fence.chars().next() {
+            Some(c @ ('`' | '~')) => c,
+            _ => {
+                i += 1;
+                continue;
+            }
+        };
+        let ticks = fence.len() - fence.trim_start_matches(mark).len();
         if ticks < 3 {
             i += 1;
             continue;
         }
-        let run = match lines[i][ticks..].trim() {
-            "console" => true,
-            "console,no-run" => false,
+        let info = fence[ticks..].trim();
+        let run = match info {
+            "console" if mark == '`' && fence.len() == lines[i].len() => true,
+            "console,no-run" if mark == '`' && fence.len() == lines[i].len() => false,
             _ => {
-                // Another block (`text`, `toml`, bare...): skipped whole, but a shell
-                // transcript in it would be an example no test keeps.
-                let end = closing_fence(&lines, i + 1, ticks);
-                if lines[i + 1..end].iter().any(|l| l.starts_with("$ ")) {
+                // Another block (`text`, `toml`, bare, `~~~`, indented in a list...): skipped
+                // whole, but a shell transcript in it would be an example no test keeps.
+                let end = closing_fence(&lines, i + 1, mark, ticks);
+                if lines[i + 1..end]
+                    .iter()
+                    .any(|l| l.trim_start().starts_with("$ "))
+                {
                     stray_transcripts.push(i);
                 }
                 i = end + 1;
@@ -297,7 +312,7 @@ fn parse(text: &str) -> Parsed {
             }
         }
         let start = i + 1;
-        let end = closing_fence(&lines, start, ticks);
+        let end = closing_fence(&lines, start, '`', ticks);
         let mut steps: Vec<Step> = Vec::new();
         for line in &lines[start..end] {
             match line.strip_prefix("$ ") {
@@ -687,11 +702,14 @@ fn a_transcript_outside_a_console_block_is_found() {
                 ```toml\nx = \"$ not at the start\"\n```\n\
                 ````\n```console\n```\n$ inside four\n````\n\
                 ```console\n$ rtoracle scenes\n```\n\
+                - a list item:\n  ```\n  $ rtoracle scenes\n  ```\n\
+                ~~~\n$ rtoracle scenes\n~~~\n\
                 ```text\n$ cargo bench\n";
     let parsed = parse(text);
-    // The bare block, the four-backtick one (its inner fences do not close it) and the
-    // unclosed one at the end; not the blocks without a `$ ` line at a line's start.
-    assert_eq!(parsed.stray_transcripts, [0, 10, 18]);
+    // The bare block, the four-backtick one (its inner fences do not close it), the indented
+    // one, the one fenced with tildes and the unclosed one at the end; not the blocks without
+    // a `$ ` line at a line's start.
+    assert_eq!(parsed.stray_transcripts, [0, 10, 19, 22, 25]);
     // The console block after them is still read, and the one inside four backticks is not.
     assert_eq!(parsed.blocks.len(), 1);
     assert_eq!(parsed.blocks[0].fence, 15);
