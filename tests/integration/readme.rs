@@ -24,11 +24,19 @@
 //!   (or `NAME=FOLDER`, `FOLDER` ending in the name) is `tests/fixtures/submissions/NAME` made a
 //!   submission by `rtoracle::grade::bench::materialize` (its images rendered), and
 //!   `python:VARIANT=FOLDER` is the `check` fixture `tests/fixtures/python/variants/VARIANT` (the
-//!   common modules, then the variant's) by `rtoracle::candidate::bench::assemble_fixture`;
+//!   common modules, then the variant's) by `rtoracle::candidate::bench::assemble_fixture`, and
+//!   `mistake:SCENE:MISTAKE=FILE.png` is the built-in `SCENE` rendered with a mistake of
+//!   `rtoracle::compare::mistakes` (`MISTAKE` by the names `examples/mistake.rs` takes) by
+//!   `render_with_mistake`, at the scene's samples per pixel and seed 1: the PNG that
+//!   `cargo run --release --example mistake -- SCENE MISTAKE FILE.png` writes;
 //! - `<!-- setup: SHELL -->`: the shell line runs, silently, in the section's folder (after the
 //!   fixtures are made);
 //! - `<!-- no-run: REASON -->` says why a block marked `console,no-run` cannot run in the tests
 //!   (every such block must say it; the test prints how many were skipped).
+//!
+//! A shell transcript (a line starting `$ `, indented or not) in a fenced block of any other
+//! kind (bare, `text`, fenced with `~~~`, indented in a list...) fails the test: every transcript
+//! is a `console` block, or `console,no-run` with a reason.
 //!
 //! `RTORACLE_UPDATE_README=1 cargo test --test integration -- readme::` writes the real outputs
 //! of the examples that differ into `docs/sections/` instead of comparing (the others keep their
@@ -100,6 +108,33 @@ enum Fixture {
     Submission { name: String, folder: String },
     /// `tests/fixtures/python/variants/<variant>` with the common modules, into the folder.
     Python { variant: String, folder: String },
+    /// A built-in scene rendered with a mistake of the catalogue, as `examples/mistake.rs`
+    /// renders it (the scene's samples per pixel, seed 1), into the PNG `file`.
+    Mistake {
+        scene: String,
+        mistake: String,
+        file: String,
+    },
+}
+
+/// The mistakes of the catalogue by the names `examples/mistake.rs` takes.
+fn mistake_named(name: &str) -> Option<rtoracle::compare::mistakes::Mistake> {
+    use rtoracle::compare::mistakes::Mistake;
+    Some(match name {
+        "honest" => Mistake::Honest,
+        "no-gamma" => Mistake::NoGamma,
+        "gamma22" => Mistake::Gamma22,
+        "albedo" => Mistake::AlbedoScaled,
+        "half-pixel" => Mistake::HalfPixelShift,
+        "jitter01" => Mistake::JitterZeroOne,
+        "flip-y" => Mistake::YFlipped,
+        "flip-x" => Mistake::XFlipped,
+        "bgr" => Mistake::Bgr,
+        "fov" => Mistake::WiderFov,
+        "missing" => Mistake::ObjectMissing,
+        "sky" => Mistake::SkyReversed,
+        _ => return None,
+    })
 }
 
 /// The value of the directive `<!-- key: VALUE -->` on `line`, if it is one.
@@ -129,6 +164,24 @@ fn parse_fixtures(spec: &str) -> Result<Vec<Fixture>, String> {
                 return Err(format!(
                     "fixture {word:?}: want NAME, FOLDER/NAME, NAME=FOLDER or python:VARIANT=FOLDER"
                 ));
+            }
+            if let Some(spec) = what.strip_prefix("mistake:") {
+                return match spec.split_once(':') {
+                    Some((scene, mistake))
+                        if word.contains('=')
+                            && rtoracle::scene::builtin(scene).is_ok()
+                            && mistake_named(mistake).is_some() =>
+                    {
+                        Ok(Fixture::Mistake {
+                            scene: scene.to_string(),
+                            mistake: mistake.to_string(),
+                            file: folder.to_string(),
+                        })
+                    }
+                    _ => Err(format!(
+                        "fixture {word:?}: want mistake:SCENE:MISTAKE=FILE.png, a built-in scene and a mistake examples/mistake.rs knows"
+                    )),
+                };
             }
             Ok(match what.strip_prefix("python:") {
                 Some(variant) => Fixture::Python {
@@ -162,23 +215,85 @@ fn make_fixture(fixture: &Fixture, dir: &Path) -> Result<(), String> {
             }
             Ok(())
         }
+        Fixture::Mistake {
+            scene,
+            mistake,
+            file,
+        } => {
+            let description = rtoracle::scene::builtin(scene).map_err(|e| e.to_string())?;
+            let mistake = mistake_named(mistake).ok_or("an unknown mistake")?;
+            let spp = description.image.samples_per_pixel;
+            let image =
+                rtoracle::compare::mistakes::render_with_mistake(&description, mistake, spp, 1);
+            rtoracle::image_io::write_png(&dir.join(file), &image).map_err(|e| e.to_string())
+        }
     }
 }
 
+/// What a section holds: its console blocks, and the opening fence (0-based line) of every other
+/// fenced block with a line starting `$ `, a shell transcript nothing would check.
+#[derive(Debug)]
+struct Parsed {
+    blocks: Vec<Block>,
+    stray_transcripts: Vec<usize>,
+}
+
+/// The console blocks of `text` (see [`parse`]).
 fn blocks(text: &str) -> Vec<Block> {
+    parse(text).blocks
+}
+
+/// The closing fence of the block whose body starts at `start`, opened by `len` of `mark`
+/// (`` ` `` or `~`): the index of the first line of as many or more of them only (indented or
+/// not), or the end.
+fn closing_fence(lines: &[&str], start: usize, mark: char, len: usize) -> usize {
+    let closes = |line: &str| {
+        let line = line.trim();
+        line.len() >= len && line.chars().all(|c| c == mark)
+    };
+    (start..lines.len())
+        .find(|&i| closes(lines[i]))
+        .unwrap_or(lines.len())
+}
+
+/// Reads the fenced blocks of a section: the console ones, and the others only for transcripts.
+fn parse(text: &str) -> Parsed {
     let lines: Vec<&str> = text.lines().collect();
     let mut out = Vec::new();
+    let mut stray_transcripts = Vec::new();
     let mut i = 0;
     while i < lines.len() {
-        // A fence of 3 or more backticks (4 when the output holds fences of 3), closed by a
-        // line of as many or more backticks only.
-        let ticks = lines[i].len() - lines[i].trim_start_matches('`').len();
-        let info = (ticks >= 3).then(|| lines[i][ticks..].trim());
-        let run = match info {
-            Some("console") => true,
-            Some("console,no-run") => false,
+        // A fence of 3 or more backticks (4 when the output holds fences of 3) or tildes,
+        // closed by a line of as many or more of them only. A console block's fence is of
+        // backticks and starts its line.
+        let fence = lines[i].trim_start();
+        let mark = match fence.chars().next() {
+            Some(c @ ('`' | '~')) => c,
             _ => {
                 i += 1;
+                continue;
+            }
+        };
+        let ticks = fence.len() - fence.trim_start_matches(mark).len();
+        if ticks < 3 {
+            i += 1;
+            continue;
+        }
+        let info = fence[ticks..].trim();
+        let run = match info {
+            "console" if mark == '`' && fence.len() == lines[i].len() => true,
+            "console,no-run" if mark == '`' && fence.len() == lines[i].len() => false,
+            _ => {
+                // Another block (`text`, `toml`, bare, `~~~`, indented in a list...): skipped
+                // whole, but a shell transcript in it would be an example no test keeps.
+                let end = closing_fence(&lines, i + 1, mark, ticks);
+                if lines[i + 1..end]
+                    .iter()
+                    .any(|l| l.trim_start().starts_with("$ "))
+                {
+                    stray_transcripts.push(i);
+                }
+                i = end + 1;
                 continue;
             }
         };
@@ -197,14 +312,7 @@ fn blocks(text: &str) -> Vec<Block> {
             }
         }
         let start = i + 1;
-        let mut end = start;
-        let closes = |line: &str| {
-            let line = line.trim_end();
-            line.len() >= ticks && line.bytes().all(|b| b == b'`')
-        };
-        while end < lines.len() && !closes(lines[end]) {
-            end += 1;
-        }
+        let end = closing_fence(&lines, start, '`', ticks);
         let mut steps: Vec<Step> = Vec::new();
         for line in &lines[start..end] {
             match line.strip_prefix("$ ") {
@@ -230,7 +338,10 @@ fn blocks(text: &str) -> Vec<Block> {
         });
         i = end + 1;
     }
-    out
+    Parsed {
+        blocks: out,
+        stray_transcripts,
+    }
 }
 
 /// Replaces what changes from run to run (see the module docs).
@@ -375,7 +486,14 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
     };
     // Blocks in reverse order when rewriting, so earlier line numbers stay valid.
     let mut rewritten: Vec<(std::ops::Range<usize>, Vec<String>)> = Vec::new();
-    for block in blocks(&text) {
+    let parsed = parse(&text);
+    for fence in parsed.stray_transcripts {
+        run.failures.push(format!(
+            "docs/sections/{section}.md:{}: a shell transcript must be a `console` block (or `console,no-run` with a reason)",
+            fence + 1
+        ));
+    }
+    for block in parsed.blocks {
         if !block.run {
             run.skipped += 1;
             if block.no_run_reason.is_none() {
@@ -557,4 +675,43 @@ fn directives_before_a_block_are_read() {
     assert_eq!(b[0].steps[0].output, ["```python", "x = 1", "```"]);
     assert!(parse_fixtures("honest=/tmp/x").is_err());
     assert!(parse_fixtures("honest=../x").is_err());
+    assert_eq!(
+        parse_fixtures("mistake:week04-sphere:flip-y=flipped.png"),
+        Ok(vec![Fixture::Mistake {
+            scene: "week04-sphere".into(),
+            mistake: "flip-y".into(),
+            file: "flipped.png".into()
+        }])
+    );
+    // No file, an unknown scene or mistake, a file outside the folder.
+    for bad in [
+        "mistake:week04-sphere:flip-y",
+        "mistake:no-such-scene:flip-y=a.png",
+        "mistake:week04-sphere:flip-z=a.png",
+        "mistake:week04-sphere=a.png",
+        "mistake:week04-sphere:bgr=../a.png",
+    ] {
+        assert!(parse_fixtures(bad).is_err(), "{bad}");
+    }
+}
+
+#[test]
+fn a_transcript_outside_a_console_block_is_found() {
+    let text = "```\n$ rtoracle scenes\nweek04-sphere\n```\n\
+                ```text\nno command\n```\n\
+                ```toml\nx = \"$ not at the start\"\n```\n\
+                ````\n```console\n```\n$ inside four\n````\n\
+                ```console\n$ rtoracle scenes\n```\n\
+                - a list item:\n  ```\n  $ rtoracle scenes\n  ```\n\
+                ~~~\n$ rtoracle scenes\n~~~\n\
+                ```text\n$ cargo bench\n";
+    let parsed = parse(text);
+    // The bare block, the four-backtick one (its inner fences do not close it), the indented
+    // one, the one fenced with tildes and the unclosed one at the end; not the blocks without
+    // a `$ ` line at a line's start.
+    assert_eq!(parsed.stray_transcripts, [0, 10, 19, 22, 25]);
+    // The console block after them is still read, and the one inside four backticks is not.
+    assert_eq!(parsed.blocks.len(), 1);
+    assert_eq!(parsed.blocks[0].fence, 15);
+    assert_eq!(parsed.blocks[0].steps[0].command, "rtoracle scenes");
 }
