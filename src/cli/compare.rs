@@ -8,7 +8,7 @@ use rtoracle::compare::{
 };
 use rtoracle::image_io::decode_exr;
 
-/// `rtoracle compare CANDIDATE (--scene NAME|FILE.toml | --golden FILE.exr) [--spp N] [--encoding E]
+/// `rtoracle compare CANDIDATE (--scene NAME|FILE.toml [--golden FILE.exr] | --golden FILE.exr) [--spp N] [--encoding E]
 /// [--json] [--heatmap OUT.png] [--report DIR]`
 #[derive(Debug, clap::Args)]
 #[command(group(clap::ArgGroup::new("reference").required(true).multiple(true).args(["scene", "golden"])))]

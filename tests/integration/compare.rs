@@ -750,7 +750,9 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
         "{text}"
     );
     assert_eq!(
-        with_scene("flipped.png", "mine.exr", "mine.toml").status.code(),
+        with_scene("flipped.png", "mine.exr", "mine.toml")
+            .status
+            .code(),
         Some(1)
     );
     let alone = compare_cli(dir.path(), &["honest.png", "--golden", "mine.exr"]);
