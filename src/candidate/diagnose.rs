@@ -12,7 +12,11 @@
 //! `1e-6` relative for `t`, `1e-4` per normal component). It is named when it explains at least
 //! 95 % of the group's failures and passes all but 1 % of the sampled passing vectors; of
 //! several, the one that explains most (then: disagrees least, then: comes first in the
-//! catalogue). Nothing is named otherwise: the diagnosis never guesses.
+//! catalogue). Nothing is named otherwise: the diagnosis never guesses. Other mistakes that fit
+//! exactly as well (as many failures explained, as few passing vectors disagreeing) are named
+//! with it ([`Diagnosis::also`]): a few failing vectors may not tell two mistakes apart (a
+//! minimal case of radius -1 fails alike for a normal divided by `|r|` and one not divided at
+//! all), and naming one of them alone would be a guess.
 //!
 //! The submission's answers are judged against its own triangle winding
 //! ([`check::Winding`](super::check::Winding)); the variants wind as the reference does and are
@@ -43,13 +47,17 @@ pub struct Diagnosis {
     pub explained: usize,
     /// How many failures the group has (wrong answers and raised errors).
     pub of: usize,
+    /// The phrases of other mistakes that fit these failures exactly as well, in catalogue
+    /// order (empty when the vectors single one out).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub also: Vec<String>,
 }
 
 impl Diagnosis {
     /// One sentence for a student: "your failures are exactly those of taking the far root
     /// first" (or "match those of ..., 11 of 12", when not all are explained).
     pub fn sentence(&self) -> String {
-        if self.explained == self.of {
+        let mut s = if self.explained == self.of {
             format!(
                 "your {} failures are exactly those of {} ({} of {})",
                 self.shape, self.description, self.explained, self.of
@@ -59,7 +67,14 @@ impl Diagnosis {
                 "your {} failures match those of {} ({} of {} explained)",
                 self.shape, self.description, self.explained, self.of
             )
+        };
+        if !self.also.is_empty() {
+            s.push_str(&format!(
+                ", or equally of {}: these vectors cannot tell them apart",
+                self.also.join(", or of ")
+            ));
         }
+        s
     }
 }
 
@@ -240,7 +255,7 @@ pub fn diagnose(cases: &[Case], outcomes: &[Outcome], winding: Option<Winding>) 
                 .map(|i| passing[i * passing.len() / SAMPLE])
                 .collect()
         };
-        let mut best: Option<(usize, usize, &Variant)> = None;
+        let mut fits: Vec<(usize, usize, &Variant)> = Vec::new();
         for v in catalogue.iter().filter(|v| v.shape == kind) {
             let explained = failing
                 .iter()
@@ -256,21 +271,29 @@ pub fn diagnose(cases: &[Case], outcomes: &[Outcome], winding: Option<Winding>) 
             if disagree * 100 > sample.len() {
                 continue;
             }
-            let better = match best {
-                None => true,
-                Some((e, d, _)) => explained > e || (explained == e && disagree < d),
-            };
-            if better {
-                best = Some((explained, disagree, v));
-            }
+            fits.push((explained, disagree, v));
         }
-        if let Some((explained, _, v)) = best {
+        // Most explained, then fewest disagreeing; the sort is stable, so catalogue order last.
+        fits.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+        if let Some(&(explained, disagree, v)) = fits.first() {
+            let description = describe(v.name);
+            let mut also: Vec<String> = Vec::new();
+            for &(e, d, other) in &fits[1..] {
+                let phrase = describe(other.name);
+                if (e, d) == (explained, disagree)
+                    && phrase != description
+                    && !also.contains(&phrase)
+                {
+                    also.push(phrase);
+                }
+            }
             found.push(Diagnosis {
                 shape: kind,
                 mistake_id: v.name.to_string(),
-                description: describe(v.name),
+                description,
                 explained,
                 of: failing.len(),
+                also,
             });
         }
     }
@@ -339,6 +362,38 @@ mod tests {
         }
     }
 
+    /// The minimal case `fuzz` shrinks a `|r|` normal to: radius -1, seen from its centre. There
+    /// `(P - C) / |r|` and the undivided `P - C` are the same wrong normal, so the diagnosis names
+    /// both; with the whole suite the two mistakes part, and only the real one is named.
+    #[test]
+    fn mistakes_the_vectors_cannot_tell_apart_are_named_together() {
+        let line = r#"{"id":"shrunk","shape":{"type":"sphere","center":[0.0,0.0,0.0],"radius":-1.0},"ray":{"origin":[0.0,0.0,0.0],"direction":[0.0,-1.0,0.0]},"interval":[1e-6,1.7976931348623157e+308],"expect":{"class":"hit","tags":["negative-radius"],"t":1.0,"t_tol":1e-9,"point":[0.0,-1.0,0.0],"normal":[-0.0,1.0,-0.0],"front_face":true}}"#;
+        let case: Case = serde_json::from_str(line).unwrap();
+        let abs = catalogue()
+            .into_iter()
+            .find(|v| v.name == "sphere-abs-radius-in-normal")
+            .unwrap();
+        let cases = vec![case];
+        let found = diagnose(&cases, &run(&abs, &cases), None);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let d = &found[0];
+        let phrases: Vec<&str> = std::iter::once(d.description.as_str())
+            .chain(d.also.iter().map(String::as_str))
+            .collect();
+        for id in ["sphere-abs-radius-in-normal", "sphere-unnormalised-normal"] {
+            assert!(phrases.contains(&describe(id).as_str()), "{id}: {d:?}");
+        }
+        assert!(
+            d.sentence().contains("cannot tell them apart"),
+            "{}",
+            d.sentence()
+        );
+        let suite = default_suite(0);
+        let found = diagnose(&suite, &run(&abs, &suite), None);
+        assert_eq!(found[0].mistake_id, "sphere-abs-radius-in-normal");
+        assert!(found[0].also.is_empty(), "{:?}", found[0]);
+    }
+
     #[test]
     fn an_unexplained_failure_names_nothing_and_the_sentence_says_what_it_names() {
         let cases = default_suite(0);
@@ -362,6 +417,7 @@ mod tests {
             description: describe("sphere-far-root-first"),
             explained: 12,
             of: 12,
+            also: vec![],
         };
         assert_eq!(
             d.sentence(),
