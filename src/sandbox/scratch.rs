@@ -786,7 +786,7 @@ mod tests {
             .spawn()
             .unwrap();
         let mut seen = ProcessUsage::default();
-        for _ in 0..300 {
+        for _ in 0..1000 {
             seen = process_usage(&Members::Uid(uid));
             if seen.processes == 21 {
                 break;
