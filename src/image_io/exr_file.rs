@@ -235,8 +235,7 @@ fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
 /// name. A missing, non-EXR, truncated or damaged file, or one without R, G, B, is an error
 /// naming the file.
 pub fn read_exr(path: &Path) -> Result<ExrImage, ImageError> {
-    let bytes =
-        std::fs::read(path).map_err(|e| ImageError::io(path, format!("cannot read: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| ImageError::unreadable(path, &e))?;
     decode_exr(&bytes, path)
 }
 

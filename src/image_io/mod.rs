@@ -31,6 +31,17 @@ pub enum ImageError {
 }
 
 impl ImageError {
+    /// `path` could not be read: "no such file" and "is a folder" in those words, else the
+    /// system's reason.
+    pub(crate) fn unreadable(path: &Path, e: &std::io::Error) -> Self {
+        let message = match e.kind() {
+            std::io::ErrorKind::NotFound => "no such file".to_string(),
+            std::io::ErrorKind::IsADirectory => "is a folder, not an image".to_string(),
+            _ => format!("cannot read: {e}"),
+        };
+        ImageError::io(path, message)
+    }
+
     pub(crate) fn io(path: &Path, message: impl std::fmt::Display) -> Self {
         ImageError::Io {
             path: path.to_path_buf(),

@@ -44,8 +44,7 @@ pub const PNG_DECODE_ALLOWANCE: u64 = 8 << 20;
 /// allocate at most 8 bytes per pixel plus [`PNG_DECODE_ALLOWANCE`]: a file whose chunks would
 /// inflate past that is not a readable PNG.
 pub fn read_png(path: &Path) -> Result<Rgb8Image, ImageError> {
-    let bytes =
-        std::fs::read(path).map_err(|e| ImageError::io(path, format!("cannot read: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| ImageError::unreadable(path, &e))?;
     let unreadable =
         |e: image::ImageError| ImageError::format(path, format!("not a readable PNG: {e}"));
     // The size the header claims (IHDR is the first chunk); a bad header fails in the decoder.

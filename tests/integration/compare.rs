@@ -770,4 +770,8 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
         &with_scene("honest.png", "none.exr", "mine.toml"),
         "--golden none.exr: no such file",
     );
+    assert_bad_input(
+        &compare_cli(dir.path(), &["honest.png", "--golden", "none.exr"]),
+        "none.exr: no such file",
+    );
 }
