@@ -42,7 +42,7 @@ pub enum SceneError {
     /// The scene file could not be read.
     // The reason is in the message, not a `#[source]`, so a report of the whole chain (anyhow's
     // `{:#}`) does not say it twice.
-    #[error("{path}: cannot read the scene file: {error}")]
+    #[error("{path}: cannot read the scene file: {}", read_reason(.error))]
     Read {
         /// The file.
         path: String,
@@ -167,6 +167,17 @@ pub struct SceneDescription {
     pub materials: Vec<MaterialEntry>,
     /// The objects, in order (the order decides ties).
     pub objects: Vec<ObjectEntry>,
+}
+
+/// Why a scene file could not be read, in a few words ("no such file" rather than "No such file
+/// or directory (os error 2)").
+fn read_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        std::io::ErrorKind::IsADirectory => "it is a folder".to_string(),
+        std::io::ErrorKind::InvalidData => "it is not UTF-8 text".to_string(),
+        _ => e.to_string(),
+    }
 }
 
 fn check_vec(path: &str, field: &str, v: [f64; 3]) -> Result<(), SceneError> {
