@@ -147,9 +147,9 @@ fn file_name(path: &Path) -> String {
 impl ImageChecker for CompareImageChecker {
     fn describe(&self) -> String {
         format!(
-            "noise-aware comparison (rtoracle compare): golden of {} spp, candidate {} spp (a scene file's: its samples_per_pixel, golden max(4096, 100 x that)), {} encoding, per-image false-failure rate {}",
-            golden_spp(self.options.samples_per_pixel),
+            "noise-aware comparison (rtoracle compare): a built-in scene's image as {} spp against a golden of {} spp; a scene file's as its samples_per_pixel N against a golden of max(4096, 100 N) spp, or the rubric's golden as given (each image's metrics give its candidate_spp and golden_spp); {} encoding, per-image false-failure rate {}",
             self.options.samples_per_pixel,
+            golden_spp(self.options.samples_per_pixel),
             self.options.encoding,
             self.options.alpha
         )

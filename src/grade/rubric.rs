@@ -402,12 +402,26 @@ impl Rubric {
                         ))
                     })?;
                     crate::golden::golden_fits(&gbytes, &gpath, &description).map_err(|why| {
+                        // The command suggested must itself work: `golden -o` wants a .exr name.
+                        let is_exr = gpath
+                            .extension()
+                            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+                        let target = if is_exr {
+                            gpath.clone()
+                        } else {
+                            gpath.with_extension("exr")
+                        };
+                        let rename = if is_exr {
+                            String::new()
+                        } else {
+                            " and name it in `golden`".to_string()
+                        };
                         invalid(format!(
-                            "image group {:?}: the golden {} {why}; make it with `rtoracle golden {} -o {}`",
+                            "image group {:?}: the golden {} {why}; make it with `rtoracle golden {} -o {}`{rename}",
                             g.id,
                             gpath.display(),
                             path.display(),
-                            gpath.display()
+                            target.display()
                         ))
                     })?;
                     Some(GoldenFile {
@@ -540,6 +554,29 @@ impl Rubric {
                     }
                 }
             }
+        }
+        // One image file can answer one group only: two groups wanting the same file (two scene
+        // files of the same name, say) could never both pass.
+        let mut files: Vec<(String, &str)> = Vec::new();
+        for g in self.groups.iter().filter(|g| g.kind == GroupKind::Image) {
+            let file = match (&g.file, &g.scene) {
+                (Some(file), _) => file.clone(),
+                (None, Some(scene)) => format!(
+                    "{}.png",
+                    Path::new(scene)
+                        .file_stem()
+                        .map(|s| s.to_string_lossy().to_string())
+                        .unwrap_or_default()
+                ),
+                (None, None) => continue,
+            };
+            if let Some((_, first)) = files.iter().find(|(f, _)| *f == file) {
+                return Err(invalid(format!(
+                    "image groups {first:?} and {:?} both want the image {file:?}; give one of them another `file`",
+                    g.id
+                )));
+            }
+            files.push((file, g.id.as_str()));
         }
         Ok(())
     }

@@ -400,6 +400,7 @@ fn rubric_scene_file_errors_exit_2_with_one_line_naming_the_rubric() {
         assert!(out.status.success(), "{}", stderr(&out));
     }
     std::fs::write(p.join("notexr.exr"), b"not an exr").unwrap();
+    std::fs::write(p.join("image.png"), b"not an exr").unwrap();
     let rubric = |scene_line: &str| {
         format!(
             "name = \"t\"\n[[group]]\nid = \"image.t\"\nname = \"T\"\nkind = \"image\"\n{scene_line}\npoints = 10\n"
@@ -424,6 +425,17 @@ fn rubric_scene_file_errors_exit_2_with_one_line_naming_the_rubric() {
         (
             "scene = \"tri.toml\"\ngolden = \"notexr.exr\"",
             "notexr.exr",
+        ),
+        // The command the message suggests must work: `golden -o` wants a .exr name.
+        (
+            "scene = \"tri.toml\"\ngolden = \"image.png\"",
+            "make it with `rtoracle golden tri.toml -o image.exr` and name it in `golden`",
+        ),
+        // Two groups wanting one image could never both pass.
+        (
+            "scene = \"tri.toml\"\npoints = 5\n[[group]]\nid = \"image.u\"\nname = \"U\"\n\
+             kind = \"image\"\nscene = \"week04-quad\"\nfile = \"tri.png\"",
+            "image groups \"image.t\" and \"image.u\" both want the image \"tri.png\"",
         ),
         (
             "scene = \"week04-quad\"\nfile = \"q.png\"\ngolden = \"moved.exr\"",
