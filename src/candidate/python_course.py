@@ -71,7 +71,10 @@ def missing_module_message(exc):
         )
     own = os.path.join(SUBMISSION, top + ".py")
     if top.startswith("RT_") and not os.path.exists(own):
-        return "your code imports %s, which is not in your submission (upload %s.py)" % (top, top)
+        return (
+            "your code imports %s, which is not in your submission folder (add %s.py to it)"
+            % (top, top)
+        )
     return "your code imports %s, which the grader does not provide" % top
 
 
@@ -250,6 +253,8 @@ def main():
         import RT_ray
         import RT_object
     except BaseException as exc:  # SyntaxError, ImportError, SystemExit, ...
+        # Every shape, so every case (a triangle too) gets the import error, not "unsupported".
+        hello["shapes"].append("triangle")
         hello["error"] = loads(error_json(exc))
         out.write(json.dumps(hello) + "\n")
         # Keep answering so every case gets the import error.

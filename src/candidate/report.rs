@@ -171,6 +171,10 @@ pub struct CheckReport {
     /// The known mistakes that explain the failures, per shape group ([`super::diagnose`]).
     #[serde(default)]
     pub diagnosis: Vec<Diagnosis>,
+    /// The shapes the check requires (`check --require`): one of them with a definite vector
+    /// not run (a candidate without triangles, say) fails the check ([`Self::required_not_run`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub required: Vec<ShapeKind>,
 }
 
 /// Extra facts about a run for [`build_report`].
@@ -271,6 +275,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         sandbox: info.sandbox,
         triangle_winding: winding,
         diagnosis: super::diagnose::diagnose(cases, outcomes, winding),
+        required: Vec::new(),
     }
 }
 
@@ -343,7 +348,16 @@ impl CheckReport {
     /// Whether no definite vector failed, raised an error or timed out (exit code 0); see
     /// [`Counts::all_passed`].
     pub fn passed(&self) -> bool {
-        self.counts.all_passed()
+        self.counts.all_passed() && self.required_not_run().is_empty()
+    }
+
+    /// The [required](Self::required) shapes some of whose definite vectors were not run.
+    pub fn required_not_run(&self) -> Vec<ShapeKind> {
+        self.required
+            .iter()
+            .copied()
+            .filter(|k| self.by_shape.get(k).is_some_and(|c| c.not_run > 0))
+            .collect()
     }
 
     /// The report as one JSON object.
@@ -423,6 +437,13 @@ impl CheckReport {
                 String::new()
             }
         );
+        for k in self.required_not_run() {
+            let _ = writeln!(
+                s,
+                "required: {k}s (--require {k}), but {} {k} vectors were not run (why: below)",
+                self.by_shape[&k].not_run
+            );
+        }
         if let Some(w) = self.triangle_winding {
             let _ = writeln!(s, "triangles: your triangles face {}", w.formula());
         }

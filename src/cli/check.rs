@@ -217,6 +217,18 @@ pub struct Args {
     /// Failures shown in the text report.
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = super::num::show)]
     show: usize,
+    /// Shapes the check must cover (sphere, quad, triangle; comma-separated or repeated): if any
+    /// of their vectors is not run (a candidate without a usable Triangle, say), the check fails.
+    /// Without it, shapes the candidate does not support are reported as not run and the check
+    /// can still pass (the course's week 4 has no triangles).
+    #[arg(long, value_name = "SHAPE", value_delimiter = ',', value_parser = shape_kind)]
+    require: Vec<rtoracle::oracle::vectors::ShapeKind>,
+}
+
+/// A shape kind named on the command line.
+fn shape_kind(s: &str) -> Result<rtoracle::oracle::vectors::ShapeKind, String> {
+    rtoracle::oracle::vectors::ShapeKind::from_name(s)
+        .ok_or_else(|| format!("{s:?} is not a shape (sphere, quad or triangle)"))
 }
 
 /// `rtoracle check` with no candidate: the course submission in the current folder, as
@@ -271,6 +283,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let mut report = check_command(command, &cases, options).context("check")?;
     report.judged_by = Some(judged_by);
+    report.required = args.require.clone();
     let text = if args.json {
         report.to_json()
     } else {

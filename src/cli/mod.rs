@@ -42,7 +42,9 @@ enum Command {
     Explain(explain::Args),
     /// Check an implementation against the intersection vectors.
     ///
-    /// Exit codes: 0 every vector passed, 1 a vector failed, 2 bad input or a harness error.
+    /// Exit codes: 0 every vector run passed (shapes the candidate does not support are not run,
+    /// and said so; `--require triangle` makes that a failure), 1 a vector failed, 2 bad input or
+    /// a harness error.
     Check(check::Args),
     /// Differential fuzzing of an implementation against the oracle, with shrinking.
     Fuzz(fuzz::Args),

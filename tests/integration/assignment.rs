@@ -501,6 +501,59 @@ fn check_with_no_argument_checks_the_submission_in_the_current_folder() {
     assert!(stderr(&out).contains("--python-course DIR"));
 }
 
+/// For the triangle assignment a student checks with `--require triangle`: an RT_object.py
+/// without a usable Triangle then fails (without the flag its triangles are "not run" and the
+/// check passes, as week 4 wants), an honest one passes, and a submission that cannot be
+/// imported reports the import error on its triangles too, not "does not support triangles".
+#[test]
+fn check_require_triangle_fails_a_submission_without_triangles() {
+    let dir = tempfile::tempdir().unwrap();
+    submission(dir.path(), "", None);
+    let out = run_in(dir.path(), &["check", "--require", "triangle"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    // The same Sphere and Quad, and the Triangle class cut out.
+    let object = dir.path().join("RT_object.py");
+    let text = std::fs::read_to_string(&object).unwrap();
+    let at = text
+        .find("class Triangle")
+        .expect("the fixture has a Triangle");
+    assert!(text[at..].lines().skip(1).all(|l| !l.starts_with("class ")));
+    std::fs::write(&object, &text[..at]).unwrap();
+    let without = run_in(dir.path(), &["check"]);
+    assert_eq!(without.status.code(), Some(0), "{}", stderr(&without));
+    let report = String::from_utf8_lossy(&without.stdout).to_string();
+    assert!(
+        report.contains("not run: 559 triangle vectors: the candidate does not support triangles"),
+        "{report}"
+    );
+    let required = run_in(dir.path(), &["check", "--require", "sphere,triangle"]);
+    assert_eq!(required.status.code(), Some(1), "{}", stderr(&required));
+    let report = String::from_utf8_lossy(&required.stdout).to_string();
+    assert!(report.contains("verdict: FAIL"), "{report}");
+    assert!(
+        report.contains(
+            "required: triangles (--require triangle), but 559 triangle vectors were not run"
+        ),
+        "{report}"
+    );
+    assert!(!report.contains("required: spheres"), "{report}");
+    assert_bad_input(
+        &run_in(dir.path(), &["check", "--require", "cube"]),
+        "\"cube\" is not a shape",
+    );
+    // A syntax error: every triangle vector gets the import error.
+    std::fs::write(&object, "class Sphere(:\n").unwrap();
+    let broken = run_in(dir.path(), &["check", "--json"]);
+    assert_eq!(broken.status.code(), Some(1));
+    let v: Value = serde_json::from_slice(&broken.stdout).unwrap();
+    assert_eq!(
+        v["by_shape"]["triangle"]["errors"],
+        v["by_shape"]["triangle"]["total"]
+    );
+    assert_eq!(v["by_shape"]["triangle"]["not_run"], 0);
+    assert!(!String::from_utf8_lossy(&broken.stdout).contains("does not support"));
+}
+
 /// A scene file as an instructor writes one: a triangle and a sphere, `spp` samples per pixel.
 fn own_scene(width: usize, aspect_ratio: f64, spp: u32, albedo: [f64; 3]) -> String {
     format!(
