@@ -103,6 +103,7 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("check", "--show", true, true),
     ("check", "--profile", false, false),
     ("check", "--precision", false, false),
+    ("check", "--require", false, false),
     ("check", "--python", false, false),
     ("fuzz", "--python-course", false, false),
     ("fuzz", "--adapter", false, false),
