@@ -13,7 +13,7 @@
 //!   and at most [`HASH_MAX_FILES`] files are listed there, so a submission of many files cannot
 //!   make a report of many megabytes;
 //! - a PNG whose header says it is not the expected size, has more than [`MAX_IMAGE_PIXELS`]
-//!   pixels, is grey, uses a palette or has 16-bit channels is reported in plain words, naming
+//!   pixels, is grey or has 16-bit channels is reported in plain words, naming
 //!   the file as the student knows it (relative to the submission), without being decoded;
 //! - so is an OpenEXR file (which the comparison also reads, whatever the file's name says)
 //!   whose header describes a part of another size or of more than [`MAX_IMAGE_PIXELS`], or
@@ -207,9 +207,8 @@ pub fn check_png(
     }
     match header.colour_type {
         0 | 4 => Err(format!("{shown} is greyscale; expected an RGB PNG")),
-        3 => Err(format!(
-            "{shown} uses a colour palette; expected an RGB PNG"
-        )),
+        // A palette image decodes to the RGB it stands for, losslessly (as `compare` reads it).
+        3 => Ok(()),
         2 | 6 if header.bit_depth != 8 => Err(format!(
             "{shown} has {} bits per channel; expected 8",
             header.bit_depth
@@ -444,10 +443,9 @@ mod tests {
             check_png("week04_quad.png", &png(400, 225, 8, 0), ok).unwrap_err(),
             "week04_quad.png is greyscale; expected an RGB PNG"
         );
-        assert_eq!(
-            check_png("a.png", &png(400, 225, 8, 3), ok).unwrap_err(),
-            "a.png uses a colour palette; expected an RGB PNG"
-        );
+        // A palette (of any bit depth) stands for RGB colours: decoded, not refused.
+        assert_eq!(check_png("a.png", &png(400, 225, 8, 3), ok), Ok(()));
+        assert_eq!(check_png("a.png", &png(400, 225, 4, 3), ok), Ok(()));
         assert_eq!(
             check_png("a.png", &png(400, 225, 16, 2), ok).unwrap_err(),
             "a.png has 16 bits per channel; expected 8"

@@ -39,8 +39,9 @@ pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
 /// the decoder inflate hundreds of MB (the `image` crate's default allows 512 MiB).
 pub const PNG_DECODE_ALLOWANCE: u64 = 8 << 20;
 
-/// Reads a PNG as 8-bit RGB. 8-bit RGB and RGBA files are accepted (alpha is dropped); anything
-/// else (16-bit, grey, palette) is an error naming the file and what it is. The decoder may
+/// Reads a PNG as 8-bit RGB. 8-bit RGB and RGBA files are accepted (alpha is dropped), and so
+/// are palette files (the decoder expands them to the RGB colours they stand for); anything
+/// else (16-bit, grey) is an error naming the file and what it is. The decoder may
 /// allocate at most 8 bytes per pixel plus [`PNG_DECODE_ALLOWANCE`]: a file whose chunks would
 /// inflate past that is not a readable PNG.
 pub fn read_png(path: &Path) -> Result<Rgb8Image, ImageError> {

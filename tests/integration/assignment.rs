@@ -755,3 +755,55 @@ fn a_rubric_of_images_only_needs_no_python_and_no_seed() {
     assert!(stderr(&out).contains("/bin/true"), "{}", stderr(&out));
     assert!(!p.join("out2").exists());
 }
+
+/// A palette PNG holding exactly an honest render's colours (what a PNG optimiser makes of an
+/// image of few colours) is that render: `grade` gives it full marks, as `compare` passes it.
+#[test]
+fn a_lossless_palette_png_of_an_honest_render_gets_full_marks() {
+    let Some(python) = rtoracle::candidate::bench::course_python_or_skip("the palette PNG test")
+    else {
+        return;
+    };
+    let root = tempfile::tempdir().unwrap();
+    let p = root.path();
+    std::fs::write(p.join("mine.toml"), own_scene(40, 1.0, 4, [0.9, 0.3, 0.1])).unwrap();
+    std::fs::write(
+        p.join("r.toml"),
+        format!("name = \"pal\"\n\n{}", image_group("mine", "mine.toml", 10)),
+    )
+    .unwrap();
+    std::fs::create_dir(p.join("sub")).unwrap();
+    let made = run_in(p, &["render", "mine.toml", "--seed", "9", "-o", "rgb.png"]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    // Quantised to a palette, and checked to be lossless (the test's premise), by Pillow.
+    let script = "import sys\nfrom PIL import Image\nrgb = Image.open(sys.argv[1]).convert('RGB')\n\
+                  pal = rgb.convert('P', palette=Image.ADAPTIVE, colors=256)\n\
+                  assert list(pal.convert('RGB').getdata()) == list(rgb.getdata()), 'lossy'\n\
+                  pal.save(sys.argv[2])\n";
+    let done = std::process::Command::new(&python)
+        .args(["-c", script])
+        .arg(p.join("rgb.png"))
+        .arg(p.join("sub/mine.png"))
+        .output()
+        .unwrap();
+    assert!(done.status.success(), "{}", stderr(&done));
+    let bytes = std::fs::read(p.join("sub/mine.png")).unwrap();
+    assert_eq!(bytes[25], 3, "colour type 3 (palette) in IHDR");
+    let cache = p.join("cache");
+    let out = rtoracle()
+        .current_dir(p)
+        .env("RTORACLE_CACHE_DIR", &cache)
+        .args(["grade", "sub", "--rubric", "r.toml", "--out", "out"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report = read_json(&p.join("out/report.json"));
+    assert_eq!(scores(&report), [("image.mine".to_string(), 10.0, 10.0)]);
+    let compared = rtoracle()
+        .current_dir(p)
+        .env("RTORACLE_CACHE_DIR", &cache)
+        .args(["compare", "sub/mine.png", "--scene", "mine.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(compared.status.code(), Some(0), "{}", stderr(&compared));
+}
