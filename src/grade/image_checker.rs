@@ -217,7 +217,7 @@ impl ImageChecker for CompareImageChecker {
         let heatmap = write_heatmap(heatmap_out, &comparison)
             .ok()
             .map(|_| heatmap_out.to_path_buf());
-        let diagnosis = comparison.diagnosis.as_ref().map(|d| {
+        let mut diagnosis = comparison.diagnosis.as_ref().map(|d| {
             let mut s = d.summary.clone();
             if let Some(r) = comparison.regions.first() {
                 s.push_str(&format!(
@@ -230,6 +230,30 @@ impl ImageChecker for CompareImageChecker {
             }
             s
         });
+        // Too few samples is told first when no mistake of the catalogue explains the image (a
+        // wrong encoding also makes an image look noisy: then the mistake is the cause).
+        let explained = comparison
+            .diagnosis
+            .as_ref()
+            .is_some_and(|d| d.best.is_some() && d.hypotheses.first().is_some_and(|h| h.passes));
+        if let Some(n) = comparison
+            .noise
+            .as_ref()
+            .filter(|n| !n.passed && !explained)
+        {
+            let about = n
+                .effective_spp
+                .map(|e| format!(" (its noise is that of about {e:.1} samples per pixel)"))
+                .unwrap_or_default();
+            let noisy = format!(
+                "it is noisier than a render of {} samples per pixel{about}: render it with {} samples per pixel",
+                n.claimed_spp, n.claimed_spp
+            );
+            diagnosis = Some(match diagnosis {
+                Some(d) => format!("{noisy}; {d}"),
+                None => noisy,
+            });
+        }
         ImageOutcome {
             verdict: if comparison.passed() {
                 ImageVerdict::Pass

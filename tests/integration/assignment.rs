@@ -807,3 +807,56 @@ fn a_lossless_palette_png_of_an_honest_render_gets_full_marks() {
         .unwrap();
     assert_eq!(compared.status.code(), Some(0), "{}", stderr(&compared));
 }
+
+/// An image rendered with far fewer samples than its scene asks for is told so, with the count
+/// to render with: the feedback names the noise, not only "no common mistake explains it".
+#[test]
+fn a_render_with_too_few_samples_is_told_the_count_to_render_with() {
+    let root = tempfile::tempdir().unwrap();
+    let p = root.path();
+    std::fs::write(p.join("mine.toml"), own_scene(64, 1.0, 50, [0.9, 0.3, 0.1])).unwrap();
+    std::fs::write(
+        p.join("r.toml"),
+        format!("name = \"few\"\n\n{}", image_group("mine", "mine.toml", 10)),
+    )
+    .unwrap();
+    std::fs::create_dir(p.join("sub")).unwrap();
+    let made = run_in(
+        p,
+        &[
+            "render",
+            "mine.toml",
+            "--spp",
+            "1",
+            "--seed",
+            "2",
+            "-o",
+            "sub/mine.png",
+        ],
+    );
+    assert!(made.status.success(), "{}", stderr(&made));
+    let out = rtoracle()
+        .current_dir(p)
+        .env("RTORACLE_CACHE_DIR", p.join("cache"))
+        .args(["grade", "sub", "--rubric", "r.toml", "--out", "out"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report = read_json(&p.join("out/report.json"));
+    assert_eq!(scores(&report), [("image.mine".to_string(), 0.0, 10.0)]);
+    assert_eq!(
+        report["checks"][0]["image"]["metrics"]["noise"]["passed"],
+        false
+    );
+    let message = report["checks"][0]["message"].as_str().unwrap();
+    assert!(
+        message.contains("noisier than a render of 50 samples per pixel")
+            && message.contains("render it with 50 samples per pixel"),
+        "{message}"
+    );
+    let feedback = std::fs::read_to_string(p.join("out/feedback.md")).unwrap();
+    assert!(
+        feedback.contains("render it with 50 samples per pixel"),
+        "{feedback}"
+    );
+}
