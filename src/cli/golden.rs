@@ -76,6 +76,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 fn write_scene_file(file: &Path, out: &Path, spp: Option<u32>) -> anyhow::Result<ExitCode> {
+    if !file.exists() {
+        if let Some(name) = file
+            .to_str()
+            .filter(|n| rtoracle::scene::builtin(n).is_ok())
+        {
+            anyhow::bail!(
+                "{name}: no such file; it names a built-in scene, whose golden `rtoracle golden --scenes {name} --dir DIR` writes (as DIR/{name}.exr)"
+            );
+        }
+    }
     let description = SceneDescription::from_file(file)?;
     // The grader's golden of this scene, so that the bytes are the cache's.
     let spp = spp.unwrap_or_else(|| golden_spp(description.image.samples_per_pixel));

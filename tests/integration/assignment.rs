@@ -682,6 +682,12 @@ fn honest_independent_renders_of_scene_files_at_1_and_50_spp_get_full_marks_flip
             );
         }
     }
+    // A built-in's name where a scene file is wanted: the command that makes its golden.
+    assert_bad_input(
+        &run_in(p, &["golden", "week04-quad", "-o", "q.exr"]),
+        "names a built-in scene, whose golden `rtoracle golden --scenes week04-quad --dir DIR`",
+    );
+    assert!(!p.join("q.exr").exists());
     // `golden FILE.toml` with no --spp makes the golden a grading of that scene uses.
     let made = run_in(p, &["golden", "fifty.toml", "-o", "fifty.exr"]);
     assert!(made.status.success(), "{}", stderr(&made));
