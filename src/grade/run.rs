@@ -381,11 +381,20 @@ fn heatmap_name(group: &Group) -> String {
 fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckResult {
     let file = group.file.clone().expect("validated");
     let scene = group.scene.clone().expect("validated");
+    // A scene file is named by its file name in messages: the folder is the rubric's business
+    // (an autograder package keeps its scenes in `rtoracle-scenes/`, which students never see).
+    let shown = if scene.ends_with(".toml") {
+        Path::new(&scene)
+            .file_name()
+            .map_or_else(|| scene.clone(), |n| n.to_string_lossy().to_string())
+    } else {
+        scene.clone()
+    };
     let (score, status, message) = match &outcome.verdict {
         ImageVerdict::Pass => (
             group.points,
             CheckStatus::Passed,
-            format!("{file} matches the reference of {scene} up to sampling noise."),
+            format!("{file} matches the reference of {shown} up to sampling noise."),
         ),
         ImageVerdict::Fail => (
             0.0,
@@ -396,9 +405,9 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
                     let first = chars.next().map(|c| c.to_uppercase().collect::<String>());
                     let d = format!("{}{}", first.unwrap_or_default(), chars.as_str());
                     let end = if d.ends_with('.') { "" } else { "." };
-                    format!("{file} differs from the reference of {scene}. {d}{end}")
+                    format!("{file} differs from the reference of {shown}. {d}{end}")
                 }
-                _ => format!("{file} differs from the reference of {scene}."),
+                _ => format!("{file} differs from the reference of {shown}."),
             },
         ),
         ImageVerdict::Unusable(why) => (
@@ -430,7 +439,7 @@ fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckRes
         status,
         message,
         visibility: group.visibility,
-        tags: vec!["image".to_string(), scene.clone()],
+        tags: vec!["image".to_string(), shown.clone()],
         counts: None,
         failures: vec![],
         image: Some(ImageResult {

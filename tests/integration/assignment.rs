@@ -358,6 +358,13 @@ fn the_autograder_package_carries_the_scene_and_its_golden_so_gradescope_never_r
     assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
     let results = read_json(&root.join("results/results.json"));
     assert_eq!(results["score"], 100.0, "{results}");
+    // Students read of their scene by its name, not of the package's folder for it.
+    let text = results.to_string();
+    assert!(
+        text.contains("the reference of triangles-scene.toml"),
+        "{text}"
+    );
+    assert!(!text.contains("rtoracle-scenes/"), "{text}");
 }
 
 fn copy_dir(from: &Path, to: &Path) {
