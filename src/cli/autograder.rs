@@ -43,13 +43,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     // Refuse a wrong binary before rendering any golden.
     autograder::check_binary(&binary)?;
-    let (packed, rubric_seed) = match &args.rubric {
+    let (packed, rubric_seed, runs_code) = match &args.rubric {
         Some(path) => {
             // Validate it now, so a bad rubric fails here and not on Gradescope.
             let rubric = Rubric::from_file(path)?;
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("{}: cannot read the rubric", path.display()))?;
-            (pack::pack_rubric(&rubric, &text)?, rubric.seed)
+            let runs_code = rubric
+                .groups
+                .iter()
+                .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
+            (pack::pack_rubric(&rubric, &text)?, rubric.seed, runs_code)
         }
         None => (
             pack::PackedRubric {
@@ -58,6 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 rendered: 0,
             },
             Rubric::week04().seed,
+            true,
         ),
     };
     let (seed, how) = match (args.seed, rubric_seed) {
@@ -67,6 +72,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             autograder::secret_seed().context("cannot draw a secret seed from /dev/urandom")?,
             "secret, drawn now",
         ),
+    };
+    // A rubric of images only draws no vectors: its seed is there but unused.
+    let how = if runs_code {
+        how
+    } else {
+        "unused: the rubric has no code group"
     };
     let rubric_text = autograder::with_seed(&packed.rubric_toml, seed);
     autograder::build_package_with(&binary, &rubric_text, &packed.files, &args.out)?;

@@ -165,33 +165,43 @@ impl Target {
 impl Target {
     /// Checks the submission folder before any work: it is a folder holding `RT_object.py`.
     pub fn check(&self) -> anyhow::Result<()> {
-        if let Some(dir) = &self.python_course {
-            if !dir.is_dir() {
-                let what = if dir.exists() {
-                    "is a file; the submission folder is wanted"
-                } else {
-                    "no such folder"
-                };
-                anyhow::bail!("--python-course {}: {what}", dir.display());
-            }
-            if !dir.join("RT_object.py").is_file() {
-                anyhow::bail!(
-                    "--python-course {}: the folder has no RT_object.py (the course's layout: \
-                     RT_utility.py, RT_ray.py, RT_object.py)",
-                    dir.display()
-                );
-            }
+        match &self.python_course {
+            Some(dir) => check_submission_folder(dir, "--python-course "),
+            None => Ok(()),
         }
-        Ok(())
     }
+}
+
+/// Checks that `dir` is a folder holding `RT_object.py`; errors name it after `label` (the
+/// option it came with, or nothing for a positional argument).
+fn check_submission_folder(dir: &std::path::Path, label: &str) -> anyhow::Result<()> {
+    if !dir.is_dir() {
+        let what = if dir.exists() {
+            "is a file; the submission folder is wanted"
+        } else {
+            "no such folder"
+        };
+        anyhow::bail!("{label}{}: {what}", dir.display());
+    }
+    if !dir.join("RT_object.py").is_file() {
+        anyhow::bail!(
+            "{label}{}: the folder has no RT_object.py (the course's layout: \
+             RT_utility.py, RT_ray.py, RT_object.py)",
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// `rtoracle check`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Without --python-course or --adapter, checks the course submission in the current folder (as --python-course .)."
+    after_help = "Without FOLDER, --python-course or --adapter, checks the course submission in the current folder (as --python-course .)."
 )]
 pub struct Args {
+    /// A course submission folder to check (the same as --python-course FOLDER).
+    #[arg(value_name = "FOLDER", conflicts_with_all = ["python_course", "adapter"])]
+    folder: Option<PathBuf>,
     #[command(flatten)]
     target: Target,
     #[command(flatten)]
@@ -237,15 +247,38 @@ fn current_submission() -> anyhow::Result<PathBuf> {
     let here = std::env::current_dir().context("cannot read the current folder")?;
     let shown = rtoracle::escape::terminal_line(&here.display().to_string());
     if !here.join("RT_object.py").is_file() {
+        // Run one folder too high: name the submission folders below (a few, sorted).
+        let mut below: Vec<String> = std::fs::read_dir(&here)
+            .map(|entries| {
+                entries
+                    .flatten()
+                    .filter(|e| e.path().join("RT_object.py").is_file())
+                    .map(|e| e.file_name().to_string_lossy().to_string())
+                    .collect()
+            })
+            .unwrap_or_default();
+        below.sort();
+        let hint = match below.first() {
+            Some(first) => format!(
+                "; {} has one: `rtoracle check {}`",
+                rtoracle::escape::terminal_line(first),
+                rtoracle::escape::terminal_line(first)
+            ),
+            None => String::new(),
+        };
         anyhow::bail!(
-            "no RT_object.py in {shown}: run `rtoracle check` in a course submission folder (RT_utility.py, RT_ray.py, RT_object.py), or give --python-course DIR or --adapter 'CMD ARGS'"
+            "no RT_object.py in {shown}: run `rtoracle check` in a course submission folder (RT_utility.py, RT_ray.py, RT_object.py), or give --python-course DIR or --adapter 'CMD ARGS'{hint}"
         );
     }
     errln!("checking the course submission in {shown} (as --python-course .)");
     Ok(here)
 }
 
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
+    if let Some(folder) = args.folder.take() {
+        check_submission_folder(&folder, "")?;
+        args.target.python_course = Some(folder);
+    }
     args.target.check()?;
     let judging = args.judging.judging(args.target.default_profile());
     let (cases, judged_by) = match &args.vectors {

@@ -501,11 +501,30 @@ fn check_with_no_argument_checks_the_submission_in_the_current_folder() {
     };
     assert_eq!(failed(&bare), failed(&explicit));
 
+    // The folder as an argument is `--python-course FOLDER`; from one folder too high, the
+    // message names the submission folder below.
+    let parent = dir.path().parent().unwrap();
+    let name = dir.path().file_name().unwrap().to_str().unwrap();
+    let positional = run_in(parent, &["check", "--json", name]);
+    assert_eq!(positional.status.code(), Some(1));
+    assert_eq!(failed(&positional), failed(&explicit));
+    let above = tempfile::tempdir().unwrap();
+    submission(&above.path().join("my-sub"), "", None);
+    assert_bad_input(
+        &run_in(above.path(), &["check"]),
+        "; my-sub has one: `rtoracle check my-sub`",
+    );
+    assert_bad_input(
+        &run_in(above.path(), &["check", "nope"]),
+        "nope: no such folder",
+    );
+
     // Outside a submission folder: what it looked for, exit 2.
     let empty = tempfile::tempdir().unwrap();
     let out = run_in(empty.path(), &["check"]);
     assert_bad_input(&out, "no RT_object.py in");
     assert!(stderr(&out).contains("--python-course DIR"));
+    assert!(!stderr(&out).contains("has one"));
 }
 
 /// For the triangle assignment a student checks with `--require triangle`: an RT_object.py
