@@ -772,6 +772,19 @@ fn a_rubric_of_images_only_needs_no_python_and_no_seed() {
     assert!(!stderr(&out).contains("sandbox"), "{}", stderr(&out));
     let report = read_json(&p.join("out/report.json"));
     assert_eq!(scores(&report), [("image.mine".to_string(), 10.0, 10.0)]);
+    // Its package has a seed, and says it is not used.
+    let packed = rtoracle()
+        .current_dir(p)
+        .env("RTORACLE_CACHE_DIR", &cache)
+        .args(["autograder", "--rubric", "images.toml", "--out", "a.zip"])
+        .output()
+        .unwrap();
+    assert!(packed.status.success(), "{}", stderr(&packed));
+    assert!(
+        stderr(&packed).contains("(unused: the rubric has no code group)"),
+        "{}",
+        stderr(&packed)
+    );
     // With a code group the same Python is refused before any grading.
     std::fs::write(
         p.join("code.toml"),
