@@ -257,7 +257,12 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
                 fatal += 1;
             }
             for c in &r.checks {
-                if c.score < c.max_score {
+                // A check of a 0-point group loses nothing but can still fail.
+                let failed = matches!(
+                    c.status,
+                    super::run::CheckStatus::Failed | super::run::CheckStatus::Error
+                );
+                if c.score < c.max_score || failed {
                     let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
                     e.1 += 1;
                 }
@@ -288,7 +293,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         }
         md.push_str("\n## Most common failures\n\n");
         if checks.is_empty() {
-            md.push_str("Every submission got full marks.\n");
+            md.push_str("Every submission passed every check.\n");
         } else {
             let mut rows: Vec<_> = checks.into_iter().collect();
             rows.sort_by(|a, b| b.1.1.cmp(&a.1.1).then(a.0.cmp(&b.0)));
@@ -411,6 +416,34 @@ mod tests {
             );
         }
         assert!(!report.contains("failed_vectors"), "{report}");
+    }
+
+    /// A group worth 0 points loses nothing when it fails, but its failures are still the most
+    /// common ones: the summary lists the check, not "every submission passed".
+    #[test]
+    fn a_failing_check_of_a_0_point_group_is_listed_in_the_summary() {
+        let text = crate::grade::rubric::WEEK04_RUBRIC.replacen("points = 30", "points = 0", 1);
+        let rubric = Rubric::from_toml(&text, "zero.toml").unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("a")).unwrap();
+        fake_images(&dir.path().join("a"));
+        let out = dir.path().join("out");
+        let code = FakeCode::new(counts(2, 1), counts(2, 2));
+        grade_batch(
+            dir.path(),
+            &rubric,
+            &code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        assert!(summary.contains("| `sphere"), "{summary}");
+        assert!(
+            !summary.contains("Every submission passed every check"),
+            "{summary}"
+        );
     }
 
     /// A submission folder named like the batch's own report is an error row; the others are
