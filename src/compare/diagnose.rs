@@ -21,65 +21,42 @@ fn encoding_mistake(e: Encoding, asked: Encoding) -> String {
     }
 }
 
-/// The image with its rows in reverse order.
-fn flip_y(c: &CandidateImage) -> CandidateImage {
+/// The image whose pixel `(i, j)` is the candidate's pixel `from(i, j, width, height)`: a flip.
+fn remapped(
+    c: &CandidateImage,
+    from: impl Fn(usize, usize, usize, usize) -> (usize, usize),
+) -> CandidateImage {
+    let (width, height) = c.size();
+    let sources = (0..height)
+        .flat_map(|j| (0..width).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let (si, sj) = from(i, j, width, height);
+            sj * width + si
+        });
     match c {
-        CandidateImage::Rgb8 {
+        CandidateImage::Rgb8 { data, .. } => CandidateImage::Rgb8 {
             width,
             height,
-            data,
-        } => CandidateImage::Rgb8 {
-            width: *width,
-            height: *height,
-            data: data
-                .chunks_exact(3 * width)
-                .rev()
-                .flatten()
-                .copied()
+            data: sources
+                .flat_map(|k| data[3 * k..3 * k + 3].iter().copied())
                 .collect(),
         },
-        CandidateImage::Linear {
+        CandidateImage::Linear { data, .. } => CandidateImage::Linear {
             width,
             height,
-            data,
-        } => CandidateImage::Linear {
-            width: *width,
-            height: *height,
-            data: data.chunks_exact(*width).rev().flatten().copied().collect(),
+            data: sources.map(|k| data[k]).collect(),
         },
     }
 }
 
+/// The image with its rows in reverse order.
+fn flip_y(c: &CandidateImage) -> CandidateImage {
+    remapped(c, |i, j, _, h| (i, h - 1 - j))
+}
+
 /// The image with each row's pixels in reverse order (mirrored left to right).
 fn flip_x(c: &CandidateImage) -> CandidateImage {
-    match c {
-        CandidateImage::Rgb8 {
-            width,
-            height,
-            data,
-        } => CandidateImage::Rgb8 {
-            width: *width,
-            height: *height,
-            data: data
-                .chunks_exact(3 * width)
-                .flat_map(|row| row.chunks_exact(3).rev().flatten())
-                .copied()
-                .collect(),
-        },
-        CandidateImage::Linear {
-            width,
-            height,
-            data,
-        } => CandidateImage::Linear {
-            width: *width,
-            height: *height,
-            data: data
-                .chunks_exact(*width)
-                .flat_map(|row| row.iter().rev())
-                .copied()
-                .collect(),
-        },
-    }
+    remapped(c, |i, j, w, _| (w - 1 - i, j))
 }
 
 fn bgr(c: &CandidateImage) -> CandidateImage {
@@ -211,5 +188,42 @@ pub fn diagnose(
         summary,
         best: best.map(|s| s.name),
         hypotheses: scores,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a 3 x 2 image of distinct pixels, both kinds: y reverses the rows, x each row, and
+    /// both twice give the image back.
+    #[test]
+    fn flips_reverse_rows_or_columns() {
+        let rgb = CandidateImage::Rgb8 {
+            width: 3,
+            height: 2,
+            data: (0..18).collect(),
+        };
+        let pixels = |c: &CandidateImage| match c {
+            CandidateImage::Rgb8 { data, .. } => {
+                data.chunks(3).map(|p| p[0] / 3).collect::<Vec<_>>()
+            }
+            CandidateImage::Linear { data, .. } => data.iter().map(|p| p[0] as u8).collect(),
+        };
+        assert_eq!(pixels(&flip_y(&rgb)), [3, 4, 5, 0, 1, 2]);
+        assert_eq!(pixels(&flip_x(&rgb)), [2, 1, 0, 5, 4, 3]);
+        let linear = CandidateImage::Linear {
+            width: 3,
+            height: 2,
+            data: (0..6).map(|k| [k as f32, 0.0, 0.0]).collect(),
+        };
+        assert_eq!(pixels(&flip_y(&linear)), [3, 4, 5, 0, 1, 2]);
+        assert_eq!(pixels(&flip_x(&linear)), [2, 1, 0, 5, 4, 3]);
+        assert_eq!(pixels(&flip_x(&flip_x(&rgb))), pixels(&rgb));
+        // Channels stay with their pixel.
+        match flip_x(&rgb) {
+            CandidateImage::Rgb8 { data, .. } => assert_eq!(data[..3], [6, 7, 8]),
+            _ => unreachable!(),
+        }
     }
 }
