@@ -11,21 +11,8 @@ fn main() -> anyhow::Result<()> {
     let [scene, mistake, out, rest @ ..] = args.as_slice() else {
         anyhow::bail!("usage: mistake SCENE MISTAKE OUT.png [SEED]");
     };
-    let mistake = match mistake.as_str() {
-        "honest" => Mistake::Honest,
-        "no-gamma" => Mistake::NoGamma,
-        "gamma22" => Mistake::Gamma22,
-        "albedo" => Mistake::AlbedoScaled,
-        "half-pixel" => Mistake::HalfPixelShift,
-        "jitter01" => Mistake::JitterZeroOne,
-        "flip-y" => Mistake::YFlipped,
-        "flip-x" => Mistake::XFlipped,
-        "bgr" => Mistake::Bgr,
-        "fov" => Mistake::WiderFov,
-        "missing" => Mistake::ObjectMissing,
-        "sky" => Mistake::SkyReversed,
-        other => anyhow::bail!("unknown mistake '{other}'"),
-    };
+    let mistake = Mistake::from_argument(mistake)
+        .ok_or_else(|| anyhow::anyhow!("unknown mistake '{mistake}'"))?;
     let seed = rest.first().map(|s| s.parse()).transpose()?.unwrap_or(1);
     let description = rtoracle::scene::builtin(scene)?;
     let spp = description.image.samples_per_pixel;

@@ -55,7 +55,32 @@ pub const MUST_FAIL: [Mistake; 10] = [
     Mistake::SkyReversed,
 ];
 
+/// Every mistake of the catalogue with the name `examples/mistake.rs` (and the README test's
+/// `mistake:` fixture) calls it by.
+pub const BY_ARGUMENT: [(&str, Mistake); 12] = [
+    ("honest", Mistake::Honest),
+    ("no-gamma", Mistake::NoGamma),
+    ("gamma22", Mistake::Gamma22),
+    ("albedo", Mistake::AlbedoScaled),
+    ("half-pixel", Mistake::HalfPixelShift),
+    ("jitter01", Mistake::JitterZeroOne),
+    ("flip-y", Mistake::YFlipped),
+    ("flip-x", Mistake::XFlipped),
+    ("bgr", Mistake::Bgr),
+    ("fov", Mistake::WiderFov),
+    ("missing", Mistake::ObjectMissing),
+    ("sky", Mistake::SkyReversed),
+];
+
 impl Mistake {
+    /// The mistake called `argument` in [`BY_ARGUMENT`].
+    pub fn from_argument(argument: &str) -> Option<Mistake> {
+        BY_ARGUMENT
+            .iter()
+            .find(|(name, _)| *name == argument)
+            .map(|&(_, m)| m)
+    }
+
     /// A short name.
     pub fn name(self) -> &'static str {
         match self {
@@ -199,6 +224,24 @@ mod tests {
         )
         .unwrap();
         assert_eq!(ours.data, film.to_course_rgb8());
+    }
+
+    /// Every mistake has one argument name, and every name one mistake.
+    #[test]
+    fn each_mistake_has_its_own_argument_name() {
+        let mut all: Vec<Mistake> = MUST_FAIL.to_vec();
+        all.extend([Mistake::Honest, Mistake::XFlipped]);
+        for m in &all {
+            let names: Vec<&str> = BY_ARGUMENT
+                .iter()
+                .filter(|(_, x)| x == m)
+                .map(|(n, _)| *n)
+                .collect();
+            assert_eq!(names.len(), 1, "{m:?}: {names:?}");
+            assert_eq!(Mistake::from_argument(names[0]), Some(*m));
+        }
+        assert_eq!(BY_ARGUMENT.len(), all.len());
+        assert_eq!(Mistake::from_argument("flipped"), None);
     }
 
     #[test]

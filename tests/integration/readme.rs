@@ -117,26 +117,6 @@ enum Fixture {
     },
 }
 
-/// The mistakes of the catalogue by the names `examples/mistake.rs` takes.
-fn mistake_named(name: &str) -> Option<rtoracle::compare::mistakes::Mistake> {
-    use rtoracle::compare::mistakes::Mistake;
-    Some(match name {
-        "honest" => Mistake::Honest,
-        "no-gamma" => Mistake::NoGamma,
-        "gamma22" => Mistake::Gamma22,
-        "albedo" => Mistake::AlbedoScaled,
-        "half-pixel" => Mistake::HalfPixelShift,
-        "jitter01" => Mistake::JitterZeroOne,
-        "flip-y" => Mistake::YFlipped,
-        "flip-x" => Mistake::XFlipped,
-        "bgr" => Mistake::Bgr,
-        "fov" => Mistake::WiderFov,
-        "missing" => Mistake::ObjectMissing,
-        "sky" => Mistake::SkyReversed,
-        _ => return None,
-    })
-}
-
 /// The value of the directive `<!-- key: VALUE -->` on `line`, if it is one.
 fn directive<'a>(line: &'a str, key: &str) -> Option<&'a str> {
     line.trim()
@@ -170,7 +150,7 @@ fn parse_fixtures(spec: &str) -> Result<Vec<Fixture>, String> {
                     Some((scene, mistake))
                         if word.contains('=')
                             && rtoracle::scene::builtin(scene).is_ok()
-                            && mistake_named(mistake).is_some() =>
+                            && rtoracle::compare::mistakes::Mistake::from_argument(mistake).is_some() =>
                     {
                         Ok(Fixture::Mistake {
                             scene: scene.to_string(),
@@ -221,7 +201,8 @@ fn make_fixture(fixture: &Fixture, dir: &Path) -> Result<(), String> {
             file,
         } => {
             let description = rtoracle::scene::builtin(scene).map_err(|e| e.to_string())?;
-            let mistake = mistake_named(mistake).ok_or("an unknown mistake")?;
+            let mistake = rtoracle::compare::mistakes::Mistake::from_argument(mistake)
+                .ok_or("an unknown mistake")?;
             let spp = description.image.samples_per_pixel;
             let image =
                 rtoracle::compare::mistakes::render_with_mistake(&description, mistake, spp, 1);
