@@ -486,7 +486,7 @@ fn normal_check<B: Band>(
     if worst <= tol {
         (true, None)
     } else {
-        tags.push(judging.ill_conditioned_tag().into());
+        tags.push(super::tags::ill_conditioned(judging).into());
         (
             false,
             Some(format!(
