@@ -1,6 +1,7 @@
 //! How untrusted code is started: the one place that spawns a candidate or a student's
 //! submission (`check --python-course`, `check --adapter`, `fuzz` and `grade` all come here,
-//! through [`candidate::Session`](crate::candidate::Session)).
+//! through [`candidate::Session`](crate::candidate::Session)). What it does, for a reader who
+//! runs it: `docs/sandbox.md`.
 //!
 //! # What it promises
 //! - **Never as root.** Untrusted code never runs as uid 0. A root harness gives every
