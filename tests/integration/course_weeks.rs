@@ -1304,3 +1304,43 @@ fn week10_formulas_hold_on_hand_worked_cases() {
 fn week10_mistakes_show_where_the_catalogue_says() {
     mistakes_show_where_the_catalogue_says("week10");
 }
+
+/// `render_scene.py --describe` reports the scene main.py built, as the facts give it: week 6's
+/// glass on the right (IOR 1.5) under the sky, week 10's left sphere moving up by 0.5 and
+/// rendered with render_jittered at spp 200.
+#[test]
+fn the_render_driver_describes_the_scene_main_builds() {
+    let Some(py) = python() else { return };
+    let describe = |folder: &str, function: &str| -> Value {
+        let weeks = weeks_dir();
+        let out = Command::new(py)
+            .arg("-B")
+            .arg(weeks.join("render_scene.py"))
+            .arg(weeks.join(folder))
+            .args([function, "--describe"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let glass = describe("week06/solution", "renderDielectric");
+    assert_eq!(glass["output"], "week06_dielec_sky.png");
+    assert_eq!(glass["miss"], "sky");
+    assert_eq!(glass["camera"]["vertical_fov"], json!(50));
+    assert_eq!(glass["camera"]["look_from"], v3(-2.0, 2.0, 1.0));
+    let right = &glass["objects"][4];
+    assert_eq!(right["center"], v3(1.0, 0.0, -1.0));
+    assert_eq!(right["material"]["class"], "Dielectric");
+    assert_eq!(right["material"]["IOR"], json!(1.5));
+    let moving = describe("week10/solution", "renderMoving");
+    assert_eq!(moving["method"], "render_jittered");
+    assert_eq!(moving["camera"]["samples_per_pixel"], json!(200));
+    let left = &moving["objects"][1];
+    assert_eq!(left["is_moving"], json!(true));
+    assert_eq!(left["moving_center"], v3(-1.0, 0.5, -1.0));
+    assert_eq!(moving["objects"][2]["is_moving"], json!(false));
+}
