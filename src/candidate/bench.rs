@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::generate::random_cases;
-use super::process::{CandidateCommand, HarnessError, RunOptions};
+use super::command::CandidateCommand;
+use super::error::HarnessError;
+use super::options::RunOptions;
 use super::rust::{Reference, check_candidate};
 use crate::oracle::vectors::ShapeKind;
 

@@ -331,7 +331,7 @@ fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
     let dir = assemble_fixture("bug_imports_a_module_the_grader_lacks").unwrap();
     std::fs::write(
         dir.path().join("adapter.py"),
-        rtoracle::candidate::process::PYTHON_COURSE_ADAPTER,
+        rtoracle::candidate::command::PYTHON_COURSE_ADAPTER,
     )
     .unwrap();
     let mut child = std::process::Command::new(python().unwrap())
