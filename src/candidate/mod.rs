@@ -18,13 +18,15 @@
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
 //! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
 //!   [`generate::oracle_expect`], shrinking, the fuzz driver.
-//! - [`bench`](mod@bench): throughput of the harness against baselines measured in the same run.
+//! - [`bench`](mod@bench): throughput of the harness against baselines measured in the same run;
+//!   [`fixtures`]: the fixture files it (and grading's benchmark) needs, embedded in the binary.
 
 pub mod bench;
 pub mod check;
 pub mod command;
 pub mod diagnose;
 pub mod error;
+pub mod fixtures;
 pub mod fuzz;
 pub mod generate;
 pub mod lines;
