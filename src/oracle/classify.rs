@@ -1,5 +1,5 @@
 //! Classification of a case into `hit` / `miss` (definite), `ambiguous` or `any`, by the
-//! error-band policy of `ORACLE.md`.
+//! error-band policy of `docs/oracle.md` ("Classes", "Profiles and precision").
 //!
 //! The exact answer comes from [`super::exact`]. Each comparison the course's code makes on the
 //! way to that answer is then checked against the band of its naive formula (see

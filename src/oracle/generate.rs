@@ -1,4 +1,5 @@
-//! Edge-case generators: every case of `ORACLE.md` built exactly in `f64` (integer and dyadic
+//! Edge-case generators: every family of `docs/oracle.md` ("How the cases are generated") built
+//! exactly in `f64` (integer and dyadic
 //! geometry, so tangents, edges, corners and interval ends are exact), ulp ladders around them,
 //! and random cases across scales `2^-20 .. 2^20`. Every case is then classified exactly.
 //!

@@ -1,4 +1,5 @@
-//! The vector file: JSON lines, one case a line, as `ORACLE.md` specifies.
+//! The vector file: JSON lines, one case a line, as `docs/oracle.md` ("The vector format")
+//! specifies.
 //!
 //! ```json
 //! {"id": "quad-corner-0007",
