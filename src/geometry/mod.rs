@@ -1,6 +1,6 @@
 //! Rays, intervals, hit records and the three primitives, in `f64`.
 //!
-//! Everything here follows the course's semantics (see `COURSE_API.md` in the design notes):
+//! Everything here follows the course's semantics (see `docs/oracle.md`, "The course's semantics"):
 //! spheres take the near root when the interval *surrounds* it (open), quads and triangles take
 //! `t` when the interval *contains* it (closed), directions are never normalised, and the normal
 //! of a hit record is a unit vector that faces the incoming ray.
