@@ -43,7 +43,7 @@
 //! missing file, an unparsable scene or a golden of another scene stops the grading before it
 //! starts, with one line naming the rubric. Without a `golden`, the image checker renders the
 //! golden the first time it is needed and keeps it in the cache
-//! ([`crate::golden::cached_golden`]).
+//! ([`crate::golden::golden_of`]).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
