@@ -1,7 +1,7 @@
-//! Rays, intervals, hit records and the three primitives, in `f64`.
+//! Rays, intervals, hit records and the primitives (spheres, moving spheres, quads, triangles),
+//! in `f64`.
 //!
-//! Everything here follows the course's semantics (see `COURSE_API.md` in the design notes):
-//! spheres take the near root when the interval *surrounds* it (open), quads and triangles take
+//! Everything here follows the course's semantics: spheres take the near root when the interval *surrounds* it (open), quads and triangles take
 //! `t` when the interval *contains* it (closed), directions are never normalised, and the normal
 //! of a hit record is a unit vector that faces the incoming ray.
 
@@ -16,7 +16,7 @@ pub use hit::HitRecord;
 pub use interval::Interval;
 pub use quad::{PARALLEL_EPSILON, Quad};
 pub use ray::Ray;
-pub use sphere::Sphere;
+pub use sphere::{MovingSphere, Sphere};
 pub(crate) use sphere::{pick_root, roots_of};
 pub use triangle::Triangle;
 
