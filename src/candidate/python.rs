@@ -29,7 +29,8 @@ use std::time::Duration;
 
 use crate::sandbox::{Sandbox, SandboxError, SandboxPolicy};
 
-/// The modules the course's code imports at module level (COURSE_API.md): numpy and Pillow.
+/// The modules the course's code imports at module level (`RT_utility.py`: numpy and Pillow;
+/// `docs/sandbox.md`, "The interpreter").
 pub const DEFAULT_REQUIRES: [&str; 2] = ["numpy", "PIL"];
 
 /// [`DEFAULT_REQUIRES`] as owned strings (the rubric's default `python_requires`).

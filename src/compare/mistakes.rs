@@ -41,7 +41,8 @@ pub enum Mistake {
     SkyReversed,
 }
 
-/// Every mistake the comparison must reject, as IMAGES.md lists them.
+/// Every mistake the comparison must reject (`docs/comparing-images.md`, "Measured false alarms
+/// and power").
 pub const MUST_FAIL: [Mistake; 10] = [
     Mistake::NoGamma,
     Mistake::Gamma22,

@@ -6,7 +6,7 @@
 //! candidate's interval to the golden's mean into p-values at four scales (pixel, 8x8 tile,
 //! 32x32 tile, whole image), each given a quarter of the per-image false-failure rate and
 //! adjusted with Šidák's formula over its tests. When an image fails, [`diagnose`] tests the
-//! common mistakes as alternative hypotheses. See `docs/sections/compare.md`.
+//! common mistakes as alternative hypotheses. See `docs/comparing-images.md`.
 
 pub mod bench;
 pub mod diagnose;

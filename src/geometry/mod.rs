@@ -1,7 +1,8 @@
 //! Rays, intervals, hit records and the primitives (spheres, moving spheres, quads, triangles),
 //! in `f64`.
 //!
-//! Everything here follows the course's semantics: spheres take the near root when the interval *surrounds* it (open), quads and triangles take
+//! Everything here follows the course's semantics (see `docs/oracle.md`, "The course's semantics"):
+//! spheres take the near root when the interval *surrounds* it (open), quads and triangles take
 //! `t` when the interval *contains* it (closed), directions are never normalised, and the normal
 //! of a hit record is a unit vector that faces the incoming ray.
 

@@ -19,7 +19,7 @@ pub fn default_suite_with(seed: u64, judging: Judging) -> Vec<Case> {
     generate_with(seed, DEFAULT_COUNT, &ShapeKind::ALL, judging)
 }
 
-/// Every tag `ORACLE.md` names; the default suite holds each.
+/// Every tag of `docs/oracle.md` ("Tags") that the generators draw; the default suite holds each.
 pub const ORACLE_TAGS: [&str; 13] = [
     "tangent",
     "near-tangent",

@@ -1,5 +1,6 @@
 //! Rust transcriptions of the course's intersection code: the naive formulas, each honest
-//! variant `COURSE_API.md` lists, and a catalogue of buggy ones.
+//! variant the course's code admits (`docs/oracle.md`, "The course's semantics"), and a catalogue
+//! of buggy ones.
 //!
 //! They follow Python's float semantics: a float division by zero raises (here
 //! [`Answer::Err`]), comparisons with NaN are false, and nothing is fused. The fairness tests

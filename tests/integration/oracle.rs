@@ -174,7 +174,7 @@ fn filter_and_exact_agree_and_reference_is_exact_on_a_million_cases() {
 }
 
 /// Re-checks every tag of the default suite against its stated definition (`src/oracle/tags.rs`,
-/// docs/sections/oracle.md), with exact dyadic arithmetic and formulas written apart from the
+/// docs/oracle.md), with exact dyadic arithmetic and formulas written apart from the
 /// library's (the discriminant by Lagrange's identity `a r^2 - |f x d|^2`, the surface
 /// coordinates by triple products `(w x v).d`, `(u x w).d`).
 mod truthful_tags {

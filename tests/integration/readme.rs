@@ -1,13 +1,13 @@
-//! The README: assembled from `docs/sections/` by `docs/assemble-readme.sh` (an edit to one that
-//! is not carried to the other fails here), and every `console` example in it is real.
+//! The docs (README.md and every page of `docs/`): every `console` example in them is real,
+//! every relative link resolves, and none names a design note that is not in the repository.
 //!
 //! A `console` block is a list of commands (`$ ` lines), each followed by its output (stdout and
 //! stderr together) up to the next command or the closing fence. The test runs every block of a
-//! section in order (the sections at the same time), in one fresh folder per section (so a file written by one block is there for
-//! the next; mode 755, so a sandbox user can run a script written there), with `rtoracle` on
-//! `PATH` being the binary under test and `RTORACLE_CACHE_DIR` the section folder's `.cache` (so
-//! no golden is cached in the user's home), and compares the outputs after masking what changes
-//! from run to run (see [`mask`]):
+//! page in order (the pages at the same time), in one fresh folder per page (so a file written
+//! by one block is there for the next; mode 755, so a sandbox user can run a script written
+//! there), with `rtoracle` on `PATH` being the binary under test and `RTORACLE_CACHE_DIR` the
+//! page folder's `.cache` (so no golden is cached in the user's home), and compares the outputs
+//! after masking what changes from run to run (see [`mask`]):
 //! - numbers of seconds (`1.2 s`, `0.48 s`) become `N s`;
 //! - the version after `rtoracle ` and in a cached golden's name (`...-4096spp-0.1.0.exr`)
 //!   becomes `VERSION`;
@@ -20,7 +20,7 @@
 //! Setup lines and commands see `RTORACLE_SOURCE`, the checkout, to copy fixtures from.
 //!
 //! Comment lines right before a block prepare or explain it:
-//! - `<!-- fixtures: WHAT... -->` makes fixture submissions in the section's folder first: `NAME`
+//! - `<!-- fixtures: WHAT... -->` makes fixture submissions in the page's folder first: `NAME`
 //!   (or `NAME=FOLDER`, `FOLDER` ending in the name) is `tests/fixtures/submissions/NAME` made a
 //!   submission by `rtoracle::grade::bench::materialize` (its images rendered), and
 //!   `python:VARIANT=FOLDER` is the `check` fixture `tests/fixtures/python/variants/VARIANT` (the
@@ -29,7 +29,7 @@
 //!   `rtoracle::compare::mistakes` (`MISTAKE` by the names `examples/mistake.rs` takes) by
 //!   `render_with_mistake`, at the scene's samples per pixel and seed 1: the PNG that
 //!   `cargo run --release --example mistake -- SCENE MISTAKE FILE.png` writes;
-//! - `<!-- setup: SHELL -->`: the shell line runs, silently, in the section's folder (after the
+//! - `<!-- setup: SHELL -->`: the shell line runs, silently, in the page's folder (after the
 //!   fixtures are made);
 //! - `<!-- no-run: REASON -->` says why a block marked `console,no-run` cannot run in the tests
 //!   (every such block must say it; the test prints how many were skipped).
@@ -39,46 +39,46 @@
 //! is a `console` block, or `console,no-run` with a reason.
 //!
 //! `RTORACLE_UPDATE_README=1 cargo test --test integration -- readme::` writes the real outputs
-//! of the examples that differ into `docs/sections/` instead of comparing (the others keep their
-//! masked figures), and reassembles README.md.
+//! of the examples that differ into their pages instead of comparing (the others keep their
+//! masked figures).
+//!
+//! Links ([`every_relative_link_resolves`]): every link and image of a page whose target is not a
+//! URL must name a file or folder of the repository (relative to the page, never leaving the
+//! repository), and a `#anchor` must be a heading of the Markdown page it points into, spelt as
+//! GitHub spells heading anchors ([`slug`]).
 
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The sections in the order the script concatenates them.
-const SECTIONS: [&str; 9] = [
-    "intro",
-    "subcommands",
-    "render",
-    "golden",
-    "oracle",
-    "check",
-    "compare",
-    "grade",
-    "development",
-];
-
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-#[test]
-fn readme_is_the_sections_assembled() {
-    let script = std::fs::read_to_string(root().join("docs/assemble-readme.sh")).unwrap();
-    assert!(
-        script.contains(&format!("for s in {}; do", SECTIONS.join(" "))),
-        "docs/assemble-readme.sh lists other sections than this test"
-    );
-    let sections: Vec<String> = SECTIONS
-        .iter()
-        .map(|s| std::fs::read_to_string(root().join(format!("docs/sections/{s}.md"))).unwrap())
-        .collect();
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    assert!(
-        readme == sections.join("\n"),
-        "README.md differs from docs/sections/: run docs/assemble-readme.sh"
-    );
+/// The pages of the docs, relative to the checkout: README.md, then every Markdown file under
+/// `docs/` in name order.
+fn pages() -> Vec<String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(&path, out);
+            } else if path.extension().is_some_and(|e| e == "md") {
+                out.push(path);
+            }
+        }
+    }
+    let mut docs = Vec::new();
+    walk(&root().join("docs"), &mut docs);
+    docs.sort();
+    let mut pages = vec!["README.md".to_string()];
+    pages.extend(docs.iter().map(|p| {
+        p.strip_prefix(root())
+            .unwrap()
+            .to_string_lossy()
+            .into_owned()
+    }));
+    pages
 }
 
 /// One command of a block and the output the docs show.
@@ -101,7 +101,7 @@ struct Block {
     fence: usize,
 }
 
-/// A fixture to make in the section's folder before a block.
+/// A fixture to make in the page's folder before a block.
 #[derive(Debug, PartialEq)]
 enum Fixture {
     /// `tests/fixtures/submissions/<name>`, materialized into the folder.
@@ -211,7 +211,7 @@ fn make_fixture(fixture: &Fixture, dir: &Path) -> Result<(), String> {
     }
 }
 
-/// What a section holds: its console blocks, and the opening fence (0-based line) of every other
+/// What a page holds: its console blocks, and the opening fence (0-based line) of every other
 /// fenced block with a line starting `$ `, a shell transcript nothing would check.
 #[derive(Debug)]
 struct Parsed {
@@ -237,7 +237,7 @@ fn closing_fence(lines: &[&str], start: usize, mark: char, len: usize) -> usize 
         .unwrap_or(lines.len())
 }
 
-/// Reads the fenced blocks of a section: the console ones, and the others only for transcripts.
+/// Reads the fenced blocks of a page: the console ones, and the others only for transcripts.
 fn parse(text: &str) -> Parsed {
     let lines: Vec<&str> = text.lines().collect();
     let mut out = Vec::new();
@@ -420,7 +420,7 @@ fn bin_dir() -> (tempfile::TempDir, PathBuf) {
     (dir, bin)
 }
 
-/// Runs one shell command in `dir` (the section's folder) with `$?` set to `last`, and with the
+/// Runs one shell command in `dir` (the page's folder) with `$?` set to `last`, and with the
 /// golden cache in `dir/.cache`; returns its output (stdout and stderr together, in order) and
 /// exit code.
 fn run_step(command: &str, dir: &Path, path: &str, last: i32) -> (String, i32) {
@@ -441,17 +441,18 @@ fn run_step(command: &str, dir: &Path, path: &str, last: i32) -> (String, i32) {
     )
 }
 
-/// What running one section's examples gave.
-struct SectionRun {
+/// What running one page's examples gave.
+struct PageRun {
     ran: usize,
     skipped: usize,
     failures: Vec<String>,
 }
 
-/// Runs the console blocks of `section` in a fresh folder of its own (see the module docs);
-/// with `update`, writes the real outputs of those that differ into its file.
-fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRun {
-    let file = root().join(format!("docs/sections/{section}.md"));
+/// Runs the console blocks of the page `page` (a path relative to the checkout) in a fresh
+/// folder of its own (see the module docs); with `update`, writes the real outputs of those
+/// that differ into its file.
+fn run_page(page: &str, update: bool, path: &str, bin: &Path) -> PageRun {
+    let file = root().join(page);
     let text = std::fs::read_to_string(&file).unwrap();
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
     // World-readable, as a user's folder usually is: the sandbox user runs scripts from it
@@ -460,7 +461,7 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
         .permissions(std::fs::Permissions::from_mode(0o755))
         .tempdir()
         .unwrap();
-    let mut run = SectionRun {
+    let mut run = PageRun {
         ran: 0,
         skipped: 0,
         failures: Vec::new(),
@@ -470,7 +471,7 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
     let parsed = parse(&text);
     for fence in parsed.stray_transcripts {
         run.failures.push(format!(
-            "docs/sections/{section}.md:{}: a shell transcript must be a `console` block (or `console,no-run` with a reason)",
+            "{page}:{}: a shell transcript must be a `console` block (or `console,no-run` with a reason)",
             fence + 1
         ));
     }
@@ -479,7 +480,7 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
             run.skipped += 1;
             if block.no_run_reason.is_none() {
                 run.failures.push(format!(
-                    "docs/sections/{section}.md:{}: a `console,no-run` block without a `<!-- no-run: REASON -->` line before it",
+                    "{page}:{}: a `console,no-run` block without a `<!-- no-run: REASON -->` line before it",
                     block.fence + 1
                 ));
             }
@@ -488,12 +489,12 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
         run.ran += 1;
         for fixture in &block.fixtures {
             if let Err(e) = make_fixture(fixture, work.path()) {
-                panic!("{section}: fixture {fixture:?}: {e}");
+                panic!("{page}: fixture {fixture:?}: {e}");
             }
         }
         if let Some(setup) = &block.setup {
             let (out, code) = run_step(setup, work.path(), path, 0);
-            assert_eq!(code, 0, "{section}: setup {setup:?} failed: {out}");
+            assert_eq!(code, 0, "{page}: setup {setup:?} failed: {out}");
         }
         let mut last = 0;
         let mut body = Vec::new();
@@ -504,7 +505,7 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
             let want = mask(&step.output.join("\n"), work.path(), bin);
             if got != want {
                 run.failures.push(format!(
-                    "docs/sections/{section}.md: `$ {}`\n--- the docs show:\n{want}\n--- it prints:\n{got}",
+                    "{page}: `$ {}`\n--- the docs show:\n{want}\n--- it prints:\n{got}",
                     step.command
                 ));
             }
@@ -513,7 +514,7 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
                 // Unchanged but for what the masks hide: the docs keep their figures.
                 body.extend(step.output.iter().cloned());
             } else if !out.trim_end_matches('\n').is_empty() {
-                // The section's folder as the masks see it (a reader's own folder).
+                // The page's folder as the masks see it (a reader's own folder).
                 let shown = out
                     .trim_end_matches('\n')
                     .replace(&format!("{}/", work.path().display()), "")
@@ -537,7 +538,7 @@ fn run_section(section: &str, update: bool, path: &str, bin: &Path) -> SectionRu
 }
 
 #[test]
-fn every_console_example_of_the_readme_is_real_output() {
+fn every_console_example_of_the_docs_is_real_output() {
     let update = std::env::var_os("RTORACLE_UPDATE_README").is_some_and(|v| v == "1");
     let (bins, bin) = bin_dir();
     let path = format!(
@@ -545,34 +546,33 @@ fn every_console_example_of_the_readme_is_real_output() {
         bins.path().display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    // The sections are independent (a folder each), so they run at the same time: the test
-    // takes about as long as `grade`, its longest.
-    let runs: Vec<SectionRun> = std::thread::scope(|s| {
-        let handles: Vec<_> = SECTIONS
+    // The pages are independent (a folder each), so they run at the same time: the test takes
+    // about as long as grading.md, its longest.
+    let pages = pages();
+    let runs: Vec<PageRun> = std::thread::scope(|s| {
+        let handles: Vec<_> = pages
             .iter()
-            .map(|section| s.spawn(|| run_section(section, update, &path, &bin)))
+            .map(|page| s.spawn(|| run_page(page, update, &path, &bin)))
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().expect("a section's examples ran"))
+            .map(|h| h.join().expect("a page's examples ran"))
             .collect()
     });
     let ran: usize = runs.iter().map(|r| r.ran).sum();
     let skipped: usize = runs.iter().map(|r| r.skipped).sum();
     let failures: Vec<String> = runs.into_iter().flat_map(|r| r.failures).collect();
-    eprintln!("README examples: {ran} blocks run, {skipped} marked no-run");
+    eprintln!(
+        "docs examples: {ran} blocks run, {skipped} marked no-run, in {} pages",
+        pages.len()
+    );
     if update {
-        let status = Command::new("bash")
-            .arg(root().join("docs/assemble-readme.sh"))
-            .status()
-            .unwrap();
-        assert!(status.success());
         return;
     }
     assert!(ran > 0, "no console block ran");
     assert!(
         failures.is_empty(),
-        "{} README examples differ (RTORACLE_UPDATE_README=1 cargo test --test integration -- readme:: rewrites them):\n\n{}",
+        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --test integration -- readme:: rewrites them):\n\n{}",
         failures.len(),
         failures.join("\n\n")
     );
@@ -695,4 +695,241 @@ fn a_transcript_outside_a_console_block_is_found() {
     assert_eq!(parsed.blocks.len(), 1);
     assert_eq!(parsed.blocks[0].fence, 15);
     assert_eq!(parsed.blocks[0].steps[0].command, "rtoracle scenes");
+}
+
+/// The anchor GitHub gives a heading whose text is `text`: lower case, every character that is
+/// not a letter, a digit, a space, `-` or `_` dropped, and each space made a `-`.
+fn slug(text: &str) -> String {
+    text.trim()
+        .chars()
+        .flat_map(char::to_lowercase)
+        .filter(|c| c.is_alphanumeric() || matches!(c, ' ' | '-' | '_'))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The anchors of the headings of a Markdown text, with GitHub's `-1`, `-2`... for repeats.
+fn anchors(text: &str) -> Vec<String> {
+    use pulldown_cmark::{Event, Options, Parser, Tag, TagEnd};
+    let mut out: Vec<String> = Vec::new();
+    let mut heading: Option<String> = None;
+    for event in Parser::new_ext(text, Options::ENABLE_TABLES) {
+        match event {
+            Event::Start(Tag::Heading { .. }) => heading = Some(String::new()),
+            Event::Text(t) | Event::Code(t) => {
+                if let Some(h) = heading.as_mut() {
+                    h.push_str(&t);
+                }
+            }
+            Event::End(TagEnd::Heading(_)) => {
+                let base = slug(&heading.take().unwrap_or_default());
+                let mut anchor = base.clone();
+                let mut n = 0;
+                while out.contains(&anchor) {
+                    n += 1;
+                    anchor = format!("{base}-{n}");
+                }
+                out.push(anchor);
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The targets of the links and images of a Markdown text, with the line each is on.
+fn link_targets(text: &str) -> Vec<(usize, String)> {
+    use pulldown_cmark::{Event, Options, Parser, Tag};
+    Parser::new_ext(text, Options::ENABLE_TABLES)
+        .into_offset_iter()
+        .filter_map(|(event, range)| match event {
+            Event::Start(Tag::Link { dest_url, .. } | Tag::Image { dest_url, .. }) => {
+                let line = text[..range.start].matches('\n').count() + 1;
+                Some((line, dest_url.into_string()))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Why the link `target` of the page `page` (relative to `root`) does not resolve, if it does
+/// not; `None` for a URL or a link that resolves.
+fn broken_link(root: &Path, page: &Path, target: &str) -> Option<String> {
+    let is_url = target.starts_with("//")
+        || target.split_once(':').is_some_and(|(scheme, _)| {
+            !scheme.is_empty()
+                && scheme
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+        });
+    if is_url {
+        return None;
+    }
+    let (path, anchor) = match target.split_once('#') {
+        Some((path, anchor)) => (path, Some(anchor)),
+        None => (target, None),
+    };
+    let file = if path.is_empty() {
+        root.join(page)
+    } else {
+        if path.starts_with('/') {
+            return Some("an absolute path (links are relative to the page)".into());
+        }
+        let mut resolved = root.join(page).parent().unwrap().to_path_buf();
+        for part in Path::new(path).components() {
+            match part {
+                std::path::Component::ParentDir => {
+                    resolved.pop();
+                }
+                std::path::Component::Normal(p) => resolved.push(p),
+                _ => {}
+            }
+            if !resolved.starts_with(root) {
+                return Some("leaves the repository".into());
+            }
+        }
+        if !resolved.exists() {
+            return Some(format!(
+                "no such file {}",
+                resolved.strip_prefix(root).unwrap().display()
+            ));
+        }
+        resolved
+    };
+    let anchor = anchor.filter(|a| !a.is_empty())?;
+    if file.extension().is_none_or(|e| e != "md") {
+        return Some(format!(
+            "#{anchor} points into {}, which is not a Markdown page",
+            file.display()
+        ));
+    }
+    let text = std::fs::read_to_string(&file).unwrap();
+    if anchors(&text).iter().any(|a| a == anchor) {
+        None
+    } else {
+        Some(format!(
+            "no heading of {} has the anchor #{anchor}",
+            file.strip_prefix(root).unwrap().display()
+        ))
+    }
+}
+
+#[test]
+fn every_relative_link_resolves() {
+    let mut broken = Vec::new();
+    let mut checked = 0;
+    for page in pages() {
+        let text = std::fs::read_to_string(root().join(&page)).unwrap();
+        for (line, target) in link_targets(&text) {
+            checked += 1;
+            if let Some(why) = broken_link(root(), Path::new(&page), &target) {
+                broken.push(format!("{page}:{line}: ({target}): {why}"));
+            }
+        }
+    }
+    assert!(checked > 0, "no link found");
+    assert!(
+        broken.is_empty(),
+        "links that do not resolve:\n{}",
+        broken.join("\n")
+    );
+}
+
+#[test]
+fn links_are_resolved_as_github_resolves_them() {
+    assert_eq!(slug("`rtoracle render`"), "rtoracle-render");
+    assert_eq!(
+        slug("Students' code: every week's API, their triangles, and a diagnosis"),
+        "students-code-every-weeks-api-their-triangles-and-a-diagnosis"
+    );
+    assert_eq!(
+        slug("Reports: JSON, heatmap, HTML"),
+        "reports-json-heatmap-html"
+    );
+    assert_eq!(slug("snake_case and a-b"), "snake_case-and-a-b");
+    assert_eq!(
+        anchors("# A\n\n## `x` y\n\n```\n# not a heading\n```\n\n## A\n\n## A\n"),
+        ["a", "x-y", "a-1", "a-2"]
+    );
+    assert_eq!(
+        link_targets("[a](b.md#c) and ![i](img.png)\n\n`[not](a link)`\n[u](https://x.y/z)\n"),
+        [
+            (1, "b.md#c".to_string()),
+            (1, "img.png".to_string()),
+            (4, "https://x.y/z".to_string())
+        ]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    std::fs::create_dir(root.join("docs")).unwrap();
+    std::fs::write(root.join("docs/p.md"), "# Page\n\n## The part\n").unwrap();
+    std::fs::write(root.join("README.md"), "# R\n").unwrap();
+    let page = Path::new("docs/p.md");
+    for ok in [
+        "p.md",
+        "p.md#the-part",
+        "#page",
+        "../README.md",
+        "../docs",
+        "https://x/y#z",
+        "mailto:a@b",
+    ] {
+        assert_eq!(broken_link(root, page, ok), None, "{ok}");
+    }
+    for bad in [
+        "q.md",
+        "p.md#the-parts",
+        "#nothing",
+        "../../x.md",
+        "/etc/passwd",
+        "../README.md#z",
+    ] {
+        assert!(broken_link(root, page, bad).is_some(), "{bad}");
+    }
+}
+
+/// The design notes the project was written from live outside the repository: what the code
+/// and the docs need from them is in `docs/`, and nothing names them.
+#[test]
+fn nothing_names_a_design_note_outside_the_repository() {
+    const NOTES: [&str; 5] = [
+        "GRADING.md",
+        "COURSE_API.md",
+        "ORACLE.md",
+        "IMAGES.md",
+        "COURSE_LATER_WEEKS.md",
+    ];
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(&path, out);
+            } else {
+                out.push(path);
+            }
+        }
+    }
+    let mut files = vec![root().join("README.md")];
+    walk(&root().join("src"), &mut files);
+    walk(&root().join("docs"), &mut files);
+    let mut found = Vec::new();
+    for file in files {
+        let Ok(text) = std::fs::read_to_string(&file) else {
+            continue;
+        };
+        for (n, line) in text.lines().enumerate() {
+            if let Some(note) = NOTES.iter().find(|note| line.contains(*note)) {
+                found.push(format!(
+                    "{}:{}: names {note}",
+                    file.strip_prefix(root()).unwrap().display(),
+                    n + 1
+                ));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "point to docs/ instead (write what is needed there):\n{}",
+        found.join("\n")
+    );
 }
