@@ -1,5 +1,5 @@
-//! Per-submission identities: a user and group id of its own for every [`Sandbox`](super::Sandbox)
-//! made by a root harness, and the kill of every process of such an id.
+//! Who the code runs as: whether the harness is root, a user and group id of its own for every
+//! [`Sandbox`](super::Sandbox) made by a root harness, and the kill of every process of such an id.
 //!
 //! Promises:
 //! - [`allocate`] returns an id in `[2^30, 2^31)` that has no `passwd` entry and no live process,
@@ -10,7 +10,27 @@
 //!   signal), and repeats until a scan of `/proc` finds none running. Double-forked `setsid`
 //!   sleepers are processes of the id like any other, so they end too.
 
+use std::ffi::CString;
 use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Whether this process runs as root.
+pub fn running_as_root() -> bool {
+    // SAFETY: geteuid has no preconditions.
+    unsafe { libc::geteuid() == 0 }
+}
+
+/// The user id and group id of user `name`, if it exists.
+pub fn lookup_user(name: &str) -> Option<(u32, u32)> {
+    let cname = CString::new(name).ok()?;
+    // SAFETY: getpwnam returns a pointer to static storage or null; we read it at once.
+    let pw = unsafe { libc::getpwnam(cname.as_ptr()) };
+    if pw.is_null() {
+        return None;
+    }
+    // SAFETY: non-null pointer to a passwd record.
+    let (uid, gid) = unsafe { ((*pw).pw_uid, (*pw).pw_gid) };
+    Some((uid, gid))
+}
 
 /// The first id handed out (2^30): far above any real account, below `2^31` (some tools treat
 /// larger ids as negative).
@@ -136,7 +156,7 @@ mod tests {
 
     #[test]
     fn kill_all_ends_every_process_of_the_id_and_only_those() {
-        if !super::super::running_as_root() {
+        if !super::running_as_root() {
             eprintln!("skipped: needs root");
             return;
         }

@@ -36,7 +36,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use super::Reaper;
+use super::reaper::Reaper;
 
 /// Which processes are the code's, for the [`Watchdog`].
 #[derive(Clone, Debug)]

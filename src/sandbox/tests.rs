@@ -2,6 +2,10 @@
 
 use super::*;
 use std::io::Read;
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+use std::time::Duration;
 
 fn sh_output(sandbox: &Sandbox, script: &str) -> String {
     let mut child = sandbox

@@ -1,4 +1,4 @@
-//! The sandbox against hostile submissions (GRADING.md, "Running untrusted code"): one test per
+//! The sandbox against hostile submissions (docs/sandbox.md): one test per
 //! class of attack, each a course-layout submission (the honest fixture plus a hostile import)
 //! run through the real binary. They need root, as a grader on Gradescope has it; they say so
 //! and pass when not root.
