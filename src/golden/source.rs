@@ -33,18 +33,26 @@ pub fn scene_sha256(description: &SceneDescription) -> String {
     sha256_hex(description.to_toml().as_bytes())
 }
 
-/// The files `description` reads besides itself (image textures), as it names them: relative
-/// to the scene file's folder unless absolute. The scene descriptions of this version name none,
-/// so this is empty; a field that names a file must be listed here, so that its content enters
-/// every golden's key ([`GoldenScene::inputs`]).
+/// The files `description` reads besides itself (its image textures' files), as it names them:
+/// relative to the scene file's folder unless absolute, in the order of its `[[textures]]`. A
+/// field that names a file must be listed here, so that its content enters every golden's key
+/// ([`GoldenScene::inputs`]); the destructuring below fails to compile when a field is added.
 pub fn files_read(description: &SceneDescription) -> Vec<PathBuf> {
     let SceneDescription {
+        profile: _,
         image: _,
         camera: _,
+        render: _,
+        textures,
         materials: _,
         objects: _,
+        base_dir: _,
     } = description;
-    Vec::new()
+    textures
+        .iter()
+        .filter_map(|t| t.file.as_deref())
+        .map(PathBuf::from)
+        .collect()
 }
 
 /// One file a scene reads, by content.
@@ -102,9 +110,9 @@ impl GoldenScene {
     ) -> Result<Self, GoldenError> {
         let mut scene = GoldenScene {
             name: name.to_string(),
+            profile: description.profile.name().to_string(),
             description,
             builtin: false,
-            profile: DEFAULT_PROFILE.to_string(),
             inputs: Vec::new(),
         };
         for file in files_read(&scene.description) {
@@ -121,9 +129,13 @@ impl GoldenScene {
         Ok(scene)
     }
 
-    /// The same scene rendered in `profile`.
+    /// The same scene rendered in `profile` (the scene's own profile too, when `profile` names
+    /// one the renderer knows).
     pub fn with_profile(mut self, profile: &str) -> Self {
         self.profile = profile.to_string();
+        if let Some(known) = crate::scene::Profile::from_name(profile) {
+            self.description.profile = known;
+        }
         self
     }
 
