@@ -68,11 +68,6 @@ const TABLES: &[(&str, &str, &str)] = &[];
 /// `what` is a function's name, `""` for the file's length, or `"cycle FILE"` for an import
 /// cycle with another file.
 const BEING_SPLIT: &[(&str, &str)] = &[
-    ("src/cli/grade.rs", "run"),
-    ("src/grade/batch.rs", "summary_md"),
-    ("src/grade/checkers.rs", "check"),
-    ("src/grade/rubric.rs", "validate"),
-    ("src/grade/run.rs", "code_check"),
     ("src/render/fixed_origin.rs", ""),
     ("src/render/pinhole.rs", "cycle src/render/renderer.rs"),
     ("src/scene/file.rs", "validate"),
