@@ -261,6 +261,13 @@ fn camera_samples(answer: &serde_json::Value) -> Result<Vec<[f64; 7]>, String> {
 
 /// The jitter, lens and time checks of week `of`'s camera rays (week 9: the jitter alone, at
 /// spp 30 and no lens; week 10: all three, at spp 100 through a 2-degree lens).
+/// A sample of the first few numbers, the rest 0.
+fn padded(xs: &[f64]) -> Sample {
+    let mut s = [0.0; 9];
+    s[..xs.len()].copy_from_slice(xs);
+    s
+}
+
 fn camera_ray_checks(seed: u64, of: u8) -> Vec<FunctionCheck> {
     let (spp, angle, stratum, step) = if of == 9 {
         (30, 0.0, (4u32, 1u32), 1.0 / 3.0)
@@ -292,17 +299,10 @@ fn camera_ray_checks(seed: u64, of: u8) -> Vec<FunctionCheck> {
                 let o = DVec3::new(s[0], s[1], s[2]);
                 let d = DVec3::new(s[3], s[4], s[5]);
                 let off = o + d - centre;
-                [
+                padded(&[
                     off.dot(du) / du.length_squared(),
                     off.dot(dv) / dv.length_squared(),
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                ]
+                ])
             })
             .collect())
     };
@@ -312,25 +312,12 @@ fn camera_ray_checks(seed: u64, of: u8) -> Vec<FunctionCheck> {
             .iter()
             .map(|s| {
                 let off = DVec3::new(s[0], s[1], s[2]) - centre_eye;
-                [
-                    off.dot(u) / radius,
-                    off.dot(v) / radius,
-                    off.dot(w),
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                ]
+                padded(&[off.dot(u) / radius, off.dot(v) / radius, off.dot(w)])
             })
             .collect())
     };
     let time = |a: &serde_json::Value| -> Result<Vec<Sample>, String> {
-        Ok(camera_samples(a)?
-            .iter()
-            .map(|s| [s[6], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-            .collect())
+        Ok(camera_samples(a)?.iter().map(|s| padded(&[s[6]])).collect())
     };
     let function = "RT_camera.Camera.get_jittered_ray(i, j, s_i, s_j)";
     let mut checks = vec![FunctionCheck {
@@ -443,7 +430,8 @@ fn move_sphere_check(seed: u64) -> FunctionCheck {
     }
 }
 
-fn moving_intersect_check(seed: u64) -> FunctionCheck {
+/// The moving spheres and rays of the moving-intersect check: `(c0, c1, origin, d, time)`.
+fn moving_inputs(seed: u64) -> Vec<(DVec3, DVec3, DVec3, DVec3, f64)> {
     let mut inputs = vec![(
         DVec3::ZERO,
         DVec3::new(0.0, 2.0, 0.0),
@@ -477,6 +465,36 @@ fn moving_intersect_check(seed: u64) -> FunctionCheck {
         let d = (at + 0.8 * simulate::unit_vector(&mut r) - origin) * (0.5 + r.next_f64());
         inputs.push((c0, c1, origin, d, t));
     }
+    inputs
+}
+
+/// What `intersect` answers for the hit `h` (or a miss).
+fn hit_expected(h: Option<crate::geometry::HitRecord>) -> Expected {
+    match h {
+        None => Expected::one("hit", Want::Bool(false)),
+        Some(h) => Expected::one("hit", Want::Bool(true))
+            .and(
+                "t",
+                Want::Number {
+                    value: h.t,
+                    tol: 1e-9 * h.t.abs().max(1.0),
+                },
+            )
+            .and("point", Want::vector(h.point, 1e-9))
+            .and("normal", Want::vector(h.normal, 1e-6))
+            .and("front_face", Want::Bool(h.front_face))
+            .and(
+                "uv",
+                Want::Pair {
+                    value: [h.uv.0, h.uv.1],
+                    tol: 1e-6,
+                },
+            ),
+    }
+}
+
+fn moving_intersect_check(seed: u64) -> FunctionCheck {
+    let inputs = moving_inputs(seed);
     let interval = [1e-6, f64::MAX];
     let mut cases = Vec::new();
     let mut frozen = Vec::new();
@@ -485,27 +503,7 @@ fn moving_intersect_check(seed: u64) -> FunctionCheck {
         let moving = MovingSphere::new(Sphere::new(c0, 1.0), c1);
         let ray = Ray::at_time(origin, d, t);
         let hit_of = |s: &dyn Shape| s.intersect(&ray, Interval::new(interval[0], interval[1]));
-        let answer = |h: Option<crate::geometry::HitRecord>| match h {
-            None => Expected::one("hit", Want::Bool(false)),
-            Some(h) => Expected::one("hit", Want::Bool(true))
-                .and(
-                    "t",
-                    Want::Number {
-                        value: h.t,
-                        tol: 1e-9 * h.t.abs().max(1.0),
-                    },
-                )
-                .and("point", Want::vector(h.point, 1e-9))
-                .and("normal", Want::vector(h.normal, 1e-6))
-                .and("front_face", Want::Bool(h.front_face))
-                .and(
-                    "uv",
-                    Want::Pair {
-                        value: [h.uv.0, h.uv.1],
-                        tol: 1e-6,
-                    },
-                ),
-        };
+        let answer = hit_expected;
         let hit = hit_of(&moving);
         let moved = moving.at(t);
         start_normal.push(hit.and_then(|h| {

@@ -304,8 +304,8 @@ fn near_edge(x: f64, s: f64) -> bool {
     (q - q.round()).abs() <= 8.0 * f64::EPSILON * q.abs().max(1.0)
 }
 
-fn checker_check(seed: u64) -> FunctionCheck {
-    let (even, odd) = (DVec3::splat(0.2), DVec3::splat(0.9));
+/// The checker's cases: `(scale, point)`, the course's scale first, then random ones.
+fn checker_points(seed: u64) -> Vec<(f64, DVec3)> {
     let mut points: Vec<(f64, DVec3)> = [
         (0.1, 0.1, 0.1),
         (0.33, 0.1, 0.1),
@@ -324,6 +324,12 @@ fn checker_check(seed: u64) -> FunctionCheck {
         let s = [0.32, 0.12, 1.0, 0.05][k % 4];
         points.push((s, 3.0 * simulate::unit_vector(&mut r)));
     }
+    points
+}
+
+fn checker_check(seed: u64) -> FunctionCheck {
+    let (even, odd) = (DVec3::splat(0.2), DVec3::splat(0.9));
+    let points = checker_points(seed);
     let uv = (0.5, 0.1);
     let mut cases = Vec::new();
     let mut variants: Vec<(&'static str, &'static str, Vec<Option<Expected>>)> = vec![
