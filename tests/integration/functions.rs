@@ -252,3 +252,51 @@ fn week09_is_judged_fairly() {
 fn week10_is_judged_fairly() {
     week_is_judged_fairly(10);
 }
+
+/// `rtoracle check` in a week-6 folder finds the week from its files and runs its function
+/// checks too: the solution passes (exit 0), the skeleton fails (exit 1) and names `reflect`'s
+/// stub with a Python reproduction; `--week 4` checks the intersections only.
+#[test]
+fn check_finds_the_week_and_runs_its_functions() {
+    let Some(python) = python() else {
+        return;
+    };
+    let run = |dir: &Path, args: &[&str]| {
+        crate::common::rtoracle()
+            .current_dir(dir)
+            .args(args)
+            .env("RTORACLE_PYTHON", python)
+            .output()
+            .expect("rtoracle runs")
+    };
+    let solution = assemble("week06/solution", None);
+    let out = run(solution.path(), &["check"]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("checking as week 6 (found from the files: ")
+            && stderr.contains("def refract in RT_utility.py"),
+        "{stderr}"
+    );
+    assert!(stdout.contains("verdict: PASS"), "{stdout}");
+    assert!(stdout.contains("week 6 refract"), "{stdout}");
+    let skeleton = assemble("week06/skeleton", None);
+    let out = run(skeleton.path(), &["check", "--show", "20"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("reflect (RT_utility.reflect(v, n)) fails:"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("is it still the skeleton's stub?"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("print(rtu.reflect("), "{stdout}");
+    let out = run(skeleton.path(), &["check", "--week", "4"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(!stdout.contains("functions of week"), "{stdout}");
+}
