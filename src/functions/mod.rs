@@ -11,6 +11,7 @@
 //! - [`checks`]: each week's functions, their cases, expected answers and mistakes.
 //! - [`run`]: running a week's checks and judging them ([`WeekReport`]).
 //! - [`report`]: the report in words.
+//! - [`score`]: each week's groups of functions and their points.
 //! - [`submission`]: a week's submission checked in one session (intersections and functions).
 
 pub mod checks;
@@ -19,6 +20,7 @@ pub mod report;
 pub mod run;
 pub mod runner;
 pub mod samplers;
+pub mod score;
 pub mod simulate;
 pub mod stats;
 pub mod submission;

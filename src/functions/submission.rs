@@ -10,6 +10,7 @@ use serde::Serialize;
 
 use super::run::{FunctionOptions, WeekReport, run_week};
 use super::runner::SessionRunner;
+use super::score::{WeekScore, score};
 use super::week::Week;
 use crate::candidate::{
     CandidateCommand, CheckReport, HarnessError, Outcome, RunOptions, Session, build_report,
@@ -33,6 +34,8 @@ pub struct WeekCheck {
     pub pole_crashes_excused: usize,
     /// The function checks.
     pub functions: WeekReport,
+    /// The function checks scored by the week's groups.
+    pub score: WeekScore,
 }
 
 impl WeekCheck {
@@ -59,6 +62,27 @@ impl WeekCheck {
         }
         out.push('\n');
         out.push_str(&super::report::to_text(&self.functions, show));
+        out.push_str(&format!(
+            "\nscore of {}'s functions: {:.1} / {:.0}\n",
+            self.week, self.score.score, self.score.max
+        ));
+        for g in &self.score.groups {
+            let mut line = format!(
+                "  {:<22} {:>5.1} / {:<3.0} {}",
+                g.id, g.score, g.max, g.name
+            );
+            if !g.mistakes.is_empty() {
+                line.push_str(&format!(" (mistake: {})", g.mistakes.join(" or ")));
+            }
+            out.push_str(&line);
+            out.push('\n');
+        }
+        if !self.score.regressions.is_empty() {
+            out.push_str(&format!(
+                "  no points, but failing (given by the skeleton or an earlier week's): {}\n",
+                self.score.regressions.join(", ")
+            ));
+        }
         out.push_str(&format!(
             "\nverdict: {} (intersections {}, functions {})\n",
             if self.passed() { "PASS" } else { "FAIL" },
@@ -123,6 +147,7 @@ pub fn check_week(
         week_from,
         intersections,
         pole_crashes_excused,
+        score: score(&functions),
         functions,
     })
 }

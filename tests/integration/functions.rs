@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use rtoracle::candidate::bench::course_python_or_skip;
 use rtoracle::candidate::{CandidateCommand, RunOptions, Session};
+use rtoracle::functions::score::score;
 use rtoracle::functions::{
     FunctionOptions, FunctionRunner, Reply, SessionRunner, Status, Week, WeekReport, run_week,
 };
@@ -177,6 +178,7 @@ fn week_is_judged_fairly(week: u8) {
             .all(|f| f.status == Status::Passed),
         "the solution of {base}:\n{text}"
     );
+    assert_eq!(score(&solution).score, 100.0, "{base}");
     let skeleton = week_report(&format!("{base}/skeleton"), None, week).unwrap();
     let text = rtoracle::functions::report::to_text(&skeleton, 0);
     for f in skeleton.of_the_week().filter(|f| !f.given) {
@@ -187,6 +189,11 @@ fn week_is_judged_fairly(week: u8) {
             f.id
         );
     }
+    let skeleton_score = score(&skeleton).score;
+    assert!(
+        skeleton_score <= 5.0,
+        "{base}'s skeleton scores {skeleton_score}"
+    );
     let mut missed = Vec::new();
     for (name, kind) in catalogue(week) {
         if IMAGE_ONLY.contains(&name.as_str()) {
@@ -209,6 +216,19 @@ fn week_is_judged_fairly(week: u8) {
             .iter()
             .filter(|f| f.status == Status::Failed)
             .any(|f| f.mistakes.iter().any(|m| m.name == name));
+        let scored = score(&report);
+        let lost_in_its_group = scored
+            .groups
+            .iter()
+            .any(|g| g.score < g.max && g.mistakes.contains(&name));
+        // A mistake in an earlier week's function, or one the skeleton gives, is a regression:
+        // named, no points of this week's groups (its images show it).
+        let regression = report.functions.iter().any(|f| {
+            (f.week.number() < week || f.given) && f.mistakes.iter().any(|m| m.name == name)
+        });
+        if kind == "mistake" && named && !lost_in_its_group && !regression {
+            missed.push(format!("{name} loses no points: {scored:?}"));
+        }
         if !named {
             missed.push(format!(
                 "{name} ({kind}):\n{}",
@@ -283,6 +303,10 @@ fn check_finds_the_week_and_runs_its_functions() {
     );
     assert!(stdout.contains("verdict: PASS"), "{stdout}");
     assert!(stdout.contains("week 6 refract"), "{stdout}");
+    assert!(
+        stdout.contains("score of week 6's functions: 100.0 / 100"),
+        "{stdout}"
+    );
     let skeleton = assemble("week06/skeleton", None);
     let out = run(skeleton.path(), &["check", "--show", "20"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -296,6 +320,10 @@ fn check_finds_the_week_and_runs_its_functions() {
         "{stdout}"
     );
     assert!(stdout.contains("print(rtu.reflect("), "{stdout}");
+    assert!(
+        stdout.contains("score of week 6's functions: 0.0 / 100"),
+        "{stdout}"
+    );
     let out = run(skeleton.path(), &["check", "--week", "4"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(!stdout.contains("functions of week"), "{stdout}");
