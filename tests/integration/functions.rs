@@ -328,3 +328,40 @@ fn check_finds_the_week_and_runs_its_functions() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(!stdout.contains("functions of week"), "{stdout}");
 }
+
+/// `check --json` on a week's folder is one JSON object with the week, the intersections, the
+/// functions and the score; a week or a rate out of range is one line on stderr, exit 2.
+#[test]
+fn check_week_json_and_bad_input() {
+    let Some(python) = python() else {
+        return;
+    };
+    let solution = assemble("week09/solution", None);
+    let out = crate::common::rtoracle()
+        .current_dir(solution.path())
+        .args(["check", "--json"])
+        .env("RTORACLE_PYTHON", python)
+        .output()
+        .expect("rtoracle runs");
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["week"], 9);
+    assert_eq!(v["score"]["score"], 100.0);
+    assert_eq!(v["functions"]["options"]["alpha"], 1e-4);
+    let jitter = v["functions"]["functions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["id"] == "jitter")
+        .expect("the jitter check");
+    assert_eq!(jitter["statistics"]["fit"]["invariant_failures"], 0);
+    for (args, needle) in [
+        (&["check", "--week", "11"][..], "--week"),
+        (&["check", "--week", "x"][..], "--week"),
+        (&["check", "--alpha", "2"][..], "--alpha"),
+        (&["check", "--alpha", "nan"][..], "--alpha"),
+    ] {
+        let out = crate::common::run_in(solution.path(), args);
+        crate::common::assert_bad_input(&out, needle);
+    }
+}
