@@ -115,10 +115,18 @@ fn an_invariant_breaks_on_one_sample() {
 /// The measurement quoted in the docs: false alarms of each check over 100 000 honest runs,
 /// and the power against each mistake (the fraction of runs failed, and named) over 2 000.
 /// `cargo test --release --lib functions::samplers::tests::power -- --ignored --nocapture`
+/// (`RTORACLE_POWER_RUNS=2000,200` for fewer runs).
 #[test]
 #[ignore]
 fn power() {
-    let runs = 100_000;
+    // RTORACLE_POWER_RUNS=HONEST,MISTAKE runs fewer (a quick look on a loaded machine).
+    let (runs, mruns) = std::env::var("RTORACLE_POWER_RUNS")
+        .ok()
+        .and_then(|v| {
+            let (a, b) = v.split_once(',')?;
+            Some((a.parse().ok()?, b.parse().ok()?))
+        })
+        .unwrap_or((100_000u64, 2000u64));
     for (what, check) in every_check() {
         let (failed, _) = rejection_rate(
             &check,
@@ -133,7 +141,6 @@ fn power() {
             check.samples
         );
         for m in &check.mistakes {
-            let mruns = 2000;
             let (f, named) = rejection_rate(&check, m, check.samples, mruns, 98, DEFAULT_ALPHA);
             println!(
                 "    {}: failed {f} / {mruns}, named {named} / {mruns}",
