@@ -365,3 +365,45 @@ fn check_week_json_and_bad_input() {
         crate::common::assert_bad_input(&out, needle);
     }
 }
+
+/// A function answer over 128 KiB, an adapter that hangs or dies, stray lines: each is a failure
+/// of its own request, named; the next request restarts the adapter and gets its answer.
+#[test]
+fn a_hostile_function_answer_fails_its_request_only() {
+    let Some(python) = python() else {
+        return;
+    };
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/adapters/function_answers.py");
+    let command =
+        CandidateCommand::adapter(&format!("{} -I {}", python.display(), script.display()))
+            .unwrap();
+    let options = RunOptions {
+        hello_timeout: Duration::from_secs(30),
+        ..RunOptions::default()
+    };
+    let mut s = Session::start(command, options).expect("the adapter starts");
+    let mut r = SessionRunner::new(&mut s);
+    assert!(r.supports("reflect") && r.supports("intersect") && !r.supports("refract"));
+    let ask = |r: &mut SessionRunner, mode: &str, timeout: Duration| {
+        r.call(
+            &json!({"op": "reflect", "v": [1.0, 2.0, 3.0], "n": [0.0, 1.0, 0.0], "mode": mode}),
+            timeout,
+        )
+    };
+    let ok = Reply::Result(json!({"vector": [1.0, 2.0, 3.0]}));
+    assert_eq!(ask(&mut r, "ok", T), ok);
+    assert_eq!(ask(&mut r, "stray", T), ok);
+    match ask(&mut r, "big", T) {
+        Reply::Failed(why) => assert!(why.contains("over 131072 bytes"), "{why}"),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(ask(&mut r, "hang", Duration::from_secs(1)), Reply::TimedOut);
+    assert_eq!(ask(&mut r, "ok", T), ok);
+    match ask(&mut r, "die", T) {
+        Reply::Failed(why) => assert!(why.contains("died"), "{why}"),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(ask(&mut r, "ok", T), ok);
+    assert_eq!(s.restarts(), 2);
+}
