@@ -14,12 +14,7 @@
 //! A reader takes an absent optional attribute as its default, so an older golden reads as what
 //! it is: a golden of the default profile, of a scene that reads no other file.
 
-use std::path::Path;
-
-use super::GoldenError;
-use super::source::GoldenScene;
-use crate::image_io::{ExrImage, encode_exr};
-use crate::render::Film;
+use crate::image_io::ExrImage;
 
 /// The attribute naming the scene (a built-in's name, or the scene file's name).
 pub const ATTR_SCENE: &str = "rtoracle.scene";
@@ -67,48 +62,6 @@ divided by n - 1), rounded to f32; the variance of the mean is this divided by r
 /// Name of the golden file of `scene`: `<scene>.exr`.
 pub fn golden_file_name(scene: &str) -> String {
     format!("{scene}.exr")
-}
-
-/// The string attributes of a golden of `scene` with `spp` samples per pixel and `seed`.
-pub fn golden_attributes(scene: &GoldenScene, spp: u32, seed: u64) -> Vec<(String, String)> {
-    let mut attributes = vec![
-        (ATTR_SCENE, scene.name.clone()),
-        (ATTR_SCENE_SHA256, scene.scene_sha256()),
-        (ATTR_SPP, spp.to_string()),
-        (ATTR_SEED, seed.to_string()),
-        (ATTR_VERSION, env!("CARGO_PKG_VERSION").to_string()),
-        (ATTR_CAMERA, CAMERA_CONVENTION.to_string()),
-        (ATTR_SAMPLING, SAMPLING.to_string()),
-        (ATTR_VARIANCE, VARIANCE_MEANING.to_string()),
-    ];
-    if scene.profile != DEFAULT_PROFILE {
-        attributes.push((ATTR_PROFILE, scene.profile.clone()));
-    }
-    if !scene.inputs.is_empty() {
-        attributes.push((ATTR_INPUTS, scene.inputs_text()));
-    }
-    if !scene.builtin {
-        attributes.push((ATTR_SCENE_TOML, scene.description.to_toml()));
-    }
-    attributes
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect()
-}
-
-/// Encodes a film rendered for `scene` with `seed` as a golden file's bytes; `name` labels
-/// errors.
-pub(crate) fn encode_golden(
-    film: &Film,
-    scene: &GoldenScene,
-    seed: u64,
-) -> Result<Vec<u8>, GoldenError> {
-    let attributes = golden_attributes(scene, film.samples_per_pixel, seed);
-    Ok(encode_exr(
-        film,
-        &attributes,
-        Path::new(&golden_file_name(&scene.name)),
-    )?)
 }
 
 /// What a golden's attributes say it was made from (each `None` when the attribute is absent or

@@ -28,6 +28,7 @@
 pub mod cache;
 pub mod diff;
 pub mod embedded;
+pub mod encode;
 pub mod format;
 pub mod source;
 
@@ -37,10 +38,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 pub use cache::{CACHE_FORMAT, cache_dir, cache_file};
 pub use diff::{GoldenDiff, PixelDifference, Tolerance, compare_goldens};
 pub use embedded::{embedded_golden, embedded_golden_image, embedded_scenes};
+pub use encode::golden_attributes;
 pub use format::{
     ATTR_CAMERA, ATTR_INPUTS, ATTR_PROFILE, ATTR_SAMPLING, ATTR_SCENE, ATTR_SCENE_SHA256,
     ATTR_SCENE_TOML, ATTR_SEED, ATTR_SPP, ATTR_VARIANCE, ATTR_VERSION, CAMERA_CONVENTION,
-    DEFAULT_PROFILE, GoldenRecord, SAMPLING, VARIANCE_MEANING, golden_attributes, golden_file_name,
+    DEFAULT_PROFILE, GoldenRecord, SAMPLING, VARIANCE_MEANING, golden_file_name,
 };
 pub use source::{GoldenInput, GoldenScene, files_read, golden_fits, scene_sha256, sha256_hex};
 
@@ -117,7 +119,7 @@ pub fn render_golden_bytes(
     progress: bool,
 ) -> Result<Vec<u8>, GoldenError> {
     let film = render_golden(scene, spp, progress)?;
-    format::encode_golden(&film, scene, GOLDEN_SEED)
+    encode::encode_golden(&film, scene, GOLDEN_SEED)
 }
 
 /// Where a golden [`golden_of`] gave came from.
@@ -186,7 +188,7 @@ pub fn golden_of(
             let (bytes, image) = if image.attribute(ATTR_SCENE) == Some(scene.name.as_str()) {
                 (bytes, image)
             } else {
-                let bytes = format::encode_golden(&film_of(&image, spp), scene, GOLDEN_SEED)?;
+                let bytes = encode::encode_golden(&film_of(&image, spp), scene, GOLDEN_SEED)?;
                 let image = decode_exr(&bytes, path)?;
                 (bytes, image)
             };
