@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
+use super::batch_copies::flag_shared_noise;
+use super::copies::CopyFinding;
 use super::inputs::{CodeChecker, ImageChecker};
 use super::report::Format;
 use super::result::{CheckStatus, GradeError, GradeReport, round2};
@@ -117,10 +119,40 @@ pub fn grade_batch(
         })
         .collect();
     bar.finish_and_clear();
+    let mut entries = entries;
+    flag_copies(&mut entries, &output, formats)?;
     output.write("gradebook.csv", gradebook_csv(rubric, &entries).as_bytes())?;
     output.write("summary.md", summary_md(rubric, &entries).as_bytes())?;
     output.commit()?;
     Ok(entries)
+}
+
+/// Flags the submissions whose images share their noise with another's
+/// ([`flag_shared_noise`]) and writes their reports again.
+fn flag_copies(
+    entries: &mut [BatchEntry],
+    output: &OutputDir,
+    formats: &[Format],
+) -> Result<(), GradeError> {
+    let mut named: Vec<(&str, &mut GradeReport)> = entries
+        .iter_mut()
+        .filter_map(|BatchEntry { name, result }| Some((name.as_str(), result.as_mut().ok()?)))
+        .collect();
+    let pairs = flag_shared_noise(&mut named);
+    let flagged: std::collections::BTreeSet<&String> =
+        pairs.iter().flat_map(|p| &p.submissions).collect();
+    for (name, report) in named
+        .iter()
+        .filter(|(n, _)| flagged.contains(&n.to_string()))
+    {
+        for &f in formats {
+            output.write(
+                Path::new(name).join(f.file_name()),
+                f.render(report).as_bytes(),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// `gradebook.csv`: `submission,score,max_score`, one column per rubric group, then `status`.
@@ -206,6 +238,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
     if !graded.is_empty() {
         score_distribution(&mut md, &graded, rubric.max_score());
         common_failures(&mut md, &graded);
+        copies_section(&mut md, entries);
     }
     let errors: Vec<&BatchEntry> = entries.iter().filter(|e| e.result.is_err()).collect();
     if !errors.is_empty() {
@@ -220,6 +253,71 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         }
     }
     md
+}
+
+/// The images that are not a render of the submission's code: the course's, the reference
+/// tracer's, and the pairs that share their noise (for review). Nothing when there is none.
+fn copies_section(md: &mut String, entries: &[BatchEntry]) {
+    let mut zeroed = Vec::new();
+    let mut pairs = std::collections::BTreeSet::new();
+    for e in entries {
+        let Ok(r) = &e.result else { continue };
+        for c in &r.checks {
+            let Some(image) = &c.image else { continue };
+            for f in &image.copies {
+                match f {
+                    CopyFinding::SharedWith { submission, noise } => {
+                        let (a, b) = if e.name <= *submission {
+                            (&e.name, submission)
+                        } else {
+                            (submission, &e.name)
+                        };
+                        pairs.insert((
+                            c.group.clone(),
+                            a.clone(),
+                            b.clone(),
+                            noise.differing,
+                            noise.common_busy,
+                        ));
+                    }
+                    CopyFinding::CourseImage { .. } => zeroed.push((
+                        e.name.clone(),
+                        image.file.clone(),
+                        "the course's published image",
+                    )),
+                    CopyFinding::ReferenceRender { .. } => zeroed.push((
+                        e.name.clone(),
+                        image.file.clone(),
+                        "the reference tracer's own render",
+                    )),
+                }
+            }
+        }
+    }
+    if zeroed.is_empty() && pairs.is_empty() {
+        return;
+    }
+    md.push_str("\n## Images that are not the submission's render\n\n");
+    for (name, file, what) in &zeroed {
+        let _ = writeln!(
+            md,
+            "- {}: {} is {what} (scored 0).",
+            markdown_inline(name),
+            markdown_inline(file)
+        );
+    }
+    if !pairs.is_empty() {
+        md.push_str("\nThese pairs' images share their Monte Carlo noise (one copied from the other, or both from a third); review them:\n\n");
+        md.push_str("| Group | Submissions | Busy pixels that differ |\n|---|---|---:|\n");
+        for (group, a, b, differing, common) in pairs {
+            let _ = writeln!(
+                md,
+                "| `{group}` | {} and {} | {differing} of {common} |",
+                markdown_inline(&a),
+                markdown_inline(&b)
+            );
+        }
+    }
 }
 
 /// The scores' mean, median and range, and a histogram by tenths of `max`.

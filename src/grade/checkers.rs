@@ -15,6 +15,7 @@ use crate::candidate::report::python_repro;
 use crate::candidate::{
     CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
 };
+use crate::grade::credit;
 use crate::grade::inputs::{CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts};
 use crate::grade::rubric::sha256_hex;
 use crate::oracle::default_suite;
@@ -295,6 +296,13 @@ impl CourseCodeChecker {
             } else {
                 continue;
             };
+            let mark = credit::mark(case, outcome, &verdict, winding);
+            let hit = credit::expects_hit(case);
+            if definite {
+                counts.tally.record(hit, mark);
+            } else {
+                counts.ambiguous_tally.record(hit, mark);
+            }
             let (failure_kind, message) = match verdict {
                 Verdict::Pass => {
                     if definite {

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::credit::ClassTally;
 use crate::oracle::vectors::ShapeKind;
 
 pub use super::rubric::{SceneFile, SceneSource};
@@ -93,6 +94,16 @@ pub struct GroupCounts {
     pub ambiguous: usize,
     /// Ambiguous vectors whose answer equals the exact one.
     pub ambiguous_passed: usize,
+    /// The definite vectors by what they expect and how they were answered: what the scoring
+    /// rule ([`credit`](super::credit)) reads. `report.json` shows it in the check's `credit`.
+    /// A checker that leaves it empty is scored as if every vector hit (in proportion to the
+    /// vectors passed).
+    #[serde(default, skip_serializing)]
+    pub tally: ClassTally,
+    /// The same for the ambiguous vectors, judged by their exact answer (scored only when the
+    /// rubric says so).
+    #[serde(default, skip_serializing)]
+    pub ambiguous_tally: ClassTally,
 }
 
 /// How one vector went wrong: the `check` harness's own kinds.

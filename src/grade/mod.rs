@@ -26,8 +26,11 @@
 
 pub mod autograder;
 pub mod batch;
+pub mod batch_copies;
 pub mod bench;
 pub mod checkers;
+pub mod copies;
+pub mod credit;
 #[cfg(test)]
 pub(crate) mod fakes;
 pub mod image_checker;

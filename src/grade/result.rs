@@ -4,9 +4,11 @@
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use serde::Serialize;
 
+use super::copies::{CopyFinding, Fingerprint};
 use super::inputs::{FailureKind, FailureSummary, GroupCounts, ImageVerdict};
 use super::rubric::Visibility;
 use crate::output::OutputError;
@@ -57,6 +59,10 @@ pub struct ImageResult {
     pub diagnosis: Option<String>,
     /// The heatmap, relative to the report folder.
     pub heatmap: Option<String>,
+    /// What the copy checks found: the course's image, the reference's render, or (in a batch)
+    /// another submission's image sharing its noise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub copies: Vec<CopyFinding>,
 }
 
 /// One check: a line of the gradebook's detail and a test on Gradescope.
@@ -83,6 +89,9 @@ pub struct CheckResult {
     /// The vector counts, for code checks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counts: Option<GroupCounts>,
+    /// How a code check's points were counted: the rule, its components and the share earned.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub credit: Option<super::credit::Credit>,
     /// The first failing vectors, with reproductions.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub failures: Vec<FailureSummary>,
@@ -149,6 +158,10 @@ pub struct GradeReport {
     pub execution_time: f64,
     /// Every check, in rubric order.
     pub checks: Vec<CheckResult>,
+    /// The uploaded images' fingerprints by image group id, for a batch's comparison of
+    /// submissions (not written into report.json; recognised copies are left out).
+    #[serde(skip)]
+    pub fingerprints: Vec<(String, Arc<Fingerprint>)>,
     /// The code run.
     pub code: CodeRun,
     /// Versions and hashes.

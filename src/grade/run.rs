@@ -2,8 +2,10 @@
 //! [`ImageChecker`], scored into a [`GradeReport`].
 
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
+use super::copies::{CopyFinding, Fingerprint, recognise};
 use super::inputs::{
     CodeChecker, CodeOutcome, FailureKind, ImageChecker, ImageOutcome, ImageVerdict,
 };
@@ -23,12 +25,16 @@ pub(crate) fn expected_size(scene: &SceneSource) -> Option<(usize, usize)> {
 /// Reads the image of group `g` with care (see [`intake`](super::intake)) into a private copy
 /// and hands the copy to `images`; whatever the checker says names the file relative to the
 /// submission, never by the grader's paths.
+///
+/// The image is first checked for a copy ([`copies`](super::copies)): the course's published
+/// image or the reference tracer's own render is not compared (it scores 0, the finding says
+/// why); the fingerprint comes back for a batch's comparison of submissions.
 fn check_image(
     submission: &Path,
     g: &Group,
     images: &dyn ImageChecker,
     out_dir: &Path,
-) -> ImageOutcome {
+) -> StagedImage {
     let rel = g.file.as_deref().expect("validated");
     let scene = g.scene_source().expect("validated");
     // Made and registered in one step: a batch makes these on many threads at once.
@@ -43,7 +49,7 @@ fn check_image(
     let (stage, _cleanup) = match made {
         Ok(made) => made,
         Err(e) => {
-            return ImageOutcome::unusable(format!(
+            return StagedImage::unusable(format!(
                 "{rel} could not be staged for comparison ({})",
                 e.kind()
             ));
@@ -52,15 +58,51 @@ fn check_image(
     let staged =
         match super::intake::stage_image(submission, rel, expected_size(&scene), stage.path()) {
             Ok(p) => p,
-            Err(why) => return ImageOutcome::unusable(why),
+            Err(why) => return StagedImage::unusable(why),
         };
+    // An image that cannot be decoded is the comparison's to explain.
+    let fingerprint = crate::image_io::read_png(&staged)
+        .ok()
+        .map(|img| Arc::new(Fingerprint::of(&img)));
+    let copy = fingerprint.as_deref().and_then(|fp| recognise(fp, &scene));
+    if copy.is_some() {
+        return StagedImage {
+            outcome: ImageOutcome {
+                verdict: ImageVerdict::Fail,
+                ..ImageOutcome::unusable("")
+            },
+            fingerprint,
+            copy,
+        };
+    }
     let mut outcome = images.check_scene(&staged, &scene, &out_dir.join(heatmap_name(g)));
     if let ImageVerdict::Unusable(why) = &mut outcome.verdict {
         let shown = format!("{}: ", staged.display());
         *why = why.replace(&shown, &format!("{rel}: "));
         *why = why.replace(&staged.display().to_string(), rel);
     }
-    outcome
+    StagedImage {
+        outcome,
+        fingerprint,
+        copy: None,
+    }
+}
+
+/// What checking one image group's upload found.
+struct StagedImage {
+    outcome: ImageOutcome,
+    fingerprint: Option<Arc<Fingerprint>>,
+    copy: Option<CopyFinding>,
+}
+
+impl StagedImage {
+    fn unusable(why: String) -> Self {
+        StagedImage {
+            outcome: ImageOutcome::unusable(why),
+            fingerprint: None,
+            copy: None,
+        }
+    }
 }
 
 /// Grades the submission in folder `submission`: runs the code groups through `code` and the
@@ -101,14 +143,18 @@ pub fn grade(
     );
     let mut image_outcomes = image_outcomes.into_iter();
     let mut checks = Vec::new();
+    let mut fingerprints = Vec::new();
     for g in &rubric.groups {
         match g.kind {
             GroupKind::Code => checks.extend(code_check(g, &outcome)),
-            GroupKind::Image => checks.push(image_check(
-                g,
-                image_outcomes.next().expect("one per image group"),
-                out_dir,
-            )),
+            GroupKind::Image => {
+                let staged = image_outcomes.next().expect("one per image group");
+                // A recognised copy is not compared with classmates' images (it scores 0).
+                if let (Some(fp), None) = (staged.fingerprint, &staged.copy) {
+                    fingerprints.push((g.id.clone(), fp));
+                }
+                checks.push(image_check(g, staged.outcome, staged.copy, out_dir));
+            }
         }
     }
     let goldens_sha256 = image_groups
@@ -135,6 +181,7 @@ pub fn grade(
         max_score: rubric.max_score(),
         execution_time: 0.0,
         checks,
+        fingerprints,
         code: CodeRun {
             fatal: outcome.fatal.clone(),
             stderr_tail: outcome.stderr_tail.clone(),

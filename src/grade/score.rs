@@ -2,6 +2,8 @@
 
 use std::path::Path;
 
+use super::copies::CopyFinding;
+use super::credit::{ClassTally, Credit, credit};
 use super::inputs::{
     CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageOutcome, ImageVerdict,
 };
@@ -34,6 +36,22 @@ pub(crate) fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResul
     } else {
         (counts.passed, counts.definite_total)
     };
+    let tally = if group.score_ambiguous {
+        counts.tally.plus(counts.ambiguous_tally)
+    } else {
+        counts.tally
+    };
+    // A checker that does not say which vectors hit is scored as if every one did.
+    let tally = if tally.is_empty() {
+        ClassTally {
+            hits: total,
+            hits_right: passed,
+            ..Default::default()
+        }
+    } else {
+        tally
+    };
+    let mut earned = None;
     let (score, status, message) = if let Some(fatal) = &outcome.fatal {
         (
             0.0,
@@ -47,20 +65,21 @@ pub(crate) fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResul
             format!("There are no {shape} vectors to run."),
         )
     } else {
-        let score = if passed == total {
-            group.points
-        } else if group.all_or_nothing {
-            0.0
+        let c = credit(tally, group.all_or_nothing);
+        // Full marks need every vector right, whatever the tally says.
+        let fraction = if passed == total {
+            1.0
         } else {
-            group.points * passed as f64 / total as f64
+            c.fraction.min(1.0)
         };
-        let message = code_message(group, outcome, &counts, (passed, total), &failures);
+        earned = Some(c);
+        let message = code_message(group, outcome, &counts, (passed, total), &failures, &c);
         let status = if passed == total {
             CheckStatus::Passed
         } else {
             CheckStatus::Failed
         };
-        (round2(score), status, message)
+        (round2(group.points * fraction), status, message)
     };
     let tags = vec!["code".to_string(), shape.name().to_string()];
     let mut checks = vec![CheckResult {
@@ -74,6 +93,7 @@ pub(crate) fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResul
         visibility: group.visibility,
         tags,
         counts: Some(counts.clone()),
+        credit: earned,
         failures,
         image: None,
     }];
@@ -91,6 +111,7 @@ fn code_message(
     counts: &GroupCounts,
     (passed, total): (usize, usize),
     failures: &[FailureSummary],
+    credit: &Credit,
 ) -> String {
     let shape = group.shape.expect("validated: code groups have a shape");
     let mut parts = Vec::new();
@@ -110,6 +131,9 @@ fn code_message(
         message.push_str(&format!(" ({})", parts.join(", ")));
     }
     message.push('.');
+    if passed < total {
+        message.push_str(&credit_sentence(credit));
+    }
     if group.all_or_nothing && passed < total {
         message.push_str(" This group is all-or-nothing.");
     }
@@ -129,6 +153,32 @@ fn code_message(
     message
 }
 
+/// How the points of a code check that lost some were counted: the vectors that hit and those
+/// that miss are scored apart, and the group earns the product of the two credits.
+fn credit_sentence(c: &Credit) -> String {
+    let t = &c.tally;
+    let partly = t.hits_wrong_normal + t.hits_wrong_front_face + t.hits_t_only;
+    let partly = if partly > 0 {
+        format!(
+            " and {partly} more at the right t with a wrong normal or front_face (partial credit)"
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        " Points: of the {} vectors where the ray hits, {} right{partly} (hit credit {:.2}); of the {} where it misses, {} right (miss credit {:.2}); {:.2} x {:.2} = {:.1}% of the group's points.",
+        t.hits,
+        t.hits_right,
+        c.hit_credit,
+        t.misses,
+        t.misses_right,
+        c.miss_credit,
+        c.hit_credit,
+        c.miss_credit,
+        100.0 * c.fraction
+    )
+}
+
 /// The unscored check that reports a group's ambiguous vectors (where rounding decides).
 fn ambiguous_check(group: &Group, outcome: &CodeOutcome, counts: &GroupCounts) -> CheckResult {
     let shape = group.shape.expect("validated: code groups have a shape");
@@ -146,6 +196,7 @@ fn ambiguous_check(group: &Group, outcome: &CodeOutcome, counts: &GroupCounts) -
         visibility: group.visibility,
         tags: vec!["code".to_string(), shape.name().to_string()],
         counts: None,
+        credit: None,
         failures: outcome
             .failures
             .iter()
@@ -167,7 +218,12 @@ pub(crate) fn heatmap_name(group: &Group) -> String {
     )
 }
 
-pub(crate) fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) -> CheckResult {
+pub(crate) fn image_check(
+    group: &Group,
+    outcome: ImageOutcome,
+    copy: Option<CopyFinding>,
+    out_dir: &Path,
+) -> CheckResult {
     let file = group.file.clone().expect("validated");
     let scene = group.scene.clone().expect("validated");
     // A scene file is named by its file name in messages: the folder is the rubric's business
@@ -179,13 +235,14 @@ pub(crate) fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) 
     } else {
         scene.clone()
     };
-    let (score, status, message) = match &outcome.verdict {
-        ImageVerdict::Pass => (
+    let (score, status, message) = match (&copy, &outcome.verdict) {
+        (Some(c), _) => (0.0, CheckStatus::Failed, c.sentence(&file)),
+        (None, ImageVerdict::Pass) => (
             group.points,
             CheckStatus::Passed,
             format!("{file} matches the reference of {shown} up to sampling noise."),
         ),
-        ImageVerdict::Fail => (
+        (None, ImageVerdict::Fail) => (
             0.0,
             CheckStatus::Failed,
             match outcome.diagnosis.as_deref().map(str::trim) {
@@ -199,7 +256,7 @@ pub(crate) fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) 
                 _ => format!("{file} differs from the reference of {shown}."),
             },
         ),
-        ImageVerdict::Unusable(why) => (
+        (None, ImageVerdict::Unusable(why)) => (
             0.0,
             CheckStatus::Error,
             if why.starts_with(file.as_str()) {
@@ -230,6 +287,7 @@ pub(crate) fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) 
         visibility: group.visibility,
         tags: vec!["image".to_string(), shown.clone()],
         counts: None,
+        credit: None,
         failures: vec![],
         image: Some(ImageResult {
             file,
@@ -238,6 +296,7 @@ pub(crate) fn image_check(group: &Group, outcome: ImageOutcome, out_dir: &Path) 
             metrics: outcome.metrics,
             diagnosis: outcome.diagnosis,
             heatmap,
+            copies: copy.into_iter().collect(),
         }),
     }
 }

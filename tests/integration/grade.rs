@@ -665,3 +665,324 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
     assert_bad_input(&out, "notelf: not an x86_64 Linux");
     assert!(!dir.path().join("x.zip").exists());
 }
+
+// ---- A grade that measures the student's own work (constant answers, copies) ----
+
+/// `RT_object.py` whose `Sphere` and `Quad` answer every ray with `body` (Python, indented for
+/// a method, may use `rRay`), after the course's constructors.
+fn strategy_object(body: &str) -> String {
+    format!(
+        r#"import random
+import RT_utility as rtu
+
+_coin = random.Random(12345)
+
+
+def _answer(rRay):
+{body}
+
+
+class Sphere:
+    def __init__(self, vCenter, fRadius, mMat=None):
+        self.center = vCenter
+        self.radius = fRadius
+        self.material = mMat
+
+    def intersect(self, rRay, cInterval):
+        return _answer(rRay)
+
+
+class Quad:
+    def __init__(self, vQ, vU, vV, mMat=None):
+        self.Qpoint = vQ
+        self.Uvec = vU
+        self.Vvec = vV
+        self.material = mMat
+        self.uxv = rtu.Vec3.cross_product(self.Uvec, self.Vvec)
+        self.normal = rtu.Vec3.unit_vector(self.uxv)
+        self.D = rtu.Vec3.dot_product(self.normal, self.Qpoint)
+        self.Wvec = self.uxv / rtu.Vec3.dot_product(self.uxv, self.uxv)
+
+    def intersect(self, rRay, cInterval):
+        return _answer(rRay)
+
+    def is_interior(self, fa, fb):
+        return None
+
+
+class Triangle:
+    def __init__(self):
+        pass
+"#
+    )
+}
+
+/// The answers that ignore the ray: the bodies of [`strategy_object`].
+const STRATEGIES: [(&str, &str); 5] = [
+    // The course's skeleton: `intersect` is a stub.
+    ("always-none", "    pass"),
+    (
+        "constant-hit",
+        "    h = rtu.Hitinfo(rtu.Vec3(0.0, 0.0, 0.0), rtu.Vec3(0.0, 0.0, 1.0), 1.0)\n    h.front_face = True\n    return h",
+    ),
+    (
+        "ray-origin",
+        "    d = rtu.Vec3.unit_vector(rRay.getDirection())\n    h = rtu.Hitinfo(rRay.getOrigin(), -d, 0.0)\n    h.front_face = True\n    return h",
+    ),
+    (
+        "coin-toss",
+        "    if _coin.random() < 0.5:\n        return None\n    t = _coin.uniform(0.0, 20.0)\n    h = rtu.Hitinfo(rRay.at(t), rtu.Vec3(0.0, 1.0, 0.0), t)\n    h.front_face = _coin.random() < 0.5\n    return h",
+    ),
+    (
+        "mostly-miss",
+        "    if _coin.random() < 0.9:\n        return None\n    h = rtu.Hitinfo(rRay.at(2.0), rtu.Vec3(0.0, 0.0, -1.0), 2.0)\n    h.front_face = True\n    return h",
+    ),
+];
+
+/// The two week-4 images of an honest student: the reference's render at `seed`.
+fn honest_images(dest: &Path, seed: u64) {
+    for (scene, file) in [
+        ("week04-sphere", "week04_sphere.png"),
+        ("week04-quad", "week04_quad.png"),
+    ] {
+        let d = rtoracle::scene::builtin(scene).unwrap();
+        let img = rtoracle::grade::copies::render_png_pixels(&d, None, seed).unwrap();
+        rtoracle::image_io::write_png(&dest.join(file), &img).unwrap();
+    }
+}
+
+/// A submission of the course's modules, `object` as its `RT_object.py` and the images of
+/// `seed` (or none).
+fn course_submission(dest: &Path, object: &str, seed: Option<u64>) {
+    std::fs::create_dir_all(dest).unwrap();
+    let common = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/python/common");
+    for e in std::fs::read_dir(common).unwrap().flatten() {
+        std::fs::copy(e.path(), dest.join(e.file_name())).unwrap();
+    }
+    std::fs::write(dest.join("RT_object.py"), object).unwrap();
+    if let Some(seed) = seed {
+        honest_images(dest, seed);
+    }
+}
+
+/// The `check` fixture variant `name`'s own files on top of the course's modules.
+fn variant_submission(dest: &Path, name: &str, seed: u64) {
+    let variant = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/python/variants")
+        .join(name);
+    let object = std::fs::read_to_string(variant.join("RT_object.py")).unwrap();
+    course_submission(dest, &object, Some(seed));
+    for e in std::fs::read_dir(&variant).unwrap().flatten() {
+        std::fs::copy(e.path(), dest.join(e.file_name())).unwrap();
+    }
+}
+
+/// `src` written again as an RGBA PNG (the same pixels, another file).
+fn re_encode(src: &Path, dest: &Path) {
+    let img = rtoracle::image_io::read_png(src).unwrap();
+    let rgba: Vec<u8> = img
+        .data
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    image::save_buffer(
+        dest,
+        &rgba,
+        img.width as u32,
+        img.height as u32,
+        image::ExtendedColorType::Rgba8,
+    )
+    .unwrap();
+}
+
+struct GamingBatch {
+    out: PathBuf,
+    output: Output,
+    /// Whether the course's published images were there (the skeleton's submission).
+    skeleton: bool,
+}
+
+/// One batch of what must earn nothing (the answers that ignore the ray, the course's skeleton
+/// with its published images, a copy of a classmate's image, the reference's own render) and of
+/// honest work that must earn everything, graded with the built-in rubric and suite.
+fn gaming_batch() -> &'static GamingBatch {
+    static BATCH: OnceLock<GamingBatch> = OnceLock::new();
+    BATCH.get_or_init(|| {
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("grade-gaming");
+        let _ = std::fs::remove_dir_all(&root);
+        let subs = root.join("subs");
+        for (i, (name, body)) in STRATEGIES.iter().enumerate() {
+            course_submission(
+                &subs.join(name),
+                &strategy_object(body),
+                Some(40 + i as u64),
+            );
+        }
+        // The instructor's solution is the course's formulas as the course teaches them.
+        variant_submission(&subs.join("instructor-solution"), "honest_reference", 31);
+        variant_submission(&subs.join("honest-numpy"), "honest_numpy_vectors", 32);
+        // A classmate's sphere image, re-encoded; the quad image is the copier's own.
+        variant_submission(&subs.join("copier"), "honest_reference", 33);
+        re_encode(
+            &subs.join("honest-numpy/week04_sphere.png"),
+            &subs.join("copier/week04_sphere.png"),
+        );
+        // The sphere image `rtoracle render week04-sphere` writes.
+        variant_submission(&subs.join("pip-render"), "honest_reference", 34);
+        let made = run_in(
+            &subs.join("pip-render"),
+            &["render", "week04-sphere", "-o", "week04_sphere.png"],
+        );
+        assert!(made.status.success(), "{made:?}");
+        let skeleton = match course_fixtures("the skeleton's grade") {
+            Some(dir) => {
+                let dest = subs.join("skeleton");
+                course_submission(&dest, &strategy_object("    pass"), None);
+                for f in ["week04_sphere.png", "week04_quad.png"] {
+                    std::fs::copy(dir.join(f), dest.join(f)).unwrap();
+                }
+                true
+            }
+            None => false,
+        };
+        let output = run_in(&root, &["grade", "--batch", "subs", "--out", "out"]);
+        GamingBatch {
+            out: root.join("out"),
+            output,
+            skeleton,
+        }
+    })
+}
+
+fn check<'a>(report: &'a Value, id: &str) -> &'a Value {
+    report["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"] == id)
+        .unwrap_or_else(|| panic!("no check {id}"))
+}
+
+#[test]
+fn answers_that_ignore_the_ray_earn_at_most_2_percent_of_each_code_group() {
+    let b = gaming_batch();
+    assert!(
+        b.output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&b.output.stderr)
+    );
+    for (name, _) in STRATEGIES {
+        let report = read_json(&b.out.join(name).join("report.json"));
+        for id in ["sphere.intersect", "quad.intersect"] {
+            let c = check(&report, id);
+            let (score, max) = (
+                c["score"].as_f64().unwrap(),
+                c["max_score"].as_f64().unwrap(),
+            );
+            assert!(
+                score <= 0.02 * max,
+                "{name} {id}: {score} of {max}: {}",
+                c["message"]
+            );
+            // The rule and its components are in report.json.
+            let credit = &c["credit"];
+            assert_eq!(credit["rule"], "hit_credit_times_miss_credit", "{c}");
+            let f =
+                credit["hit_credit"].as_f64().unwrap() * credit["miss_credit"].as_f64().unwrap();
+            assert!(
+                (f - credit["fraction"].as_f64().unwrap()).abs() < 1e-12,
+                "{credit}"
+            );
+            assert!(
+                credit["hits"].as_u64().unwrap() > 100 && credit["misses"].as_u64().unwrap() > 100
+            );
+        }
+    }
+}
+
+#[test]
+fn the_instructors_solution_and_honest_work_score_100_and_the_skeleton_at_most_5() {
+    let b = gaming_batch();
+    for name in ["instructor-solution", "honest-numpy"] {
+        let report = read_json(&b.out.join(name).join("report.json"));
+        assert_eq!(report["score"].as_f64(), Some(100.0), "{name}: {report}");
+    }
+    if b.skeleton {
+        let report = read_json(&b.out.join("skeleton/report.json"));
+        assert!(report["score"].as_f64().unwrap() <= 5.0, "{report}");
+        for (id, file) in [
+            ("image.week04-sphere", "week04_sphere.png"),
+            ("image.week04-quad", "week04_quad.png"),
+        ] {
+            let c = check(&report, id);
+            assert_eq!(c["score"].as_f64(), Some(0.0));
+            assert!(
+                c["message"]
+                    .as_str()
+                    .unwrap()
+                    .contains("is the course's published image"),
+                "{c}"
+            );
+            assert_eq!(c["image"]["copies"][0]["kind"], "course_image");
+            assert_eq!(c["image"]["copies"][0]["file"], file);
+        }
+    }
+}
+
+#[test]
+fn a_copied_image_flags_both_submissions_and_the_reference_render_scores_0() {
+    let b = gaming_batch();
+    let shared = |name: &str| -> Vec<String> {
+        let report = read_json(&b.out.join(name).join("report.json"));
+        let mut with = Vec::new();
+        for c in report["checks"].as_array().unwrap() {
+            for f in c["image"]["copies"].as_array().into_iter().flatten() {
+                if f["kind"] == "shared_with" {
+                    with.push(format!(
+                        "{} {}",
+                        c["id"].as_str().unwrap(),
+                        f["submission"].as_str().unwrap()
+                    ));
+                }
+            }
+        }
+        with
+    };
+    assert_eq!(shared("copier"), ["image.week04-sphere honest-numpy"]);
+    assert_eq!(shared("honest-numpy"), ["image.week04-sphere copier"]);
+    // Independent renders of the same scenes are never flagged.
+    for (name, _) in STRATEGIES {
+        assert!(shared(name).is_empty(), "{name}: {:?}", shared(name));
+    }
+    assert!(shared("instructor-solution").is_empty());
+    let feedback = std::fs::read_to_string(b.out.join("copier/feedback.md")).unwrap();
+    assert!(
+        feedback.contains("shares its Monte Carlo noise with another submission"),
+        "{feedback}"
+    );
+    assert!(
+        !feedback.contains("honest-numpy"),
+        "a student's feedback names no classmate"
+    );
+    let summary = std::fs::read_to_string(b.out.join("summary.md")).unwrap();
+    assert!(
+        summary.contains(r"| `image.week04-sphere` | copier and honest\-numpy |"),
+        "{summary}"
+    );
+    // The reference tracer's own render scores 0 and says so; the rest of the grade stands.
+    let report = read_json(&b.out.join("pip-render/report.json"));
+    let c = check(&report, "image.week04-sphere");
+    assert_eq!(c["score"].as_f64(), Some(0.0));
+    assert!(
+        c["message"]
+            .as_str()
+            .unwrap()
+            .contains("the reference tracer's own render"),
+        "{c}"
+    );
+    assert_eq!(report["score"].as_f64(), Some(80.0));
+    assert!(
+        summary.contains(r"pip\-render: week04\_sphere\.png is the reference tracer's own render"),
+        "{summary}"
+    );
+}
