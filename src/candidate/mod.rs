@@ -9,6 +9,8 @@
 //! - [`session`]: [`Session`] runs a [`CandidateCommand`] in the [sandbox](crate::sandbox) with
 //!   pipelined requests, per-case timeouts, restarts after crashes and the process group killed
 //!   on drop, over the pipes of [`pipe`], judging each line by the strict protocol of [`lines`].
+//! - [`render`](mod@render): the `render` request, a scene rendered tile by tile with the
+//!   candidate's own code, with bounds on what comes back.
 //! - [`python`]: choosing the interpreter of the course adapter (the assignment's modules,
 //!   runnable in the sandbox).
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and
@@ -35,6 +37,7 @@ pub mod outcome;
 pub mod pipe;
 pub mod protocol;
 pub mod python;
+pub mod render;
 pub mod report;
 pub mod report_text;
 pub mod repro;
@@ -53,26 +56,28 @@ pub use outcome::Outcome;
 pub use protocol::{Answer, CandidateError, Hello};
 pub use report::{CheckReport, Counts, Failure, RunInfo, build_report};
 pub use rust::{Candidate, Reference, check_candidate};
-pub use session::Session;
+pub use session::{CallOutcome, Session};
 
 use crate::oracle::vectors::Case;
 
 /// Runs `cases` through a started session and builds the report.
 pub fn check_session(session: &mut Session, cases: &[Case]) -> Result<CheckReport, HarnessError> {
     let outcomes = session.run(cases)?;
-    Ok(build_report(
-        cases,
-        &outcomes,
-        RunInfo {
-            candidate: session.hello().name.clone(),
-            import_error: session.hello().error.clone(),
-            start_failure: session.start_failure().map(str::to_string),
-            stderr_tail: session.stderr_tail(),
-            restarts: session.restarts(),
-            sandbox: Some(session.sandbox_facts()),
-            course_api: session.command().is_course_adapter(),
-        },
-    ))
+    Ok(build_report(cases, &outcomes, run_info(session)))
+}
+
+/// What a report says of the session that ran it (its candidate, import error, restarts,
+/// stderr, sandbox).
+pub fn run_info(session: &Session) -> RunInfo {
+    RunInfo {
+        candidate: session.hello().name.clone(),
+        import_error: session.hello().error.clone(),
+        start_failure: session.start_failure().map(str::to_string),
+        stderr_tail: session.stderr_tail(),
+        restarts: session.restarts(),
+        sandbox: Some(session.sandbox_facts()),
+        course_api: session.command().is_course_adapter(),
+    }
 }
 
 /// Starts `command`, checks it against `cases` and returns the report (the process group is

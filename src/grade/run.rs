@@ -84,7 +84,12 @@ pub fn grade(
         .iter()
         .filter(|g| g.kind == GroupKind::Image)
         .collect();
-    let (outcome, image_outcomes) = rayon::join(
+    let render_groups: Vec<&Group> = image_groups
+        .iter()
+        .copied()
+        .filter(|g| g.renders())
+        .collect();
+    let (outcome, (image_outcomes, renders)) = rayon::join(
         || {
             if shapes.is_empty() {
                 CodeOutcome::default()
@@ -93,17 +98,36 @@ pub fn grade(
             }
         },
         || {
-            image_groups
-                .iter()
-                .map(|g| check_image(submission, g, images, out_dir))
-                .collect::<Vec<_>>()
+            rayon::join(
+                || {
+                    image_groups
+                        .iter()
+                        .map(|g| check_image(submission, g, images, out_dir))
+                        .collect::<Vec<_>>()
+                },
+                || {
+                    super::render::render_groups(&render_groups, rubric.seed, |jobs| {
+                        code.render(submission, jobs)
+                    })
+                },
+            )
         },
     );
     let mut image_outcomes = image_outcomes.into_iter();
+    let mut renders = renders.into_iter();
     let mut checks = Vec::new();
     for g in &rubric.groups {
         match g.kind {
             GroupKind::Code => checks.extend(code_check(g, &outcome)),
+            GroupKind::Image if g.renders() => {
+                let upload = image_outcomes.next().expect("one per image group");
+                let render = renders.next().expect("one per render group");
+                let heatmap = out_dir.join(heatmap_name(g));
+                let judged = super::render::judge(g, render, upload, images, &heatmap);
+                let mut check = image_check(g, judged, out_dir);
+                super::render::explain(&mut check, g);
+                checks.push(check);
+            }
             GroupKind::Image => checks.push(image_check(
                 g,
                 image_outcomes.next().expect("one per image group"),
