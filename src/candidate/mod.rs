@@ -9,6 +9,8 @@
 //! - [`session`]: [`Session`] runs a [`CandidateCommand`] in the [sandbox](crate::sandbox) with
 //!   pipelined requests, per-case timeouts, restarts after crashes and the process group killed
 //!   on drop, over the pipes of [`pipe`], judging each line by the strict protocol of [`lines`].
+//! - [`render`](mod@render): the `render` request, a scene rendered tile by tile with the
+//!   candidate's own code, with bounds on what comes back.
 //! - [`python`]: choosing the interpreter of the course adapter (the assignment's modules,
 //!   runnable in the sandbox).
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and
@@ -35,6 +37,7 @@ pub mod outcome;
 pub mod pipe;
 pub mod protocol;
 pub mod python;
+pub mod render;
 pub mod report;
 pub mod report_text;
 pub mod repro;

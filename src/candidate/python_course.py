@@ -19,6 +19,12 @@ missing required module is said to be the grader's.
 The requests for the course's functions of weeks 5 to 10 (reflect, refract, the samplers, ...;
 docs/PROTOCOL.md, "Function requests") are answered by rtoracle's driver, a second file written
 beside this one (FUNCTIONS_FILE); the hello lists them in "ops" when it is there.
+
+A "render" request (docs/PROTOCOL.md, "Render requests") renders one tile of a scene with the
+submission's own classes: RT_scene.Scene, RT_object.Sphere / Quad / Triangle, RT_material's
+materials, RT_camera.Camera and RT_integrator.Integrator, looping over the pixels here (so the
+course's RT_renderer and its progress bar are never imported). The answer is the tile's mean
+linear RGB, or {"declined": why} for a scene the submission's classes cannot build.
 """
 
 import importlib.util
@@ -166,6 +172,224 @@ def triangle_maker(Triangle, Vec3):
     return make
 
 
+# --- render requests ------------------------------------------------------------------------
+
+# A scene's materials as the course's classes of weeks 4 to 10 take them: the class name in
+# RT_material and the entry's keys after the colour (CookTorrance takes the colour in week 8 only,
+# so its arguments follow its signature).
+MATERIAL_CLASSES = {
+    "lambertian": ("Lambertian", ()),
+    "diffuse_light": ("Diffuse_light", ()),
+    "mirror": ("Mirror", ()),
+    "dielectric": ("Dielectric", ("ior",)),
+    "metal": ("Metal", ("roughness",)),
+    "phong": ("Phong", ("kd", "ks", "alpha")),
+    "blinn": ("Blinn", ("kd", "ks", "alpha")),
+    "cook_torrance": ("CookTorrance", ("kd", "ks", "alpha", "ior")),
+    "textured": ("TextureColor", ()),
+}
+
+
+class Declined(Exception):
+    """The submission's classes cannot build this scene (the answer says why)."""
+
+
+def positional_count(f):
+    try:
+        params = inspect.signature(f).parameters.values()
+    except (TypeError, ValueError):
+        return None
+    return len([p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)])
+
+
+class SceneBuilder:
+    """Builds a scene description (the request's "scene") from the submission's classes."""
+
+    def __init__(self, Vec3, make_triangle):
+        import RT_utility
+        self.rtu = RT_utility
+        self.Vec3 = Vec3
+        self.make_triangle = make_triangle
+        self.modules = {}
+
+    def module(self, name):
+        if name not in self.modules:
+            if name not in sys.modules and not os.path.exists(os.path.join(SUBMISSION, name + ".py")):
+                raise Declined("the submission has no %s.py, which rendering needs" % name)
+            self.modules[name] = __import__(name)
+        return self.modules[name]
+
+    def cls(self, module, name):
+        c = getattr(self.module(module), name, None)
+        if c is None:
+            raise Declined("%s.py has no class %s, which the scene needs" % (module, name))
+        return c
+
+    def color(self, c):
+        return self.rtu.Color(float(c[0]), float(c[1]), float(c[2]))
+
+    def v3(self, a):
+        return self.Vec3(float(a[0]), float(a[1]), float(a[2]))
+
+    def texture(self, t):
+        kind = t.get("type")
+        if kind == "solid":
+            return self.cls("RT_texture", "SolidColor")(self.color(t["color"]))
+        if kind == "checker":
+            make = self.cls("RT_texture", "CheckerTexture")
+            return make(float(t["scale"]), self.color(t["even"]), self.color(t["odd"]))
+        raise Declined("the grader does not hand picture textures to the submission yet")
+
+    def material(self, m, textures):
+        kind = m.get("type")
+        if kind not in MATERIAL_CLASSES:
+            raise Declined("the adapter cannot build %r materials" % (kind,))
+        name, keys = MATERIAL_CLASSES[kind]
+        make = self.cls("RT_material", name)
+        if kind == "textured":
+            return make(textures[m["texture"]])
+        args = [float(m[k]) for k in keys]
+        if kind == "cook_torrance" and positional_count(make) == len(keys):
+            return make(*args)
+        return make(self.color(m.get("albedo", [1.0, 1.0, 1.0])), *args)
+
+    def objects(self, scene, materials):
+        rto = self.module("RT_object")
+        out = []
+        for o in scene["objects"]:
+            mat = materials[o["material"]]
+            kind = o.get("type")
+            if kind == "sphere":
+                obj = self.cls("RT_object", "Sphere")(self.v3(o["center"]), float(o["radius"]), mat)
+                if o.get("moving_center") is not None:
+                    if not callable(getattr(obj, "add_moving", None)):
+                        raise Declined("Sphere has no add_moving, which the scene's moving sphere needs")
+                    obj.add_moving(self.v3(o["moving_center"]))
+            elif kind == "quad":
+                obj = self.cls("RT_object", "Quad")(self.v3(o["q"]), self.v3(o["u"]), self.v3(o["v"]), mat)
+            elif kind == "triangle":
+                Triangle = getattr(rto, "Triangle", None)
+                if Triangle is None or self.make_triangle is None:
+                    raise Declined("RT_object.py has no Triangle that can be built")
+                # The material where the constructor takes one, else as an attribute.
+                a, b, c = self.v3(o["a"]), self.v3(o["b"]), self.v3(o["c"])
+                if (positional_count(Triangle) or 0) >= 4:
+                    obj = Triangle(a, b, c, mat)
+                else:
+                    obj = self.make_triangle(a, b, c)
+                    obj.material = mat
+            else:
+                raise Declined("the adapter cannot build %r objects" % (kind,))
+            out.append(obj)
+        return out
+
+    def camera(self, scene, spp):
+        image, cam, settings = scene["image"], scene["camera"], scene.get("render", {})
+        c = self.cls("RT_camera", "Camera")()
+        c.aspect_ratio = float(image["aspect_ratio"])
+        c.img_width = int(image["width"])
+        c.samples_per_pixel = spp
+        c.max_depth = int(settings.get("max_depth", getattr(c, "max_depth", 1) or 1))
+        c.vertical_fov = float(cam["vfov"])
+        c.look_from = self.v3(cam["look_from"])
+        c.look_at = self.v3(cam["look_at"])
+        c.vec_up = self.v3(cam["up"])
+        c.init_camera(float(cam.get("defocus_angle", 0.0)), float(cam.get("focus_distance", 10.0)))
+        return c
+
+    def scene(self, scene):
+        Scene = self.cls("RT_scene", "Scene")
+        bg = scene.get("render", {}).get("background_color")
+        if bg is not None and (positional_count(Scene) or 0) >= 1:
+            return Scene(self.color(bg))
+        return Scene()
+
+    def integrator(self, scene):
+        Integrator = self.cls("RT_integrator", "Integrator")
+        settings = scene.get("render", {})
+        try:
+            params = inspect.signature(Integrator).parameters
+        except (TypeError, ValueError):
+            params = {}
+        kwargs = {}
+        if "bDlight" in params and "direct_light" in settings:
+            kwargs["bDlight"] = bool(settings["direct_light"])
+        if "bSkyBG" in params and "background" in settings:
+            kwargs["bSkyBG"] = settings["background"] == "sky"
+        return Integrator(**kwargs)
+
+    def build(self, scene, spp):
+        textures = {t["name"]: self.texture(t) for t in scene.get("textures", [])}
+        materials = {m["name"]: self.material(m, textures) for m in scene["materials"]}
+        world = self.scene(scene)
+        for obj in self.objects(scene, materials):
+            world.add_object(obj)
+        camera = self.camera(scene, spp)
+        integrator = self.integrator(scene)
+        if callable(getattr(world, "find_lights", None)):
+            world.find_lights()
+        return world, camera, integrator
+
+
+def seed_row(seed, x0, y):
+    """Seeds the RNGs the course draws from (numpy's global one, random's) for one tile row."""
+    s = (int(seed) * 1000003 + y * 4099 + x0) % (1 << 32)
+    import random
+    random.seed(s)
+    np = sys.modules.get("numpy")
+    if np is not None:
+        np.random.seed(s)
+
+
+def render_tile(built, req):
+    """The mean linear RGB of each pixel of the request's tile, row by row, as JSON text."""
+    world, camera, integrator = built
+    spp = int(req["spp"])
+    x0, y0, x1, y1 = (int(v) for v in req["tile"])
+    depth = camera.max_depth
+    get_ray = camera.get_ray
+    trace = integrator.compute_scattering
+    parts = []
+    inv = 1.0 / spp
+    for j in range(y0, y1):
+        seed_row(req.get("seed", 0), x0, j)
+        for i in range(x0, x1):
+            r = g = b = 0.0
+            for _ in range(spp):
+                c = trace(get_ray(i, j), world, depth)
+                e = getattr(c, "e", c)
+                r += float(e[0])
+                g += float(e[1])
+                b += float(e[2])
+            parts.append(num(r * inv))
+            parts.append(num(g * inv))
+            parts.append(num(b * inv))
+    size = [int(getattr(camera, "img_width", 0)), int(getattr(camera, "img_height", 0))]
+    return '{"tile":[%d,%d,%d,%d],"size":[%d,%d],"rgb":[%s]}' % (
+        x0, y0, x1, y1, size[0], size[1], ",".join(parts))
+
+
+class Renderer:
+    """Answers render requests; the scene built for one request is kept for the next tiles."""
+
+    def __init__(self, Vec3, make_triangle):
+        self.Vec3 = Vec3
+        self.make_triangle = make_triangle
+        self.key = None
+        self.built = None
+
+    def answer(self, req):
+        key = json.dumps([req["scene"], req["spp"]], sort_keys=True)
+        if key != self.key:
+            self.key, self.built = None, None
+            try:
+                self.built = SceneBuilder(self.Vec3, self.make_triangle).build(req["scene"], int(req["spp"]))
+            except Declined as d:
+                return json.dumps({"declined": str(d)})
+            self.key = key
+        return render_tile(self.built, req)
+
+
 class _Channel:
     """The answer channel: answers and anything the submission prints, in order.
 
@@ -300,6 +524,8 @@ def main():
     make_triangle = triangle_maker(Triangle, Vec3)
     if make_triangle is not None:
         hello["shapes"].append("triangle")
+    hello.setdefault("ops", ["intersect"]).append("render")
+    renderer = Renderer(Vec3, make_triangle)
     out.write(json.dumps(hello) + "\n")
     threading.Thread(target=chan.watchdog, daemon=True).start()
     monotonic = time.monotonic
@@ -320,6 +546,13 @@ def main():
                 rid = '"' + rid + '"'
             else:
                 rid = dumps(rid)
+            if req.get("op") == "render":
+                chan.busy_since = monotonic()
+                ans = '{"id":' + rid + ',"result":' + renderer.answer(req) + "}\n"
+                chan.busy_since = 0.0
+                out.write(ans)
+                chan.send()
+                continue
             op = req.get("op", "intersect")
             if op != "intersect":
                 chan.busy_since = monotonic()

@@ -184,7 +184,10 @@ pub fn run() -> String {
     starts.sort_by(f64::total_cmp);
     let baseline = starts[2];
 
-    let rubric = Rubric::week04();
+    // The grader's renders measured on their own (one submission, one core); the other figures
+    // judge the uploaded images, as they did before renders, so they stay comparable.
+    let rendered = rendered_one(&honest, work.path());
+    let rubric = Rubric::week04_uploads();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
@@ -219,7 +222,7 @@ pub fn run() -> String {
     let (builtin, scene_file) = pool.install(|| scene_file_batches(work.path()));
     let mut report = String::new();
     report.push_str(&format!(
-        "grade benchmark (2 threads; fixtures: {})",
+        "grade benchmark (2 threads unless said; fixtures: {})",
         names.join(", ")
     ));
     report.push('\n');
@@ -229,11 +232,23 @@ pub fn run() -> String {
     ));
     report.push('\n');
     report.push_str(&format!(
-        "  one submission (honest, cold)           {:8.3} s  = {:6.1} x baseline  (target < 10 s)",
+        "  one submission (honest, cold)           {:8.3} s  = {:6.1} x baseline  (target < 10 s; uploaded images)",
         one,
         one / baseline
     ));
     report.push('\n');
+    report.push_str(&format!(
+        "  one submission, the grader's renders    {:8.3} s  = {:6.1} x baseline  (week-4 rubric, 1 thread; target <= 60 s)",
+        rendered.total,
+        rendered.total / baseline
+    ));
+    report.push('\n');
+    for (id, spp, seconds) in &rendered.groups {
+        report.push_str(&format!(
+            "    {id:<36}{seconds:8.3} s  to render at {spp} spp"
+        ));
+        report.push('\n');
+    }
     report.push_str(&format!(
         "  batch of 30 (all fixtures, 2 threads)   {:8.3} s  = {:6.1} x baseline, {:.3} s per submission  (target < 180 s)",
         batch_time,
@@ -255,6 +270,49 @@ pub fn run() -> String {
     report
 }
 
+/// What grading one submission with the grader's renders took.
+struct Rendered {
+    /// Wall time of the whole grade, in seconds.
+    total: f64,
+    /// Per rendered group: id, spp, seconds the render took.
+    groups: Vec<(String, u64, f64)>,
+}
+
+/// Grades `submission` with the built-in week-4 rubric (which renders both scenes from its
+/// code) on one thread, and reads each render's spp and time from its report.
+fn rendered_one(submission: &Path, work: &Path) -> Rendered {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a pool");
+    let (total, report) = pool.install(|| {
+        let t = Instant::now();
+        let report = grade_to_dir(
+            submission,
+            &Rubric::week04(),
+            &CourseCodeChecker::default(),
+            &CompareImageChecker::default(),
+            &work.join("rendered"),
+            &Format::ALL,
+        )
+        .expect("grading works");
+        (secs(t.elapsed()), report)
+    });
+    let groups = report
+        .checks
+        .iter()
+        .filter_map(|c| {
+            let render = &c.image.as_ref()?.metrics["render"];
+            Some((
+                c.id.clone(),
+                render["spp"].as_u64().unwrap_or(0),
+                render["seconds"].as_f64().unwrap_or(f64::NAN),
+            ))
+        })
+        .collect();
+    Rendered { total, groups }
+}
+
 /// Grades 10 honest triangle submissions twice, with the triangle rubric of `examples/rubrics`
 /// (code and image groups): once with its image group on the built-in `triangles` scene, once
 /// on its scene file with an empty golden cache. Returns both times in seconds, each the median
@@ -271,6 +329,12 @@ pub fn scene_file_batches(work: &Path) -> (f64, f64) {
         include_str!("../../examples/rubrics/triangles-scene.toml"),
     )
     .expect("write the example scene");
+    // The uploaded images are judged: this measures the golden's cost, not the renders'.
+    let text = text.replace(
+        "kind = \"image\"\n",
+        "kind = \"image\"\nsource = \"upload\"\n",
+    );
+    std::fs::write(&rubric_path, &text).expect("write the example rubric");
     let file_rubric = Rubric::from_file(&rubric_path).expect("the example rubric is valid");
     let builtin_rubric = Rubric::from_toml(
         &text.replace(

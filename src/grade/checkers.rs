@@ -145,6 +145,14 @@ impl CodeChecker for CourseCodeChecker {
         )
     }
 
+    fn render(
+        &self,
+        submission: &Path,
+        jobs: &[crate::grade::inputs::RenderJob],
+    ) -> Vec<crate::grade::inputs::RenderOutcome> {
+        super::render::course_render(self, submission, jobs)
+    }
+
     fn vectors_sha256(&self) -> String {
         let text: String = self
             .suite()

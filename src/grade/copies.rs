@@ -188,6 +188,18 @@ impl CopyFinding {
         !matches!(self, CopyFinding::SharedWith { .. })
     }
 
+    /// The sentence the student reads when the grader's render of the submission's code
+    /// returned such an image (its pixels were read, not computed).
+    pub fn render_sentence(&self) -> String {
+        match self {
+            CopyFinding::CourseImage { file: course } => format!(
+                "The render of your code returned the course's published image {course}, pixel for pixel: your code did not compute it; it scores 0."
+            ),
+            CopyFinding::ReferenceRender { .. } => "The render of your code returned the reference tracer's own render of the scene (rtoracle render at its default seed): your code did not compute it; it scores 0.".to_string(),
+            CopyFinding::SharedWith { .. } => self.sentence("The render of your code"),
+        }
+    }
+
     /// The sentence the student reads (never naming a classmate).
     pub fn sentence(&self, file: &str) -> String {
         match self {

@@ -65,6 +65,25 @@ impl CodeChecker for FakeCode {
     fn vectors_sha256(&self) -> String {
         "v".into()
     }
+    /// A grey image of each job's size at once (the fake image checker reads no pixel).
+    fn render(
+        &self,
+        _: &Path,
+        jobs: &[super::inputs::RenderJob],
+    ) -> Vec<super::inputs::RenderOutcome> {
+        jobs.iter()
+            .map(|job| {
+                let camera = job.scene.camera(None);
+                super::inputs::RenderOutcome::Rendered(super::inputs::RenderedImage {
+                    width: camera.width,
+                    height: camera.height,
+                    spp: job.spp,
+                    seconds: 0.0,
+                    data: vec![[0.5; 3]; camera.width * camera.height],
+                })
+            })
+            .collect()
+    }
 }
 
 /// Gives a fixed verdict per scene.

@@ -16,7 +16,9 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict, SceneFile, SceneSource};
+use super::inputs::{
+    ImageChecker, ImageOutcome, ImageVerdict, RenderedImage, SceneFile, SceneSource,
+};
 use crate::compare::{
     CandidateImage, CompareError, CompareOptions, Golden, check_size, compare_image, write_heatmap,
 };
@@ -118,85 +120,35 @@ impl CompareImageChecker {
     }
 }
 
-/// What the golden of a rubric's scene file is made from: the scene, named by its label, reading
-/// its other files from its folder.
-pub(crate) fn golden_scene_of(f: &SceneFile) -> Result<GoldenScene, crate::golden::GoldenError> {
-    GoldenScene::from_description(&f.label, f.description.clone(), f.path.parent())
-}
-
-fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| path.display().to_string())
-}
-
-impl ImageChecker for CompareImageChecker {
-    fn describe(&self) -> String {
-        format!(
-            "noise-aware comparison (rtoracle compare): a built-in scene's image as {} spp against a golden of {} spp; a scene file's as its samples_per_pixel N against a golden of max(4096, 100 N) spp, or the rubric's golden as given (each image's metrics give its candidate_spp and golden_spp); {} encoding, per-image false-failure rate {}",
-            self.options.samples_per_pixel,
-            golden_spp(self.options.samples_per_pixel),
-            self.options.encoding,
-            self.options.alpha
-        )
-    }
-
-    fn golden_sha256(&self, scene: &str) -> String {
-        self.scene_golden_sha256(&SceneSource::Builtin(scene.to_string()))
-    }
-
-    fn prepare(&self, scenes: &[SceneSource]) -> Result<(), String> {
-        for scene in scenes {
-            self.golden(scene)
-                .map_err(|e| format!("no golden for {}: {e}", scene.label()))?;
-        }
-        Ok(())
-    }
-
-    fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
-        self.golden(scene).map(|(_, h)| h).unwrap_or_default()
-    }
-
-    fn check(&self, candidate_png: &Path, scene: &str, heatmap_out: &Path) -> ImageOutcome {
-        self.check_scene(
-            candidate_png,
-            &SceneSource::Builtin(scene.to_string()),
-            heatmap_out,
-        )
-    }
-
-    fn check_scene(
+impl CompareImageChecker {
+    /// Compares `candidate` (named `name` in messages), a render of `spp` samples per pixel, with
+    /// the golden of `scene`: the verdict, the metrics, the diagnosis and the heatmap.
+    fn judge(
         &self,
-        candidate_png: &Path,
+        candidate: &CandidateImage,
         scene: &SceneSource,
+        spp: u32,
+        name: &str,
         heatmap_out: &Path,
     ) -> ImageOutcome {
-        let name = file_name(candidate_png);
-        if !candidate_png.exists() {
-            return ImageOutcome::unusable(format!("{name} is missing from the submission"));
-        }
-        let candidate = match CandidateImage::load(candidate_png) {
-            Ok(c) => c,
-            Err(e) => return ImageOutcome::unusable(e.to_string()),
-        };
         let golden = match self.golden(scene) {
             Ok((g, _)) => g,
             Err(e) => {
                 return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
             }
         };
-        if let Err(e) = check_size(candidate_png, &candidate, golden.width, golden.height) {
-            // Name the file as the student knows it, not by the grader's path.
-            let why = e
-                .to_string()
-                .replace(&format!("{}: ", candidate_png.display()), "");
-            return ImageOutcome::unusable(format!("{name} {why}"));
+        let (w, h) = candidate.size();
+        if (w, h) != (golden.width, golden.height) {
+            return ImageOutcome::unusable(format!(
+                "{name} is {w}x{h} but the golden is {}x{}",
+                golden.width, golden.height
+            ));
         }
         let options = CompareOptions {
-            samples_per_pixel: self.candidate_spp(scene),
+            samples_per_pixel: spp,
             ..self.options
         };
-        let comparison = match compare_image(&candidate, &golden, &options) {
+        let comparison = match compare_image(candidate, &golden, &options) {
             Ok(c) => c,
             Err(e) => return ImageOutcome::unusable(format!("{name}: {e}")),
         };
@@ -250,5 +202,103 @@ impl ImageChecker for CompareImageChecker {
             diagnosis,
             heatmap,
         }
+    }
+}
+
+/// What the golden of a rubric's scene file is made from: the scene, named by its label, reading
+/// its other files from its folder.
+pub(crate) fn golden_scene_of(f: &SceneFile) -> Result<GoldenScene, crate::golden::GoldenError> {
+    GoldenScene::from_description(&f.label, f.description.clone(), f.path.parent())
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+impl ImageChecker for CompareImageChecker {
+    fn describe(&self) -> String {
+        format!(
+            "noise-aware comparison (rtoracle compare): a built-in scene's image as {} spp against a golden of {} spp; a scene file's as its samples_per_pixel N against a golden of max(4096, 100 N) spp, or the rubric's golden as given (each image's metrics give its candidate_spp and golden_spp); {} encoding, per-image false-failure rate {}",
+            self.options.samples_per_pixel,
+            golden_spp(self.options.samples_per_pixel),
+            self.options.encoding,
+            self.options.alpha
+        )
+    }
+
+    fn golden_sha256(&self, scene: &str) -> String {
+        self.scene_golden_sha256(&SceneSource::Builtin(scene.to_string()))
+    }
+
+    fn prepare(&self, scenes: &[SceneSource]) -> Result<(), String> {
+        for scene in scenes {
+            self.golden(scene)
+                .map_err(|e| format!("no golden for {}: {e}", scene.label()))?;
+        }
+        Ok(())
+    }
+
+    fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
+        self.golden(scene).map(|(_, h)| h).unwrap_or_default()
+    }
+
+    fn check(&self, candidate_png: &Path, scene: &str, heatmap_out: &Path) -> ImageOutcome {
+        self.check_scene(
+            candidate_png,
+            &SceneSource::Builtin(scene.to_string()),
+            heatmap_out,
+        )
+    }
+
+    fn check_render(
+        &self,
+        render: &RenderedImage,
+        scene: &SceneSource,
+        heatmap_out: &Path,
+    ) -> ImageOutcome {
+        let candidate = CandidateImage::Linear {
+            width: render.width,
+            height: render.height,
+            data: render.data.clone(),
+        };
+        self.judge(&candidate, scene, render.spp, "the render", heatmap_out)
+    }
+
+    fn check_scene(
+        &self,
+        candidate_png: &Path,
+        scene: &SceneSource,
+        heatmap_out: &Path,
+    ) -> ImageOutcome {
+        let name = file_name(candidate_png);
+        if !candidate_png.exists() {
+            return ImageOutcome::unusable(format!("{name} is missing from the submission"));
+        }
+        let candidate = match CandidateImage::load(candidate_png) {
+            Ok(c) => c,
+            Err(e) => return ImageOutcome::unusable(e.to_string()),
+        };
+        let golden = match self.golden(scene) {
+            Ok((g, _)) => g,
+            Err(e) => {
+                return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
+            }
+        };
+        if let Err(e) = check_size(candidate_png, &candidate, golden.width, golden.height) {
+            // Name the file as the student knows it, not by the grader's path.
+            let why = e
+                .to_string()
+                .replace(&format!("{}: ", candidate_png.display()), "");
+            return ImageOutcome::unusable(format!("{name} {why}"));
+        }
+        self.judge(
+            &candidate,
+            scene,
+            self.candidate_spp(scene),
+            &name,
+            heatmap_out,
+        )
     }
 }

@@ -29,7 +29,20 @@ pub trait CodeChecker: Sync {
 
     /// The SHA-256 (hex) of the vectors it runs, for the report's reproducibility block.
     fn vectors_sha256(&self) -> String;
+
+    /// Renders each job's scene with the submission's own code (the image groups rendered by
+    /// the grader, [`render`](super::render)), one outcome per job, in order. Never panics:
+    /// whatever the code does is an outcome. The default declines every job (a checker that
+    /// cannot run the submission's renderer).
+    fn render(&self, submission: &Path, jobs: &[RenderJob]) -> Vec<RenderOutcome> {
+        let _ = submission;
+        jobs.iter()
+            .map(|_| RenderOutcome::Declined(format!("{} does not render", self.describe())))
+            .collect()
+    }
 }
+
+pub use crate::candidate::render::{RenderJob, RenderOutcome, RenderedImage};
 
 /// Compares one image of a submission with the reference of a scene.
 pub trait ImageChecker: Sync {
@@ -69,6 +82,19 @@ pub trait ImageChecker: Sync {
     /// [`golden_sha256`](Self::golden_sha256) with the scene's label.
     fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
         self.golden_sha256(scene.label())
+    }
+
+    /// Judges the grader's render of `scene` from the submission's code (linear RGB at
+    /// `render.spp` samples per pixel). The default judges it as an uploaded PNG of the course's
+    /// encoding ([`judge_as_png`](super::render::judge_as_png)), which is enough for checkers
+    /// that read only files (and for fakes).
+    fn check_render(
+        &self,
+        render: &RenderedImage,
+        scene: &SceneSource,
+        heatmap_out: &Path,
+    ) -> ImageOutcome {
+        super::render::judge_as_png(render, |png| self.check_scene(png, scene, heatmap_out))
     }
 }
 

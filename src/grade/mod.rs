@@ -8,7 +8,9 @@
 //! `check` harness running the course adapter in the [sandbox](crate::sandbox); the image
 //! checker is [`CompareImageChecker`] ([`image_checker`]), the noise-aware comparison against
 //! the golden of a built-in scene (embedded) or of an instructor's scene file (the rubric's, or
-//! rendered once and cached).
+//! rendered once and cached). Image groups are rendered by the grader from the submission's own
+//! code by default ([`render`](mod@render)): the code checker renders, the image checker judges
+//! the render.
 //!
 //! ```no_run
 //! use rtoracle::grade::{CompareImageChecker, CourseCodeChecker, Format, Rubric, grade_to_dir};
@@ -37,6 +39,7 @@ pub mod image_checker;
 pub mod inputs;
 pub mod intake;
 pub mod pack;
+pub mod render;
 pub mod report;
 mod result;
 pub mod rubric;
@@ -55,6 +58,6 @@ pub use result::{
     CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, GradeError, GradeReport, ImageResult,
     Reproducibility, round2, smallest_failure,
 };
-pub use rubric::{GoldenFile, Group, GroupKind, Rubric, RubricError, Visibility};
+pub use rubric::{GoldenFile, Group, GroupKind, ImageSource, Rubric, RubricError, Visibility};
 pub use run::grade;
 pub use write::{REPORT_FOLDER, grade_to_dir};

@@ -23,6 +23,10 @@
 //! kind = "image"
 //! file = "week04_sphere.png"     # for image groups: the file in the submission
 //! scene = "week04-sphere"        # and the built-in scene it must show
+//! source = "render"              # default: the grader renders the scene with the submission's
+//!                                # code and judges that; "upload": the file is judged instead
+//! spp = 4                        # render: samples per pixel (default 4)
+//! render_seconds = 60            # render: wall time it may take (default 60), else not run
 //! points = 20
 //!
 //! [[group]]
@@ -34,6 +38,13 @@
 //! file = "tri.png"               # optional for scene files: default the scene's stem + ".png"
 //! points = 20
 //! ```
+//!
+//! A rendered image group (`source = "render"`) is judged on the grader's render of its scene
+//! from the submission's code, at `spp` samples per pixel against the golden (see
+//! [`render`](super::render)); its uploaded `file` is still read and reported, and earns
+//! nothing. A submission's worst case is `code_time_budget_seconds` for the code checks plus
+//! each rendered group's `render_seconds` (the renders and the code checks run at the same time
+//! when there are cores for both).
 //!
 //! An image group's `scene` is a built-in scene when it names one, and otherwise a scene file
 //! (`.toml`) relative to the folder of the rubric file (of the current folder for a rubric
@@ -82,6 +93,9 @@ name = "Sphere scene image (week04_sphere.png)"
 kind = "image"
 file = "week04_sphere.png"
 scene = "week04-sphere"
+source = "render" # rendered by the grader from the submission's code
+spp = 4
+render_seconds = 60
 points = 20
 visibility = "visible"
 
@@ -91,9 +105,21 @@ name = "Quad scene image (week04_quad.png)"
 kind = "image"
 file = "week04_quad.png"
 scene = "week04-quad"
+source = "render" # rendered by the grader from the submission's code
+spp = 4
+render_seconds = 60
 points = 20
 visibility = "visible"
 "#;
+
+/// The lines of the built-in rubric's image groups that make them rendered by the grader.
+const WEEK04_RENDER_LINES: &str = "source = \"render\" # rendered by the grader from the submission's code\nspp = 4\nrender_seconds = 60\n";
+
+/// The text of [`Rubric::week04_uploads`]: the built-in rubric with `source = "upload"` image
+/// groups.
+pub fn week04_uploads_toml() -> String {
+    WEEK04_RUBRIC.replace(WEEK04_RENDER_LINES, "source = \"upload\"\n")
+}
 
 /// Who sees a test on Gradescope, and when.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -170,7 +196,42 @@ pub struct Group {
     /// Who sees the group's tests on Gradescope.
     #[serde(default)]
     pub visibility: Visibility,
+    /// For image groups: where the judged image comes from: rendered by the grader from the
+    /// submission's code (`render`, the default) or the uploaded file (`upload`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<ImageSource>,
+    /// For rendered image groups: the samples per pixel of the grader's render (default
+    /// [`DEFAULT_RENDER_SPP`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spp: Option<u32>,
+    /// For rendered image groups: the wall time the render may take, in seconds (default
+    /// [`DEFAULT_RENDER_SECONDS`]); past it the group is not run, with the reason.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub render_seconds: Option<f64>,
 }
+
+/// Where an image group's judged image comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ImageSource {
+    /// The grader renders the scene with the submission's own code, in the sandbox; an uploaded
+    /// image is judged and reported too, but earns nothing.
+    #[default]
+    Render,
+    /// The image the submission uploaded (for assignments whose code cannot be run).
+    Upload,
+}
+
+/// The samples per pixel of a rendered image group when the rubric does not say: at the
+/// course's Python cost (about 12 to 16 us of one core per sample on the week-4 scenes), the
+/// 400x225 sphere scene takes about 4.5 s and the 400x400 quad scene about 10 s.
+pub const DEFAULT_RENDER_SPP: u32 = 4;
+
+/// The wall time a rendered image group may take when the rubric does not say, in seconds.
+pub const DEFAULT_RENDER_SECONDS: f64 = 60.0;
+
+/// The most samples per pixel a rubric may ask a render for.
+pub const MAX_RENDER_SPP: u32 = 4096;
 
 /// A scene file an image group names, read and validated when the rubric was loaded.
 #[derive(Clone, Debug, PartialEq)]
@@ -220,6 +281,27 @@ impl SceneSource {
 }
 
 impl Group {
+    /// For an image group: where its judged image comes from (`render` unless the rubric says
+    /// `upload`).
+    pub fn image_source(&self) -> ImageSource {
+        self.source.unwrap_or_default()
+    }
+
+    /// For an image group: whether the grader renders its scene from the submission's code.
+    pub fn renders(&self) -> bool {
+        self.kind == GroupKind::Image && self.image_source() == ImageSource::Render
+    }
+
+    /// The samples per pixel of the grader's render.
+    pub fn render_spp(&self) -> u32 {
+        self.spp.unwrap_or(DEFAULT_RENDER_SPP)
+    }
+
+    /// The wall time the grader's render may take, in seconds.
+    pub fn render_seconds(&self) -> f64 {
+        self.render_seconds.unwrap_or(DEFAULT_RENDER_SECONDS)
+    }
+
     /// For an image group of a validated rubric: the scene its image must show.
     pub fn scene_source(&self) -> Option<SceneSource> {
         match (&self.scene_file, &self.scene) {
@@ -313,6 +395,13 @@ impl Rubric {
     /// The built-in week-4 rubric.
     pub fn week04() -> Rubric {
         Rubric::from_toml(WEEK04_RUBRIC, "built-in").expect("the built-in rubric is valid")
+    }
+
+    /// The built-in week-4 rubric with its image groups judging the uploaded images
+    /// (`source = "upload"`) instead of the grader's renders of the submission's code.
+    pub fn week04_uploads() -> Rubric {
+        Rubric::from_toml(&week04_uploads_toml(), "built-in, uploads")
+            .expect("the upload variant is valid")
     }
 
     /// Reads a rubric file.
@@ -499,9 +588,15 @@ impl Rubric {
                 g.id
             )));
         }
-        if g.file.is_some() || g.scene.is_some() || g.golden.is_some() {
+        if g.file.is_some()
+            || g.scene.is_some()
+            || g.golden.is_some()
+            || g.source.is_some()
+            || g.spp.is_some()
+            || g.render_seconds.is_some()
+        {
             return Err(self.invalid(format!(
-                "code group {:?} takes no file, scene or golden",
+                "code group {:?} takes no file, scene, golden, source, spp or render_seconds",
                 g.id
             )));
         }
@@ -563,6 +658,34 @@ impl Rubric {
                 "image group {:?} takes no shape or score_ambiguous",
                 g.id
             )));
+        }
+        self.validate_render_settings(g)
+    }
+
+    fn validate_render_settings(&self, g: &Group) -> Result<(), RubricError> {
+        if g.image_source() == ImageSource::Upload
+            && (g.spp.is_some() || g.render_seconds.is_some())
+        {
+            return Err(self.invalid(format!(
+                "image group {:?}: spp and render_seconds are for source = \"render\", not \"upload\"",
+                g.id
+            )));
+        }
+        if let Some(spp) = g.spp {
+            if !(1..=MAX_RENDER_SPP).contains(&spp) {
+                return Err(self.invalid(format!(
+                    "image group {:?}: spp = {spp}: it must be from 1 to {MAX_RENDER_SPP}",
+                    g.id
+                )));
+            }
+        }
+        if let Some(s) = g.render_seconds {
+            if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
+                return Err(self.invalid(format!(
+                    "image group {:?}: render_seconds = {s}: it must be more than 0 and at most 3600",
+                    g.id
+                )));
+            }
         }
         Ok(())
     }
@@ -636,6 +759,67 @@ mod tests {
                 .all(|g| !g.all_or_nothing && !g.score_ambiguous)
         );
         assert_eq!(r.sha256, sha256_hex(WEEK04_RUBRIC.as_bytes()));
+    }
+
+    #[test]
+    fn the_builtin_rubric_renders_its_images_and_its_upload_variant_does_not() {
+        let r = Rubric::week04();
+        for g in r.groups.iter().filter(|g| g.kind == GroupKind::Image) {
+            assert!(g.renders(), "{}", g.id);
+            assert_eq!((g.render_spp(), g.render_seconds()), (4, 60.0));
+        }
+        let u = Rubric::week04_uploads();
+        assert_eq!(
+            week04_uploads_toml().matches("source = \"upload\"").count(),
+            2
+        );
+        for g in u.groups.iter().filter(|g| g.kind == GroupKind::Image) {
+            assert_eq!(g.image_source(), ImageSource::Upload, "{}", g.id);
+            assert!(!g.renders());
+        }
+        // Defaults: an image group without `source` renders at the default spp and time.
+        let text = "name = \"t\"\n[[group]]\nid = \"image.s\"\nname = \"S\"\nkind = \"image\"\nfile = \"s.png\"\nscene = \"week04-sphere\"\npoints = 5\n";
+        let g = &Rubric::from_toml(text, "t.toml").unwrap().groups[0];
+        assert!(g.renders());
+        assert_eq!(
+            (g.render_spp(), g.render_seconds()),
+            (DEFAULT_RENDER_SPP, DEFAULT_RENDER_SECONDS)
+        );
+        let bad = [
+            (
+                "points = 5",
+                "spp = 0\npoints = 5",
+                "spp = 0: it must be from 1 to 4096",
+            ),
+            (
+                "points = 5",
+                "render_seconds = -1\npoints = 5",
+                "render_seconds = -1",
+            ),
+            (
+                "points = 5",
+                "source = \"upload\"\nspp = 8\npoints = 5",
+                "spp and render_seconds are for source = \"render\"",
+            ),
+            (
+                "points = 5",
+                "source = \"paint\"\npoints = 5",
+                "not a valid rubric",
+            ),
+        ];
+        for (from, to, needle) in bad {
+            let e = Rubric::from_toml(&text.replace(from, to), "t.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{e}");
+        }
+        let code =
+            WEEK04_RUBRIC.replacen("shape = \"sphere\"\n", "shape = \"sphere\"\nspp = 2\n", 1);
+        let e = Rubric::from_toml(&code, "t.toml").unwrap_err().to_string();
+        assert!(
+            e.contains("takes no file, scene, golden, source, spp"),
+            "{e}"
+        );
     }
 
     #[test]

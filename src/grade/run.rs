@@ -126,7 +126,12 @@ pub fn grade(
         .iter()
         .filter(|g| g.kind == GroupKind::Image)
         .collect();
-    let (outcome, image_outcomes) = rayon::join(
+    let render_groups: Vec<&Group> = image_groups
+        .iter()
+        .copied()
+        .filter(|g| g.renders())
+        .collect();
+    let (outcome, (image_outcomes, renders)) = rayon::join(
         || {
             if shapes.is_empty() {
                 CodeOutcome::default()
@@ -135,18 +140,52 @@ pub fn grade(
             }
         },
         || {
-            image_groups
-                .iter()
-                .map(|g| check_image(submission, g, images, out_dir))
-                .collect::<Vec<_>>()
+            rayon::join(
+                || {
+                    image_groups
+                        .iter()
+                        .map(|g| check_image(submission, g, images, out_dir))
+                        .collect::<Vec<_>>()
+                },
+                || {
+                    super::render::render_groups(&render_groups, rubric.seed, |jobs| {
+                        code.render(submission, jobs)
+                    })
+                },
+            )
         },
     );
     let mut image_outcomes = image_outcomes.into_iter();
+    let mut renders = renders.into_iter();
     let mut checks = Vec::new();
     let mut fingerprints = Vec::new();
     for g in &rubric.groups {
         match g.kind {
             GroupKind::Code => checks.extend(code_check(g, &outcome)),
+            GroupKind::Image if g.renders() => {
+                let staged = image_outcomes.next().expect("one per image group");
+                let render = renders.next().expect("one per render group");
+                // What the submission's code returned may itself be a copy: pixels read from
+                // the course's published image or from the reference's render. Renders are
+                // not compared with each other: one seed and the same formulas give the same
+                // noise to honest submissions.
+                let copy = match &render {
+                    crate::candidate::render::RenderOutcome::Rendered(image) => {
+                        let scene = g.scene_source().expect("validated");
+                        let fp = Fingerprint::of(&super::render::encoded(image));
+                        recognise(&fp, &scene).filter(CopyFinding::zeroes)
+                    }
+                    _ => None,
+                };
+                let heatmap = out_dir.join(heatmap_name(g));
+                let judged = super::render::judge(g, render, staged.outcome, images, &heatmap);
+                let mut check = image_check(g, judged, copy.clone(), out_dir);
+                match &copy {
+                    Some(c) => check.message = c.render_sentence(),
+                    None => super::render::explain(&mut check, g),
+                }
+                checks.push(check);
+            }
             GroupKind::Image => {
                 let staged = image_outcomes.next().expect("one per image group");
                 // A recognised copy is not compared with classmates' images (it scores 0).

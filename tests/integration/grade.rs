@@ -40,12 +40,22 @@ fn batch() -> &'static Batch {
         // with the built-in suite (which the unit tests of the checker and
         // `one_submission_writes_the_chosen_formats_and_exits_0` run).
         let vectors = rtoracle::grade::bench::fixtures_dir().join("vectors.jsonl");
+        // The uploaded images are judged (`source = "upload"`): what each fixture's images
+        // cost is the point of `loses`; the grader's renders have tests of their own
+        // (renders.rs).
+        std::fs::write(
+            root.join("upload.toml"),
+            rtoracle::grade::rubric::week04_uploads_toml(),
+        )
+        .unwrap();
         let output = run_in(
             &root,
             &[
                 "grade",
                 "--batch",
                 "subs",
+                "--rubric",
+                "upload.toml",
                 "--out",
                 "out",
                 "--case-timeout-ms",

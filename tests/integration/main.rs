@@ -15,5 +15,6 @@ mod oracle_props;
 mod protocol;
 mod readme;
 mod render;
+mod renders;
 mod reports;
 mod sandbox;

@@ -1,0 +1,350 @@
+//! The `render` request (`docs/PROTOCOL.md`, "Render requests"): a candidate renders a scene
+//! with its own code, tile by tile, and sends back each pixel's mean linear RGB.
+//!
+//! ```text
+//! -> {"sync":true,"id":"render-3","op":"render","scene":{...the scene file as JSON...},
+//!     "spp":4,"seed":0,"tile":[0,12,400,16]}
+//! <- {"id":"render-3","result":{"tile":[0,12,400,16],"rgb":[0.73,0.84,1.0, ...]}}
+//! <- {"id":"render-3","result":{"declined":"RT_material.py has no class Mirror, ..."}}
+//! ```
+//!
+//! [`render_scene`] asks for the image in tiles small enough that each answer fits the
+//! protocol's cap on a function's answer ([`MAX_RESULT_BYTES`]), and promises bounds on what
+//! comes back whatever the candidate does: an answer of the wrong size (a tile that is not the
+//! one asked for, a pixel count that differs), a NaN or infinite value, an error, a death, or no
+//! answer within the time left of the job's limit ends the render with the reason, and memory is
+//! the image's own size (`3 * width * height` `f32`s) plus one answer line.
+
+use std::time::{Duration, Instant};
+
+use serde_json::{Value, json};
+
+use super::protocol::{CandidateError, MAX_RESULT_BYTES};
+use super::session::{CallOutcome, Session};
+use crate::scene::SceneDescription;
+
+/// The longest answer [`render_scene`] plans a tile for: a pixel's three numbers take at most
+/// about 3 x 25 bytes in the shortest round-trip syntax, and the tile is sized so that its
+/// answer stays under [`MAX_RESULT_BYTES`] with room to spare.
+const BYTES_PER_PIXEL: usize = 80;
+
+/// What to render.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderJob<'a> {
+    /// The scene (its camera, image size, objects, materials, settings).
+    pub scene: &'a SceneDescription,
+    /// Samples per pixel (the scene's own count is ignored).
+    pub spp: u32,
+    /// A seed the candidate may use for its random numbers (the course adapter does).
+    pub seed: u64,
+    /// Wall time the whole render may take, from the first tile's request.
+    pub time_limit: Duration,
+}
+
+/// A render that came back whole.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderedImage {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Samples per pixel it was asked for.
+    pub spp: u32,
+    /// Wall time it took, in seconds.
+    pub seconds: f64,
+    /// Mean linear RGB per pixel, row-major, top row first.
+    pub data: Vec<[f32; 3]>,
+}
+
+/// How a render ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RenderOutcome {
+    /// Every tile came back, valid.
+    Rendered(RenderedImage),
+    /// The candidate does not render, or not this scene: why, in its words or ours.
+    Declined(String),
+    /// The candidate's code raised (file names are the submission's).
+    Raised(CandidateError),
+    /// The time limit ran out: how long it was and how many rows had come back.
+    TimedOut {
+        /// The limit.
+        limit: Duration,
+        /// Rows rendered before it ran out.
+        rows_done: usize,
+        /// The image's height.
+        height: usize,
+    },
+    /// An answer broke the render's bounds (wrong size, NaN, malformed) or the candidate died:
+    /// what happened.
+    Invalid(String),
+}
+
+impl RenderOutcome {
+    /// One sentence saying why there is no image (`None` for a rendered one).
+    pub fn reason(&self) -> Option<String> {
+        match self {
+            RenderOutcome::Rendered(_) => None,
+            RenderOutcome::Declined(why) => Some(format!("the render was declined: {why}")),
+            RenderOutcome::Raised(e) => Some(format!("the render raised {e}")),
+            RenderOutcome::TimedOut {
+                limit,
+                rows_done,
+                height,
+            } => Some(format!(
+                "the render did not finish within {} s ({rows_done} of {height} rows done)",
+                limit.as_secs_f64()
+            )),
+            RenderOutcome::Invalid(why) => Some(format!("the render is unusable: {why}")),
+        }
+    }
+}
+
+/// The tiles of a `width` x `height` image, in order: whole rows when a row fits one answer,
+/// else pieces of rows. Each is `[x0, y0, x1, y1]` (ends excluded).
+pub fn tiles(width: usize, height: usize) -> Vec<[usize; 4]> {
+    let per_tile = (MAX_RESULT_BYTES * 3 / 4 / BYTES_PER_PIXEL).max(1);
+    let mut out = Vec::new();
+    if width == 0 || height == 0 {
+        return out;
+    }
+    if width <= per_tile {
+        let rows = (per_tile / width).max(1);
+        let mut y = 0;
+        while y < height {
+            let y1 = (y + rows).min(height);
+            out.push([0, y, width, y1]);
+            y = y1;
+        }
+    } else {
+        for y in 0..height {
+            let mut x = 0;
+            while x < width {
+                let x1 = (x + per_tile).min(width);
+                out.push([x, y, x1, y + 1]);
+                x = x1;
+            }
+        }
+    }
+    out
+}
+
+/// The request for one tile, without its id (the session adds it).
+pub fn render_request(job: &RenderJob, scene: &Value, tile: [usize; 4]) -> Value {
+    json!({
+        "op": "render",
+        "scene": scene,
+        "spp": job.spp,
+        "seed": job.seed,
+        "tile": tile,
+    })
+}
+
+/// A number of an answer: a JSON number, or `"nan"`, `"inf"`, `"-inf"` as strings.
+fn number(v: &Value) -> Option<f64> {
+    match v {
+        Value::Number(n) => n.as_f64(),
+        Value::String(s) => match s.as_str() {
+            "nan" => Some(f64::NAN),
+            "inf" => Some(f64::INFINITY),
+            "-inf" => Some(f64::NEG_INFINITY),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// Reads one tile's answer into `data` (the whole image, `width` x `height`); `Err` says what
+/// is wrong with it, naming the first bad pixel. An answer may say the `size` of the image its
+/// camera makes (the course adapter does): another size than the scene's is wrong.
+pub fn read_tile(
+    result: &Value,
+    tile: [usize; 4],
+    (width, height): (usize, usize),
+    data: &mut [[f32; 3]],
+) -> Result<(), String> {
+    let [x0, y0, x1, y1] = tile;
+    let echoed: Option<Vec<u64>> = result
+        .get("tile")
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_u64).collect());
+    if echoed.as_deref() != Some(&[x0 as u64, y0 as u64, x1 as u64, y1 as u64][..]) {
+        return Err(format!(
+            "the answer for the tile x {x0}..{x1}, y {y0}..{y1} names another tile ({})",
+            result.get("tile").map_or("none".into(), |t| {
+                crate::escape::truncate(&t.to_string(), 80)
+            })
+        ));
+    }
+    if let Some(size) = result.get("size") {
+        let made: Option<Vec<u64>> = size
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_u64).collect());
+        let want = [width as u64, height as u64];
+        if made.as_deref() != Some(&want[..]) {
+            return Err(format!(
+                "the candidate's camera makes an image of size {} but the scene is {width}x{height}",
+                crate::escape::truncate(&size.to_string(), 40)
+            ));
+        }
+    }
+    let Some(rgb) = result.get("rgb").and_then(Value::as_array) else {
+        return Err(format!(
+            "the answer for the tile x {x0}..{x1}, y {y0}..{y1} has no \"rgb\" list"
+        ));
+    };
+    let pixels = (x1 - x0) * (y1 - y0);
+    if rgb.len() != 3 * pixels {
+        return Err(format!(
+            "the tile x {x0}..{x1}, y {y0}..{y1} has {} numbers, not 3 x {pixels} (the image is {width} pixels wide)",
+            rgb.len()
+        ));
+    }
+    for (k, triple) in rgb.chunks(3).enumerate() {
+        let (x, y) = (x0 + k % (x1 - x0), y0 + k / (x1 - x0));
+        let mut px = [0f32; 3];
+        for (c, v) in triple.iter().enumerate() {
+            let Some(n) = number(v) else {
+                return Err(format!("pixel ({x}, {y}) is not a number: {}", {
+                    crate::escape::truncate(&v.to_string(), 40)
+                }));
+            };
+            if !n.is_finite() || !(n as f32).is_finite() {
+                return Err(format!(
+                    "pixel ({x}, {y}) is {} (a colour must be a finite number)",
+                    if n.is_nan() {
+                        "NaN".to_string()
+                    } else {
+                        n.to_string()
+                    }
+                ));
+            }
+            px[c] = n as f32;
+        }
+        data[y * width + x] = px;
+    }
+    Ok(())
+}
+
+/// Renders `job` through `session`, tile by tile (see the module docs); the candidate must list
+/// `"render"` among its hello's `ops`, else the render is declined without a request.
+pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
+    if session.hello().error.is_none() && !session.hello().answers("render") {
+        return RenderOutcome::Declined(
+            "the candidate's hello does not list \"render\" among its ops".into(),
+        );
+    }
+    let camera = job.scene.camera(None);
+    let (width, height) = (camera.width, camera.height);
+    let scene = match serde_json::to_value(job.scene) {
+        Ok(v) => v,
+        Err(e) => return RenderOutcome::Invalid(format!("the scene cannot be sent: {e}")),
+    };
+    let start = Instant::now();
+    let deadline = start + job.time_limit;
+    let mut data = vec![[0f32; 3]; width * height];
+    let mut rows_done = 0;
+    for (k, tile) in tiles(width, height).into_iter().enumerate() {
+        let left = deadline.saturating_duration_since(Instant::now());
+        let timed_out = RenderOutcome::TimedOut {
+            limit: job.time_limit,
+            rows_done,
+            height,
+        };
+        if left.is_zero() {
+            return timed_out;
+        }
+        let request = render_request(job, &scene, tile);
+        match session.call(&format!("render-{k}"), &request, left) {
+            CallOutcome::Result(result) => {
+                if let Some(why) = result.get("declined") {
+                    let why = why.as_str().map_or_else(|| why.to_string(), str::to_string);
+                    return RenderOutcome::Declined(crate::escape::truncate(&why, 400));
+                }
+                if let Err(why) = read_tile(&result, tile, (width, height), &mut data) {
+                    return RenderOutcome::Invalid(why);
+                }
+                if tile[2] == width {
+                    rows_done = tile[3];
+                }
+            }
+            CallOutcome::Error(e) => return RenderOutcome::Raised(e),
+            CallOutcome::TimedOut => return timed_out,
+            CallOutcome::Failed(why) => {
+                if Instant::now() >= deadline {
+                    return timed_out;
+                }
+                return RenderOutcome::Invalid(why);
+            }
+        }
+    }
+    RenderOutcome::Rendered(RenderedImage {
+        width,
+        height,
+        spp: job.spp,
+        seconds: start.elapsed().as_secs_f64(),
+        data,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_the_image_once_and_fit_an_answer() {
+        for (w, h) in [(400, 225), (400, 400), (1, 1), (5000, 3), (7, 1000)] {
+            let mut seen = vec![0u8; w * h];
+            for [x0, y0, x1, y1] in tiles(w, h) {
+                assert!(x0 < x1 && y0 < y1 && x1 <= w && y1 <= h);
+                assert!((x1 - x0) * (y1 - y0) * BYTES_PER_PIXEL <= MAX_RESULT_BYTES);
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        seen[y * w + x] += 1;
+                    }
+                }
+            }
+            assert!(seen.iter().all(|&n| n == 1), "{w}x{h}");
+        }
+        assert!(tiles(0, 5).is_empty());
+    }
+
+    /// The answer of a pixel at the worst length the course adapter writes (`repr` of a float
+    /// with 17 digits and an exponent) fits the plan of [`BYTES_PER_PIXEL`].
+    #[test]
+    fn the_longest_numbers_fit_the_tile_plan() {
+        let worst = format!("{:?},", -1.2345678901234567e-300f64);
+        assert!(3 * worst.len() <= BYTES_PER_PIXEL, "{worst}");
+    }
+
+    #[test]
+    fn answers_of_the_wrong_size_or_with_nan_are_refused_naming_the_pixel() {
+        let mut data = vec![[0f32; 3]; 4];
+        let good = json!({"tile": [0, 1, 2, 2], "rgb": [0.5, 0.25, 1, 0, 0, "inf"]});
+        let e = read_tile(&good, [0, 1, 2, 2], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("pixel (1, 1) is inf"), "{e}");
+        let ok = json!({"tile": [0, 1, 2, 2], "rgb": [0.5, 0.25, 1, 0, 0, 2]});
+        read_tile(&ok, [0, 1, 2, 2], (2, 2), &mut data).unwrap();
+        assert_eq!(data[2], [0.5, 0.25, 1.0]);
+        assert_eq!(data[3], [0.0, 0.0, 2.0]);
+        let nan = json!({"tile": [0, 0, 2, 1], "rgb": [0, 0, 0, 0, "nan", 0]});
+        let e = read_tile(&nan, [0, 0, 2, 1], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("pixel (1, 0) is NaN"), "{e}");
+        let short = json!({"tile": [0, 0, 2, 1], "rgb": [0, 0, 0]});
+        let e = read_tile(&short, [0, 0, 2, 1], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("has 3 numbers, not 3 x 2"), "{e}");
+        let other = json!({"tile": [0, 0, 1, 1], "rgb": [0, 0, 0]});
+        let e = read_tile(&other, [0, 0, 2, 1], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("names another tile"), "{e}");
+        let word = json!({"tile": [0, 0, 1, 1], "rgb": [0, "x", 0]});
+        let e = read_tile(&word, [0, 0, 1, 1], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("pixel (0, 0) is not a number"), "{e}");
+        let sized = json!({"tile": [0, 0, 1, 1], "size": [2, 3], "rgb": [0, 0, 0]});
+        let e = read_tile(&sized, [0, 0, 1, 1], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("size [2,3] but the scene is 2x2"), "{e}");
+        let right = json!({"tile": [0, 0, 1, 1], "size": [2, 2], "rgb": [0, 0, 0]});
+        read_tile(&right, [0, 0, 1, 1], (2, 2), &mut data).unwrap();
+        let huge = json!({"tile": [0, 0, 1, 1], "rgb": [0, 1e300, 0]});
+        let e = read_tile(&huge, [0, 0, 1, 1], (2, 2), &mut data).unwrap_err();
+        assert!(e.contains("finite"), "{e}");
+    }
+}
