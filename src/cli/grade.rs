@@ -122,7 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .groups
         .iter()
         .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
-    let policy = rtoracle::sandbox::SandboxPolicy::grading();
+    let policy = rubric.sandbox_policy();
     let python = if runs_code {
         let python = rtoracle::candidate::python::choose(
             args.python.as_deref(),
@@ -131,6 +131,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
         rtoracle::sandbox::announce_on_stderr();
         Some(python)
+    } else {
+        None
+    };
+    // Where the code runs on the host as uids of their own (the fallback), what it must not
+    // read is made unreadable by others until grading ends.
+    let _kept = if runs_code {
+        Some(rtoracle::sandbox::keep_from_sandboxes(&private_inputs(
+            &args, &rubric,
+        ))?)
     } else {
         None
     };
@@ -221,4 +230,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         errln!("{w}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What the code graded must not read: the batch folder (the classmates' submissions), the
+/// rubric file (its seed), its scene files and goldens, the vector file.
+fn private_inputs(args: &Args, rubric: &Rubric) -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = [
+        args.batch.clone(),
+        args.rubric.clone(),
+        args.vectors.clone(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for scene in rubric.groups.iter().filter_map(|g| g.scene_file.as_ref()) {
+        paths.push(scene.path.clone());
+        paths.extend(scene.golden.as_ref().map(|g| g.path.clone()));
+    }
+    paths.retain(|p| p.exists());
+    paths
 }
