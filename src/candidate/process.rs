@@ -1048,6 +1048,14 @@ impl Session {
                 excerpt_end(&last.join(" | "))
             ));
         }
+        if let Some(hint) = self
+            .sandbox
+            .view_hint(tail)
+            .filter(|_| !self.command.course_adapter)
+        {
+            message.push_str("; ");
+            message.push_str(&hint);
+        }
         message
     }
 

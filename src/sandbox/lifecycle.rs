@@ -177,12 +177,13 @@ impl Sandbox {
             },
             reaper.clone(),
         );
+        let exposed = policy.shown.clone();
         Ok(Sandbox {
             policy,
             isolation,
             dir: Some(dir),
             switch_to,
-            exposed: Vec::new(),
+            exposed,
             view_root,
             cgroup,
             info: Mutex::new(None),
@@ -252,6 +253,43 @@ impl Sandbox {
         std::fs::write(&path, contents)?;
         std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o644))?;
         Ok(path)
+    }
+
+    /// Whether the code has a view of its own (bubblewrap's, or the fallback's where it makes a
+    /// mount namespace) that shows only some folders of the host.
+    pub fn has_view(&self) -> bool {
+        match self.isolation {
+            Isolation::Bubblewrap => true,
+            Isolation::FallbackUid => self.view_root.is_some(),
+            _ => false,
+        }
+    }
+
+    /// When a program of the sandbox failed to find a file (`stderr` says "No such file or
+    /// directory" or "not found") and the sandbox has a view: that the view shows only some
+    /// folders, which, and how to show another.
+    pub fn view_hint(&self, stderr: &str) -> Option<String> {
+        let missing = ["No such file or directory", "not found"]
+            .iter()
+            .any(|m| stderr.contains(m));
+        if !missing || !self.has_view() {
+            return None;
+        }
+        let shown: Vec<String> = self
+            .exposed
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        Some(format!(
+            "the sandbox shows only the system's folders and the folders of the files on the \
+             command line ({}): a program started from elsewhere is not there; pass \
+             --expose FOLDER to show a folder read-only",
+            if shown.is_empty() {
+                "none".to_string()
+            } else {
+                shown.join(", ")
+            }
+        ))
     }
 
     /// Records the files of the submission that were not copied in, each named (escaped) with

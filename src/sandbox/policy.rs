@@ -2,6 +2,8 @@
 //! `RTORACLE_SANDBOX` asks for ([`Mode`]), the isolation a run got ([`Isolation`]) and why a
 //! sandbox cannot be made ([`SandboxError`]).
 
+use std::path::PathBuf;
+
 use serde::{Deserialize, Serialize};
 
 /// Why a sandbox cannot be made.
@@ -104,6 +106,10 @@ pub struct SandboxPolicy {
     /// own code. Limits, the folder and the session still apply.
     #[serde(default)]
     pub unsandboxed: bool,
+    /// Folders shown read-only in the sandbox's view besides those of the files the command
+    /// line names (`check --expose FOLDER`: an adapter that starts a program from elsewhere).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shown: Vec<PathBuf>,
 }
 
 /// [`SandboxPolicy::disk_bytes`] of `check` and `fuzz` (and of reports written before it existed).
@@ -123,6 +129,7 @@ impl Default for SandboxPolicy {
             disk_bytes: default_disk_bytes(),
             isolate_network: true,
             unsandboxed: false,
+            shown: Vec::new(),
         }
     }
 }

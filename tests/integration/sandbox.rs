@@ -1444,3 +1444,79 @@ fn copy_folder(from: &Path, to: &Path) {
         }
     }
 }
+
+/// An adapter that starts a program its command line does not name (a wrapper script running
+/// `../build/tracer`) failed inside the sandbox with that program's "No such file or
+/// directory", though the file exists. The message says that the sandbox shows only the
+/// folders of the files on the command line, and `--expose FOLDER` shows another read-only.
+#[test]
+fn an_adapter_that_starts_a_program_from_elsewhere_is_told_about_expose() {
+    if !root("an_adapter_that_starts_a_program_from_elsewhere_is_told_about_expose") {
+        return;
+    }
+    let top = tempfile::tempdir().unwrap();
+    let (bin, build) = (top.path().join("bin"), top.path().join("build"));
+    std::fs::create_dir_all(&bin).unwrap();
+    std::fs::create_dir_all(&build).unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/adapters/misbehaving.py"),
+        build.join("tracer.py"),
+    )
+    .unwrap();
+    let wrapper = bin.join("run.sh");
+    std::fs::write(
+        &wrapper,
+        "#!/bin/sh\nexec /usr/bin/python3 -I \"$(dirname \"$0\")/../build/tracer.py\"\n",
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    for d in walk_dirs(top.path()) {
+        open_up(&d);
+    }
+    let vectors_dir = tempfile::tempdir().unwrap();
+    let vectors = vectors_dir.path().join("v.jsonl");
+    let made = run_in(
+        vectors_dir.path(),
+        &[
+            "vectors",
+            "--count",
+            "20",
+            "--shapes",
+            "sphere",
+            "-o",
+            vectors.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let check = |mode: &str, show: &[&Path]| {
+        let mut cmd = rtoracle();
+        cmd.current_dir(vectors_dir.path())
+            .env("RTORACLE_SANDBOX", mode)
+            .args(["check", "--adapter"])
+            .arg(&wrapper)
+            .arg("--vectors")
+            .arg(&vectors);
+        for s in show {
+            cmd.arg("--expose").arg(s);
+        }
+        let out = cmd.output().unwrap();
+        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), stderr(&out));
+        (out, text)
+    };
+    for mode in ["auto", "uid"] {
+        let (_, text) = check(mode, &[]);
+        assert!(text.contains("did not answer the hello"), "{mode}: {text}");
+        assert!(
+            text.contains("the sandbox shows only the system's folders and the folders of the files on the command line")
+                && text.contains(&bin.display().to_string())
+                && text.contains("pass --expose FOLDER to show a folder read-only"),
+            "{mode}: {text}"
+        );
+        let (out, text) = check(mode, &[&build]);
+        assert!(!text.contains("did not answer the hello"), "{mode}: {text}");
+        assert!(matches!(out.status.code(), Some(0 | 1)), "{mode}: {text}");
+    }
+    let (out, _) = check("auto", &[Path::new("/no/such/folder")]);
+    assert_bad_input(&out, "--expose /no/such/folder: no such folder");
+}
