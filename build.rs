@@ -1,12 +1,25 @@
 //! Build script.
 //!
-//! - The fixture submissions (`tests/fixtures/submissions/*/`, with the shared course modules of
-//!   `tests/fixtures/python/common`) are embedded in the library for `rtoracle bench grade`, so an
-//!   installed binary runs it without a checkout: `$OUT_DIR/fixtures.rs` lists them as
-//!   `include_bytes!`.
+//! - The fixtures (`tests/fixtures/submissions/*/`, the course modules of
+//!   `tests/fixtures/python/common`, the triangle assignment's and the `check` fixtures'
+//!   variants of `tests/fixtures/python/variants`) are embedded in the library for
+//!   `rtoracle bench grade` and `rtoracle bench candidate`, so an installed binary runs them
+//!   without a checkout: `$OUT_DIR/fixtures.rs` lists them as `include_bytes!` of paths relative
+//!   to the crate's own folder (`concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/...")`),
+//!   resolved when the crate compiles. No absolute path is written: two clones sharing one
+//!   `CARGO_TARGET_DIR` share this script's output (its `OUT_DIR`), and each must read its own
+//!   files.
 //! - One cfg, so that the tests needing the course's published images show as ignored, with the
 //!   reason, in `cargo test`'s own output when `RTORACLE_COURSE_FIXTURES` is not set (a test that
 //!   returns early would show as passed, its "skipped" line swallowed by libtest).
+
+/// The folders under `tests/fixtures/` whose `.py` and `.toml` files are embedded.
+const EMBEDDED: [&str; 4] = [
+    "submissions",
+    "python/common",
+    "python/triangle_assignment",
+    "python/variants",
+];
 
 fn main() {
     embed_fixtures();
@@ -23,7 +36,7 @@ fn embed_fixtures() {
     let root = std::path::PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").unwrap());
     let base = root.join("tests/fixtures");
     let mut files = Vec::new();
-    for top in ["submissions", "python/common", "python/triangle_assignment"] {
+    for top in EMBEDDED {
         println!("cargo::rerun-if-changed=tests/fixtures/{top}");
         collect(&base.join(top), &mut files);
     }
@@ -38,10 +51,11 @@ fn embed_fixtures() {
             .unwrap()
             .to_string_lossy()
             .replace('\\', "/");
+        // Resolved against the crate being compiled, not the folder this script ran in.
+        let include = format!("/tests/fixtures/{rel}");
         writeln!(
             code,
-            "    ({rel:?}, include_bytes!({:?})),",
-            path.display().to_string()
+            "    ({rel:?}, include_bytes!(concat!(env!(\"CARGO_MANIFEST_DIR\"), {include:?}))),"
         )
         .unwrap();
     }

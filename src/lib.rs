@@ -5,6 +5,8 @@
 //! to be checked.
 //!
 //! A short tour:
+//! - [`arithmetic`]: outward-rounded intervals, exact dyadic rationals and the exact decisions
+//!   of a ray against the three primitives, shared by the reference and the oracle.
 //! - [`geometry`]: rays, intervals, hit records and the reference primitives (sphere, quad,
 //!   watertight triangle) in `f64`, following the course's semantics.
 //! - [`scene`]: materials, the course's camera, TOML scene files and the built-in scenes.
@@ -27,6 +29,7 @@
 //!   folder, a cleared environment, limits, its own process group, no network, never as root.
 #![warn(missing_docs)]
 
+pub mod arithmetic;
 pub mod candidate;
 pub mod compare;
 pub mod escape;

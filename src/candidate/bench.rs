@@ -4,20 +4,19 @@
 //! the honest fixture. Also the wall time of the default suite, and of a submission that hangs
 //! on every miss with the default 2 s timeout.
 //!
-//! Run with `cargo bench --bench candidate` (needs python3 and this crate's test fixtures).
+//! Run with `rtoracle bench candidate` or `cargo bench --bench candidate` (needs a python3 with
+//! numpy and Pillow; the fixtures are embedded in the binary).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use super::command::CandidateCommand;
+use super::error::HarnessError;
+use super::fixtures::python_files_in;
 use super::generate::random_cases;
-use super::process::{CandidateCommand, HarnessError, RunOptions};
+use super::options::RunOptions;
 use super::rust::{Reference, check_candidate};
 use crate::oracle::vectors::ShapeKind;
-
-/// The Python fixtures of this crate (`tests/fixtures/python`), as seen at build time.
-pub fn fixture_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/python")
-}
 
 /// A Python 3 that can import the course's requirements (numpy and Pillow), which the fixtures
 /// (like the course's own `RT_utility.py`) import at module level: `$RTORACLE_PYTHON`, else the
@@ -58,28 +57,21 @@ pub fn course_python_or_skip(test: &str) -> Option<PathBuf> {
 
 /// A submission folder for the fixture `variant` (the common modules, then the variant's own
 /// `.py` files: its `RT_object.py` and any common module it replaces, as a later week's
-/// `RT_ray.py`) in a new temporary folder.
+/// `RT_ray.py`) in a new temporary folder, written from the copies embedded in the binary
+/// ([`super::fixtures`]), so it works from an installed binary.
 pub fn assemble_fixture(variant: &str) -> std::io::Result<tempfile::TempDir> {
-    let root = fixture_root();
-    let dir = tempfile::Builder::new()
-        .prefix(&format!("rtoracle-fixture-{variant}-"))
-        .tempdir()?;
-    for from in [root.join("common"), root.join("variants").join(variant)] {
-        let mut names: Vec<_> = std::fs::read_dir(&from)?
-            .flatten()
-            .map(|e| e.file_name())
-            .filter(|n| n.to_string_lossy().ends_with(".py"))
-            .collect();
-        names.sort();
-        for name in names {
-            std::fs::copy(from.join(&name), dir.path().join(&name))?;
-        }
-    }
-    if !dir.path().join("RT_object.py").is_file() {
+    let own = python_files_in(&format!("python/variants/{variant}"));
+    if !own.iter().any(|(name, _)| *name == "RT_object.py") {
         return Err(std::io::Error::new(
             std::io::ErrorKind::NotFound,
             format!("fixture {variant} has no RT_object.py"),
         ));
+    }
+    let dir = tempfile::Builder::new()
+        .prefix(&format!("rtoracle-fixture-{variant}-"))
+        .tempdir()?;
+    for (name, bytes) in python_files_in("python/common").into_iter().chain(own) {
+        std::fs::write(dir.path().join(name), bytes)?;
     }
     Ok(dir)
 }
@@ -127,14 +119,43 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration, [f64; 2]) {
     (out, t.elapsed(), [d[0] - c[0], d[1] - c[1]])
 }
 
+/// What the benchmark runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// Random cases through each candidate.
+    pub cases: usize,
+    /// Whether the default suite is run too, through the honest and the hanging submission.
+    pub suites: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            cases: 20_000,
+            suites: true,
+        }
+    }
+}
+
+impl Options {
+    /// A run of a few seconds that shows the benchmark works (1,000 cases, no suites): not a
+    /// measurement.
+    pub fn quick() -> Self {
+        Options {
+            cases: 1_000,
+            suites: false,
+        }
+    }
+}
+
 /// Runs the benchmark and returns its report (or why it could not run).
-pub fn run() -> Result<String, HarnessError> {
+pub fn run(options: Options) -> Result<String, HarnessError> {
     let io = |context: &str| {
         let context = context.to_string();
         move |reason| HarnessError::Io { context, reason }
     };
     let mut out = String::new();
-    let n = 20_000;
+    let n = options.cases;
     let cases = random_cases(11, 0, n, &[ShapeKind::Sphere, ShapeKind::Quad]);
     out.push_str(&format!(
         "{} definite random cases (spheres and quads), one process each, 2-core machine\n\n",
@@ -194,6 +215,9 @@ pub fn run() -> Result<String, HarnessError> {
             .collect::<Vec<_>>()
             .join(" ")
     ));
+    if !options.suites {
+        return Ok(out);
+    }
 
     let suite = crate::oracle::default_suite(0);
     let t = Instant::now();

@@ -14,7 +14,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::process::Outcome;
+use super::outcome::Outcome;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// How far each component of a candidate's normal may be from the expected one.

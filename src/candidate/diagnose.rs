@@ -26,7 +26,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::check::{NORMAL_TOL, Winding};
-use super::process::Outcome;
+use super::outcome::Outcome;
 use super::protocol::Answer;
 use crate::oracle::variants::{self, VHit, Variant};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};

@@ -15,9 +15,10 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_wound};
+use super::error::HarnessError;
 use super::generate::random_cases_with;
-use super::process::{HarnessError, Outcome};
-use super::report::{expected_in_words, python_repro};
+use super::outcome::Outcome;
+use super::repro::{expected_in_words, python_repro};
 use crate::oracle::Judging;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
 
@@ -227,6 +228,10 @@ impl FuzzReport {
     }
 }
 
+/// A failure found by the search, before shrinking: the case, how it failed (finely and as
+/// the check report counts it).
+type Found = (Case, FuzzKind, FailureKind);
+
 /// Runs the fuzzer with `run` as the candidate (a batch of cases in, one outcome per case out).
 pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport, HarnessError> {
     let start = Instant::now();
@@ -237,7 +242,32 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
         by_kind: Vec::new(),
         failures: Vec::new(),
     };
-    let mut found: Vec<(Case, FuzzKind, FailureKind)> = Vec::new();
+    let (found, winding) = search(run, options, &mut report, start)?;
+    report.search_seconds = start.elapsed().as_secs_f64();
+    // With a time limit T, shrinking gets a tenth of it more (at least 0.2 s, at most
+    // SHRINK_TIME), so `--time 6` ends by about 6.6 s; without one, SHRINK_TIME.
+    let shrink_time = match options.time {
+        Some(t) => (t / 10).clamp(Duration::from_millis(200), SHRINK_TIME),
+        None => SHRINK_TIME,
+    };
+    let shrink_until = Instant::now() + shrink_time;
+    for (case, detail, kind) in found {
+        let failure = shrunk(run, options, case, detail, kind, winding, shrink_until)?;
+        report.failures.push(failure);
+    }
+    Ok(report)
+}
+
+/// The search: rounds of random cases until the case count or the time is reached, counting
+/// failures into `report`; returns the first failure of each shape and kind, and the winding
+/// of the candidate's triangles.
+fn search(
+    run: &mut RunBatch<'_>,
+    options: &FuzzOptions,
+    report: &mut FuzzReport,
+    start: Instant,
+) -> Result<(Vec<Found>, Option<Winding>), HarnessError> {
+    let mut found: Vec<Found> = Vec::new();
     let mut seen: BTreeSet<(ShapeKind, FuzzKind)> = BTreeSet::new();
     let mut stream = 0u64;
     // Students' triangles are judged by their own winding, decided on the first round that hits.
@@ -293,63 +323,65 @@ pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport,
             }
         }
     }
-    report.search_seconds = start.elapsed().as_secs_f64();
-    // With a time limit T, shrinking gets a tenth of it more (at least 0.2 s, at most
-    // SHRINK_TIME), so `--time 6` ends by about 6.6 s; without one, SHRINK_TIME.
-    let shrink_time = match options.time {
-        Some(t) => (t / 10).clamp(Duration::from_millis(200), SHRINK_TIME),
-        None => SHRINK_TIME,
-    };
-    let shrink_until = Instant::now() + shrink_time;
-    for (case, detail, kind) in found {
-        // Timeouts and deaths cost a restart per try: keep them as found.
-        let keep = matches!(detail, FuzzKind::Timeout | FuzzKind::Crash);
-        let minimal = if keep || Instant::now() >= shrink_until {
-            case.clone()
-        } else {
-            let mut fails = |batch: &[Case]| -> Vec<Option<FuzzKind>> {
-                if Instant::now() >= shrink_until {
-                    return vec![None; batch.len()];
-                }
-                match run(batch) {
-                    Ok(outcomes) => batch
-                        .iter()
-                        .zip(&outcomes)
-                        .map(|(c, o)| FuzzKind::of_wound(c, o, winding))
-                        .collect(),
-                    Err(_) => vec![None; batch.len()],
-                }
-            };
-            super::shrink::shrink_with(
-                &case,
-                detail,
-                &mut fails,
-                options.shrink_budget,
-                options.judging,
-            )
+    Ok((found, winding))
+}
+
+/// One failure found, shrunk until `shrink_until` (timeouts and crashes are kept as found:
+/// each try would cost a restart), with the message of its minimal case run once more.
+fn shrunk(
+    run: &mut RunBatch<'_>,
+    options: &FuzzOptions,
+    case: Case,
+    detail: FuzzKind,
+    kind: FailureKind,
+    winding: Option<Winding>,
+    shrink_until: Instant,
+) -> Result<FuzzFailure, HarnessError> {
+    let keep = matches!(detail, FuzzKind::Timeout | FuzzKind::Crash);
+    let minimal = if keep || Instant::now() >= shrink_until {
+        case.clone()
+    } else {
+        let mut fails = |batch: &[Case]| -> Vec<Option<FuzzKind>> {
+            if Instant::now() >= shrink_until {
+                return vec![None; batch.len()];
+            }
+            match run(batch) {
+                Ok(outcomes) => batch
+                    .iter()
+                    .zip(&outcomes)
+                    .map(|(c, o)| FuzzKind::of_wound(c, o, winding))
+                    .collect(),
+                Err(_) => vec![None; batch.len()],
+            }
         };
-        let message = match run(std::slice::from_ref(&minimal))?
-            .first()
-            .map(|o| judge_wound(&minimal, o, winding))
-        {
-            Some(Verdict::Fail { message, .. }) => message,
-            _ => "failed when first run".into(),
-        };
-        report.failures.push(FuzzFailure {
-            kind,
+        super::shrink::shrink_with(
+            &case,
             detail,
-            message,
-            expected_text: expected_in_words(&minimal.expect),
-            repro: if options.course_api {
-                python_repro(&minimal)
-            } else {
-                String::new()
-            },
-            original: case,
-            minimal,
-        });
-    }
-    Ok(report)
+            &mut fails,
+            options.shrink_budget,
+            options.judging,
+        )
+    };
+    let message = match run(std::slice::from_ref(&minimal))?
+        .first()
+        .map(|o| judge_wound(&minimal, o, winding))
+    {
+        Some(Verdict::Fail { message, .. }) => message,
+        _ => "failed when first run".into(),
+    };
+    Ok(FuzzFailure {
+        kind,
+        detail,
+        message,
+        expected_text: expected_in_words(&minimal.expect),
+        repro: if options.course_api {
+            python_repro(&minimal)
+        } else {
+            String::new()
+        },
+        original: case,
+        minimal,
+    })
 }
 
 #[cfg(test)]

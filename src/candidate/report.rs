@@ -1,6 +1,7 @@
-//! The check report: counts overall and per shape group, every failure with what was asked and
-//! what was expected, the candidate's import error and the end of its stderr; JSON (serde) and
-//! text renderings.
+//! The check report's model ([`CheckReport`]): counts overall and per shape group, every
+//! failure with what was asked and what was expected, the candidate's import error and the end
+//! of its stderr, as JSON (serde); [`build_report`] judges every outcome into it. Its text is
+//! [`super::report_text`]'s.
 //!
 //! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
 //! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
@@ -9,29 +10,24 @@
 //! run and reported but never scored. `ambiguous_passed` counts the `ambiguous` vectors answered
 //! with the exact answer (so `ambiguous_passed <= ambiguous`).
 //!
-//! What the report promises about text from the candidate: every message, traceback, name and
-//! stderr line was capped by the harness when it was read ([`super::protocol`],
-//! [`super::process`]), and [`CheckReport::to_text`] writes each through
-//! [`crate::escape::terminal_line`] or [`crate::escape::terminal_text`], so nothing a candidate
-//! prints can move the cursor, colour the terminal or fake a line of the report.
+//! Every message, traceback, name and stderr line from the candidate was capped by the harness
+//! when it was read ([`super::protocol`], [`super::session`]).
 //!
-//! A failure shows the request line as sent and the expected answer in words, which any
-//! adapter author can use; a Python reproduction against the course's API only for the bundled
-//! course adapter. Vectors not run are summarised per shape and reason (`not_run_summary`), not
-//! listed one by one. When every failure is the same error (a submission that cannot be
-//! imported), the text says it once.
+//! A failure keeps the request line as sent and the expected answer in words, which any
+//! adapter author can use, and a Python reproduction against the course's API only for the
+//! bundled course adapter ([`super::repro`]). Vectors not run are summarised per shape and
+//! reason (`not_run_summary`), not listed one by one.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
 use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_exact_wound, judge_wound};
 use super::diagnose::Diagnosis;
-use super::process::Outcome;
+use super::outcome::Outcome;
 use super::protocol::{Answer, CandidateError};
-use crate::escape::{terminal_line, terminal_text};
-use crate::oracle::vectors::{Case, Class, Expect, ShapeKind, ShapeSpec};
+pub use super::repro::{expected_in_words, python_repro};
+use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
 use crate::sandbox::SandboxFacts;
 
 /// Counts of one group (or of the whole run).
@@ -279,71 +275,6 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
     }
 }
 
-/// A float as Rust prints it (shortest round trip), `inf`, `-inf` or `nan`.
-fn num(x: f64) -> String {
-    if x.is_nan() {
-        "nan".into()
-    } else if x.is_infinite() {
-        if x > 0.0 { "inf".into() } else { "-inf".into() }
-    } else {
-        format!("{x:?}")
-    }
-}
-
-/// How an expected answer is written: its numbers, its booleans, and what follows a miss and a
-/// normal (the words of any language, or Python's).
-struct Dialect {
-    number: fn(f64) -> String,
-    boolean: fn(bool) -> &'static str,
-    miss: &'static str,
-    normal_note: &'static str,
-}
-
-/// The expected answer of a vector in words, for any language.
-pub fn expected_in_words(e: &Expect) -> String {
-    expected_as(
-        e,
-        &Dialect {
-            number: num,
-            boolean: |b| if b { "true" } else { "false" },
-            miss: "a miss",
-            normal_note: " (unit, facing the ray)",
-        },
-    )
-}
-
-/// The expected answer of a vector written in `dialect`.
-fn expected_as(e: &Expect, dialect: &Dialect) -> String {
-    let number = dialect.number;
-    match e.class {
-        Class::Miss => dialect.miss.to_string(),
-        Class::Hit => {
-            let mut s = String::from("a hit");
-            if let Some(t) = e.t {
-                s.push_str(&format!(" at t = {}", number(t)));
-                if let Some(tol) = e.t_tol {
-                    s.push_str(&format!(" (+- {tol:.1e})"));
-                }
-            }
-            if let Some(n) = e.normal {
-                s.push_str(&format!(
-                    ", normal ({}, {}, {}){}",
-                    number(n[0]),
-                    number(n[1]),
-                    number(n[2]),
-                    dialect.normal_note
-                ));
-            }
-            if let Some(f) = e.front_face {
-                s.push_str(&format!(", front_face {}", (dialect.boolean)(f)));
-            }
-            s
-        }
-        Class::Ambiguous => "ambiguous (not scored)".to_string(),
-        Class::Any => "anything (not scored)".to_string(),
-    }
-}
-
 impl CheckReport {
     /// Whether no definite vector failed, raised an error or timed out (exit code 0); see
     /// [`Counts::all_passed`].
@@ -364,244 +295,6 @@ impl CheckReport {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a report always serialises")
     }
-
-    /// A summary table and the first `max_failures` failures, each with its request and
-    /// expected answer (or its Python reproduction for the course adapter). Every text from
-    /// the candidate is escaped for the terminal.
-    pub fn to_text(&self, max_failures: usize) -> String {
-        let mut s = String::new();
-        let _ = writeln!(s, "candidate: {}", terminal_line(&self.candidate));
-        if let Some(j) = &self.judged_by {
-            let _ = writeln!(s, "judged by: {j}");
-        }
-        if let Some(e) = &self.import_error {
-            let _ = writeln!(
-                s,
-                "the submission could not be imported: {}",
-                terminal_line(&e.to_string())
-            );
-            if !e.traceback.is_empty() {
-                for line in terminal_text(e.traceback.trim_end()).lines() {
-                    let _ = writeln!(s, "    {line}");
-                }
-            }
-        }
-        if let Some(f) = &self.start_failure {
-            let _ = writeln!(
-                s,
-                "the candidate could not be started: {}",
-                terminal_line(f)
-            );
-        }
-        let _ = writeln!(
-            s,
-            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
-            "shape",
-            "total",
-            "passed",
-            "failed",
-            "errors",
-            "timeouts",
-            "not_run",
-            "ambiguous",
-            "any"
-        );
-        let row = |s: &mut String, name: &str, c: &Counts| {
-            let _ = writeln!(
-                s,
-                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
-                name,
-                c.total,
-                c.passed,
-                c.failed,
-                c.errors,
-                c.timeouts,
-                c.not_run,
-                c.ambiguous,
-                c.any
-            );
-        };
-        for (kind, c) in &self.by_shape {
-            row(&mut s, kind.name(), c);
-        }
-        row(&mut s, "all", &self.counts);
-        let _ = writeln!(
-            s,
-            "\nverdict: {} ({} of {} definite vectors passed{})",
-            if self.passed() { "PASS" } else { "FAIL" },
-            self.counts.passed,
-            self.counts.total,
-            if self.counts.not_run > 0 {
-                format!(", {} not run", self.counts.not_run)
-            } else {
-                String::new()
-            }
-        );
-        for k in self.required_not_run() {
-            let _ = writeln!(
-                s,
-                "required: {k}s (--require {k}), but {} {k} vectors were not run (why: below)",
-                self.by_shape[&k].not_run
-            );
-        }
-        if let Some(w) = self.triangle_winding {
-            let _ = writeln!(s, "triangles: your triangles face {}", w.formula());
-        }
-        for d in &self.diagnosis {
-            let _ = writeln!(s, "diagnosis: {}", d.sentence());
-        }
-        if self.restarts > 0 {
-            let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
-        }
-        if let Some(note) = self.sandbox.as_ref().and_then(|f| f.note.as_ref()) {
-            let _ = writeln!(s, "sandbox: {}", terminal_line(note));
-        }
-        // Vectors not run: one line per shape and reason.
-        for n in &self.not_run_summary {
-            let _ = writeln!(
-                s,
-                "not run: {} {} vectors: {}",
-                n.count,
-                n.shape,
-                terminal_line(&n.reason)
-            );
-        }
-        let shown = &self.failures;
-        if shown.is_empty() {
-        } else if shown.len() > 1
-            && shown
-                .iter()
-                .all(|f| f.kind == shown[0].kind && f.message == shown[0].message)
-        {
-            // One cause for all (an import error): said once, with one example.
-            let f = &shown[0];
-            let _ = writeln!(
-                s,
-                "\nall {} failures are the same: [{}] {}",
-                shown.len(),
-                f.kind.name(),
-                terminal_line(&f.message)
-            );
-            if max_failures > 0 && self.import_error.is_none() {
-                let _ = writeln!(s, "for example {} ({}):", terminal_line(&f.id), f.shape);
-                self.write_case(&mut s, f);
-            }
-        } else {
-            let _ = writeln!(
-                s,
-                "\nfirst {} of {} failures:",
-                shown.len().min(max_failures),
-                shown.len()
-            );
-            for f in shown.iter().take(max_failures) {
-                self.write_failure(&mut s, f);
-            }
-        }
-        let tail = self.stderr_tail.trim_end();
-        if !tail.is_empty() {
-            let _ = writeln!(s, "\nend of the candidate's stderr:");
-            for line in tail
-                .lines()
-                .rev()
-                .take(20)
-                .collect::<Vec<_>>()
-                .into_iter()
-                .rev()
-            {
-                let _ = writeln!(s, "    {}", terminal_line(line));
-            }
-        }
-        s
-    }
-
-    fn write_failure(&self, s: &mut String, f: &Failure) {
-        let _ = writeln!(
-            s,
-            "\n[{}] {} ({}): {}",
-            f.kind.name(),
-            terminal_line(&f.id),
-            f.shape,
-            terminal_line(&f.message)
-        );
-        self.write_case(s, f);
-    }
-
-    /// A failure's tags and how to reproduce it.
-    fn write_case(&self, s: &mut String, f: &Failure) {
-        if !f.tags.is_empty() {
-            let _ = writeln!(s, "  tags: {}", terminal_line(&f.tags.join(", ")));
-        }
-        if f.repro.is_empty() {
-            let _ = writeln!(s, "  request: {}", terminal_line(&f.request));
-            let _ = writeln!(s, "  expected: {}", f.expected_text);
-        } else {
-            let _ = writeln!(s, "  reproduce (run in the submission folder):");
-            for line in f.repro.lines() {
-                let _ = writeln!(s, "    {}", terminal_line(line));
-            }
-        }
-    }
-}
-
-/// A float as a Python literal that reads back to the same bits.
-fn py(x: f64) -> String {
-    if x.is_nan() {
-        "float('nan')".into()
-    } else if x.is_infinite() {
-        if x > 0.0 {
-            "float('inf')".into()
-        } else {
-            "float('-inf')".into()
-        }
-    } else {
-        format!("{x:?}")
-    }
-}
-
-fn py3(v: [f64; 3]) -> String {
-    format!("Vec3({}, {}, {})", py(v[0]), py(v[1]), py(v[2]))
-}
-
-/// A Python snippet that reproduces `case` against the course's API: builds the object with
-/// the course's constructor, calls `intersect` and prints what it got and what it should get.
-pub fn python_repro(case: &Case) -> String {
-    let (class_name, ctor) = match case.shape {
-        ShapeSpec::Sphere { center, radius } => (
-            "Sphere",
-            format!("Sphere({}, {}, None)", py3(center), py(radius)),
-        ),
-        ShapeSpec::Quad { q, u, v } => (
-            "Quad",
-            format!("Quad({}, {}, {}, None)", py3(q), py3(u), py3(v)),
-        ),
-        ShapeSpec::Triangle { a, b, c } => (
-            "Triangle",
-            format!("Triangle({}, {}, {})", py3(a), py3(b), py3(c)),
-        ),
-    };
-    let expected = expected_as(
-        &case.expect,
-        &Dialect {
-            number: py,
-            boolean: |b| if b { "True" } else { "False" },
-            miss: "a miss (None)",
-            normal_note: "",
-        },
-    );
-    format!(
-        "from RT_utility import Vec3, Interval\n\
-         from RT_ray import Ray\n\
-         from RT_object import {class_name}\n\
-         obj = {ctor}\n\
-         ray = Ray({}, {})\n\
-         hit = obj.intersect(ray, Interval({}, {}))\n\
-         print(None if hit is None else (hit.getT(), hit.getNormal().e, hit.front_face))\n\
-         # expected: {expected}\n",
-        py3(case.ray.origin),
-        py3(case.ray.direction),
-        py(case.interval[0]),
-        py(case.interval[1]),
-    )
 }
 
 #[cfg(test)]
@@ -703,41 +396,5 @@ mod tests {
             (1, 1, 1)
         );
         assert_eq!(r.counts.total, cases.len() - 2);
-    }
-
-    #[test]
-    fn one_error_on_every_case_is_said_once_and_candidate_text_is_escaped() {
-        let cases = crate::candidate::test_cases::basic_cases();
-        let error = Answer::error("SyntaxError", "bad\x1b[31m input");
-        let outcomes: Vec<Outcome> = cases
-            .iter()
-            .map(|_| Outcome::Answered {
-                answer: error.clone(),
-                junk: vec![],
-            })
-            .collect();
-        let info = RunInfo {
-            candidate: "evil\nverdict: PASS".into(),
-            course_api: true,
-            ..RunInfo::default()
-        };
-        let text = build_report(&cases, &outcomes, info).to_text(10);
-        assert_eq!(text.matches("raised SyntaxError").count(), 1, "{text}");
-        assert_eq!(text.matches("reproduce").count(), 1, "{text}");
-        assert!(text.contains(&format!("all {} failures are the same", cases.len())));
-        assert!(
-            !text.contains('\x1b') && text.contains("\\x1b[31m"),
-            "{text}"
-        );
-        assert!(!text.contains("\nverdict: PASS"), "{text}");
-    }
-
-    #[test]
-    fn python_literals_read_back_exactly() {
-        assert_eq!(py(0.1), "0.1");
-        assert_eq!(py(4.0), "4.0");
-        assert_eq!(py(f64::MAX), "1.7976931348623157e308");
-        assert_eq!(py(1e-6), "1e-6");
-        assert_eq!(py(f64::NEG_INFINITY), "float('-inf')");
     }
 }

@@ -33,7 +33,7 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use super::process::Outcome;
+use super::outcome::Outcome;
 use super::protocol::Answer;
 use super::report::{CheckReport, RunInfo, build_report};
 use crate::geometry::{Interval, Shape};

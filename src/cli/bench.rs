@@ -34,7 +34,12 @@ enum Area {
     },
     /// Checking candidates: vectors per second through the Python adapter against the in-process
     /// reference and an echo adapter.
-    Candidate,
+    Candidate {
+        /// A run of a few seconds (1000 cases, no suites) that shows the benchmark works; not a
+        /// measurement.
+        #[arg(long)]
+        quick: bool,
+    },
     /// The image comparison: one 400x400 comparison and the whole command, against a plain
     /// per-pixel difference.
     Compare,
@@ -55,8 +60,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             out!("{}", rtoracle::oracle::bench::run(opts))?;
             Ok(ExitCode::SUCCESS)
         }
-        Area::Candidate => {
-            out!("{}", rtoracle::candidate::bench::run()?)?;
+        Area::Candidate { quick } => {
+            let options = if quick {
+                rtoracle::candidate::bench::Options::quick()
+            } else {
+                rtoracle::candidate::bench::Options::default()
+            };
+            out!("{}", rtoracle::candidate::bench::run(options)?)?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Compare => {

@@ -1,6 +1,7 @@
 use glam::DVec3;
 
 use super::{HitRecord, Interval, Ray, Shape, unit_vector};
+use crate::arithmetic::{Decision, Dyadic, Iv, Line, PlaneKind, plane_decide};
 
 /// The relative error bound of an edge function, generous (2^-48; the rounding unit is 2^-53).
 const EDGE_ERROR: f64 = 3.552713678800501e-15;
@@ -154,11 +155,9 @@ impl Triangle {
     }
 
     /// Whether the ray's line meets the closed triangle, decided exactly (big integers behind
-    /// an interval filter, see [`crate::oracle::exact`]).
+    /// an interval filter, see [`crate::arithmetic`]).
     #[cold]
     fn inside_exactly(&self, ray: &Ray) -> bool {
-        use crate::oracle::band::Iv;
-        use crate::oracle::exact::{Dyadic, plane_decide};
         let finite = |v: DVec3| super::is_finite(v);
         let all_finite = [self.a, self.b, self.c, ray.origin, ray.direction]
             .into_iter()
@@ -166,15 +165,15 @@ impl Triangle {
         if !all_finite {
             return false;
         }
-        let spec = crate::oracle::vectors::RaySpec {
+        let line = Line {
             origin: ray.origin.to_array(),
             direction: ray.direction.to_array(),
         };
         let all = [f64::NEG_INFINITY, f64::INFINITY];
         let (a, b, c) = (self.a.to_array(), self.b.to_array(), self.c.to_array());
-        let decided = plane_decide::<Iv>(a, b, c, true, &spec, all)
-            .or_else(|| plane_decide::<Dyadic>(a, b, c, true, &spec, all));
-        matches!(decided, Some((crate::oracle::exact::Decision::PlaneHit, _)))
+        let decided = plane_decide::<Iv>(a, b, c, PlaneKind::Triangle, &line, all)
+            .or_else(|| plane_decide::<Dyadic>(a, b, c, PlaneKind::Triangle, &line, all));
+        matches!(decided, Some((Decision::PlaneHit, _)))
     }
 }
 

@@ -40,7 +40,7 @@ struct FixtureImage {
     encoding: Option<String>,
 }
 
-include!(concat!(env!("OUT_DIR"), "/fixtures.rs"));
+use crate::candidate::fixtures::FIXTURE_FILES;
 
 /// The embedded fixture file at `rel` (under `tests/fixtures/`).
 fn embedded(rel: &str) -> Option<&'static [u8]> {

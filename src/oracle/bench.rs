@@ -160,6 +160,14 @@ fn cpu_seconds() -> f64 {
 pub fn run(opts: Options) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "rtoracle bench oracle (seed {})", opts.seed);
+    agreement_section(&mut s, opts);
+    silhouette_section(&mut s, opts);
+    speed_section(&mut s, opts.seed);
+    s
+}
+
+/// Section 1: the reference against the exact oracle, per shape.
+fn agreement_section(s: &mut String, opts: Options) {
     let _ = writeln!(
         s,
         "\n1. reference vs exact on random cases (scales 2^-20..2^20, spheres seen from up to 1e8 radii)"
@@ -190,6 +198,10 @@ pub fn run(opts: Options) -> String {
             a.naive_wrong
         );
     }
+}
+
+/// Section 2: wrong decisions of the naive formula and the reference near far silhouettes.
+fn silhouette_section(s: &mut String, opts: Options) {
     let _ = writeln!(
         s,
         "\n2. wrong decisions on near-silhouette rays (aimed 0.9..1.1 radii from the centre), against the exact answer"
@@ -210,9 +222,11 @@ pub fn run(opts: Options) -> String {
             100.0 * rw
         );
     }
-    // 3. Per judging: classification rate against the naive course formula on the same
-    // vectors, and the default suite's generation time.
-    let variants = honest();
+}
+
+/// Section 3: per judging, the classification rate against the naive course formula on the
+/// same vectors, and the default suite's generation time.
+fn speed_section(s: &mut String, seed: u64) {
     let _ = writeln!(
         s,
         "\n3. speed (one thread, in CPU seconds of this thread, so a loaded machine does not skew it), per judging"
@@ -222,53 +236,22 @@ pub fn run(opts: Options) -> String {
         "   {:<11} {:>16} {:>18} {:>7} {:>14} {:>9}",
         "judging", "classify vec/s", "naive formula /s", "ratio", "suite gen (s)", "definite"
     );
-    let (mut n_hit, mut n_naive) = (0usize, 0usize);
     for judging in [
         Judging::COURSE,
         Judging::ROBUST,
         Judging::new(Profile::Course, Precision::F32),
         Judging::new(Profile::Robust, Precision::F32),
     ] {
-        let t0 = cpu_seconds();
-        let suite = default_suite_with(opts.seed, judging);
-        let gen_s = cpu_seconds() - t0;
-        let passes = 3;
-        let t0 = cpu_seconds();
-        for _ in 0..passes {
-            for c in &suite {
-                n_hit += usize::from(
-                    classify_with(&c.shape, &c.ray, c.interval, judging).class == Class::Hit,
-                );
-            }
-        }
-        let classify_s = cpu_seconds() - t0;
-        let t0 = cpu_seconds();
-        for _ in 0..passes {
-            for c in &suite {
-                let v = variants
-                    .iter()
-                    .find(|v| v.shape == c.shape.kind())
-                    .expect("variant");
-                n_naive +=
-                    usize::from(matches!((v.run)(&c.shape, &c.ray, c.interval), Ok(Some(_))));
-            }
-        }
-        let naive_s = (cpu_seconds() - t0).max(1e-9);
-        let rate = (passes * suite.len()) as f64 / classify_s;
-        let naive_rate = (passes * suite.len()) as f64 / naive_s;
-        let definite = suite
-            .iter()
-            .filter(|c| c.expect.class.is_definite())
-            .count();
+        let row = speed(seed, judging);
         let _ = writeln!(
             s,
             "   {:<11} {:>16.0} {:>18.0} {:>6.1}x {:>14.3} {:>9}",
             judging.to_string(),
-            rate,
-            naive_rate,
-            naive_rate / rate,
-            gen_s,
-            definite
+            row.classify_rate,
+            row.naive_rate,
+            row.naive_rate / row.classify_rate,
+            row.generate_seconds,
+            row.definite
         );
     }
     let _ = writeln!(
@@ -276,6 +259,58 @@ pub fn run(opts: Options) -> String {
         "   (classify: vectors/s over the {} vectors of the default suite; ratio: how many times faster the naive course formula alone runs; suite gen: the default suite generated and classified)",
         super::suite::DEFAULT_COUNT
     );
-    let _ = (n_hit, n_naive);
-    s
+}
+
+/// One row of the speed section.
+struct SpeedRow {
+    /// Vectors classified per CPU second.
+    classify_rate: f64,
+    /// Vectors the naive course formula runs per CPU second.
+    naive_rate: f64,
+    /// CPU seconds to generate and classify the default suite.
+    generate_seconds: f64,
+    /// Definite vectors in the suite.
+    definite: usize,
+}
+
+/// Generates the default suite under `judging`, then times classifying it and running the naive
+/// course formula on it (three passes each).
+fn speed(seed: u64, judging: Judging) -> SpeedRow {
+    let variants = honest();
+    let t0 = cpu_seconds();
+    let suite = default_suite_with(seed, judging);
+    let generate_seconds = cpu_seconds() - t0;
+    let passes = 3;
+    let (mut n_hit, mut n_naive) = (0usize, 0usize);
+    let t0 = cpu_seconds();
+    for _ in 0..passes {
+        for c in &suite {
+            n_hit += usize::from(
+                classify_with(&c.shape, &c.ray, c.interval, judging).class == Class::Hit,
+            );
+        }
+    }
+    let classify_s = cpu_seconds() - t0;
+    let t0 = cpu_seconds();
+    for _ in 0..passes {
+        for c in &suite {
+            let v = variants
+                .iter()
+                .find(|v| v.shape == c.shape.kind())
+                .expect("variant");
+            n_naive += usize::from(matches!((v.run)(&c.shape, &c.ray, c.interval), Ok(Some(_))));
+        }
+    }
+    let naive_s = (cpu_seconds() - t0).max(1e-9);
+    // The counts keep the timed loops from being optimised away.
+    std::hint::black_box((n_hit, n_naive));
+    SpeedRow {
+        classify_rate: (passes * suite.len()) as f64 / classify_s,
+        naive_rate: (passes * suite.len()) as f64 / naive_s,
+        generate_seconds,
+        definite: suite
+            .iter()
+            .filter(|c| c.expect.class.is_definite())
+            .count(),
+    }
 }

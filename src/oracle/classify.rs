@@ -486,7 +486,7 @@ fn normal_check<B: Band>(
     if worst <= tol {
         (true, None)
     } else {
-        tags.push(judging.ill_conditioned_tag().into());
+        tags.push(super::tags::ill_conditioned(judging).into());
         (
             false,
             Some(format!(
@@ -529,41 +529,77 @@ fn plane<B: Band>(
     interval: [f64; 2],
     ctx: Ctx,
 ) -> Analysis {
-    let (decision, by_filter) = (ctx.decision, ctx.by_filter);
     if s.parallel {
-        // Exactly parallel and off the plane (in the plane is degenerate, handled before). It is
-        // a definite miss when the course's f64 denominator `unit(n) . d` is surely below the
-        // 1e-8 threshold; with large or skewed inputs the rounded unit normal is not exactly
-        // perpendicular to d, honest code computes a t, and the case is ambiguous.
-        let check = Check::new(
-            "1e-8 - |unit(n) . d| > 0 (parallel)",
-            "grazing",
-            end::<B>(PARALLEL_EPSILON) - b.denom.abs(),
-            true,
-        );
-        let definite = check.definite;
-        return Analysis {
-            decision: Some(decision),
-            by_filter,
-            hit: None,
-            checks: vec![check],
-            class: if definite {
-                Class::Miss
-            } else {
-                Class::Ambiguous
-            },
-            tags: if definite {
-                vec!["parallel".into()]
-            } else {
-                vec!["grazing".into(), "parallel".into()]
-            },
-            t_tol: None,
-            why: (!definite).then(|| {
-                format!("the ray is exactly parallel to the plane, but the rounded unit normal of {} is not exactly perpendicular to d, so honest code may compute a t", formulas(ctx.judging))
-            }),
-            judging: ctx.judging,
-        };
+        return parallel_plane::<B>(b, ctx);
     }
+    let checks = plane_checks::<B>(triangle, &b, &s, interval);
+    let geometric_hit = checks.iter().all(|c| c.passes);
+    let mut tags = vec![];
+    let mut why = None;
+    let definite = if geometric_hit {
+        match shallow_hit(&b, &s, ray) {
+            Some((tag, words)) => {
+                tags.push(tag.to_string());
+                why = Some(words);
+                false
+            }
+            None => checks.iter().all(|c| c.definite),
+        }
+    } else {
+        checks.iter().any(|c| !c.passes && c.definite)
+    };
+    // Edge ambiguity on two edges at once is a corner.
+    let edge_amb = checks[2..].iter().filter(|c| !c.definite).count();
+    if !definite && edge_amb >= 2 {
+        tags.push("corner".into());
+    }
+    finish(ctx, checks, definite, tags, Some(b.t), why)
+}
+
+/// A ray exactly parallel to the plane and off it (in the plane is degenerate, handled before).
+/// It is a definite miss when the course's `f64` denominator `unit(n) . d` is surely below the
+/// 1e-8 threshold; with large or skewed inputs the rounded unit normal is not exactly
+/// perpendicular to d, honest code computes a t, and the case is ambiguous.
+fn parallel_plane<B: Band>(b: PlaneBands, ctx: Ctx) -> Analysis {
+    let check = Check::new(
+        "1e-8 - |unit(n) . d| > 0 (parallel)",
+        "grazing",
+        end::<B>(PARALLEL_EPSILON) - b.denom.abs(),
+        true,
+    );
+    let definite = check.definite;
+    Analysis {
+        decision: Some(ctx.decision),
+        by_filter: ctx.by_filter,
+        hit: None,
+        checks: vec![check],
+        class: if definite {
+            Class::Miss
+        } else {
+            Class::Ambiguous
+        },
+        tags: if definite {
+            vec!["parallel".into()]
+        } else {
+            vec!["grazing".into(), "parallel".into()]
+        },
+        t_tol: None,
+        why: (!definite).then(|| {
+            format!("the ray is exactly parallel to the plane, but the rounded unit normal of {} is not exactly perpendicular to d, so honest code may compute a t", formulas(ctx.judging))
+        }),
+        judging: ctx.judging,
+    }
+}
+
+/// The comparisons on the course's path to a plane decision: the two interval ends first, then
+/// the edges (a quad's `alpha`, `1 - alpha`, `beta`, `1 - beta`; a triangle's three
+/// barycentrics).
+fn plane_checks<B: Band>(
+    triangle: bool,
+    b: &PlaneBands,
+    s: &PlaneSigns,
+    interval: [f64; 2],
+) -> Vec<Check> {
     let (tmin, tmax) = (end::<B>(interval[0]), end::<B>(interval[1]));
     let one = Iv::point(1.0);
     let mut checks = vec![
@@ -622,53 +658,43 @@ fn plane<B: Band>(
             c.definite = true;
         }
     }
-    let geometric_hit = checks.iter().all(|c| c.passes);
-    let fails_definitely = checks.iter().any(|c| !c.passes && c.definite);
+    checks
+}
+
+/// Why a ray that meets the primitive is still not a definite hit because of its angle to the
+/// plane: the tag and the words, or `None` when the angle does not matter.
+fn shallow_hit(b: &PlaneBands, s: &PlaneSigns, ray: &RaySpec) -> Option<(&'static str, String)> {
     let dir: B3<Iv> = b3(ray.direction);
     let len_d = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
     let denom = b.denom.abs();
     let near_threshold = denom.lo < PARALLEL_EPSILON * (1.0 + 1e-6);
     let shallow = denom.lo < 1e-6 * len_d.hi;
-    let mut tags = vec![];
-    let mut why = None;
-    let definite = if geometric_hit {
-        let all = checks.iter().all(|c| c.definite);
-        if s.below_threshold || near_threshold {
-            // The course's absolute threshold on |unit(n) . d| decides, or may.
-            tags.push("parallel-threshold".to_string());
-            why = Some(if s.below_threshold {
-                format!(
-                    "the ray meets the primitive, but exactly |unit(n) . d| < 1e-8 (its band is [{:e}, {:e}]): the course's absolute parallel threshold rejects it, so the exact answer is a miss; code that tests only denom == 0 hits, so it is not scored",
-                    denom.lo, denom.hi
-                )
-            } else {
-                format!(
-                    "the ray meets the primitive, but |unit(n) . d| is in [{:e}, {:e}], within rounding of the course's absolute parallel threshold 1e-8, so honest code may reject it",
-                    denom.lo, denom.hi
-                )
-            });
-            false
-        } else if shallow {
-            tags.push("grazing".to_string());
-            why = Some(format!(
+    if s.below_threshold || near_threshold {
+        // The course's absolute threshold on |unit(n) . d| decides, or may.
+        let words = if s.below_threshold {
+            format!(
+                "the ray meets the primitive, but exactly |unit(n) . d| < 1e-8 (its band is [{:e}, {:e}]): the course's absolute parallel threshold rejects it, so the exact answer is a miss; code that tests only denom == 0 hits, so it is not scored",
+                denom.lo, denom.hi
+            )
+        } else {
+            format!(
+                "the ray meets the primitive, but |unit(n) . d| is in [{:e}, {:e}], within rounding of the course's absolute parallel threshold 1e-8, so honest code may reject it",
+                denom.lo, denom.hi
+            )
+        };
+        Some(("parallel-threshold", words))
+    } else if shallow {
+        Some((
+            "grazing",
+            format!(
                 "the ray is nearly parallel to the plane: |unit(n) . d| / |d| is in [{:e}, {:e}], below 1e-6, where code that normalises d or scales the threshold differs",
                 denom.lo / len_d.hi,
                 denom.hi / len_d.lo
-            ));
-            false
-        } else {
-            all
-        }
+            ),
+        ))
     } else {
-        fails_definitely
-    };
-    // Edge ambiguity on two edges at once is a corner.
-    let edge_amb = checks[2..].iter().filter(|c| !c.definite).count();
-    if !definite && edge_amb >= 2 {
-        tags.push("corner".into());
+        None
     }
-    let _ = (triangle, decision, by_filter);
-    finish(ctx, checks, definite, tags, Some(b.t), why)
 }
 
 #[cfg(test)]

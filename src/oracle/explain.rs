@@ -102,8 +102,7 @@ pub fn explain_with(case: &Case, judging: Judging) -> String {
     );
     match case.shape {
         ShapeSpec::Sphere { center, radius } => sphere(&mut s, center, radius, r, iv, &a),
-        ShapeSpec::Quad { q, u, v } => plane(&mut s, q, u, v, false, r, iv, &a),
-        ShapeSpec::Triangle { a: p, b, c } => plane(&mut s, p, b, c, true, r, iv, &a),
+        ShapeSpec::Quad { .. } | ShapeSpec::Triangle { .. } => plane(&mut s, &case.shape, r, iv),
     }
     let _ = writeln!(s);
     answer(&mut s, &a);
@@ -178,17 +177,13 @@ fn sphere(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn plane(
-    s: &mut String,
-    q: [f64; 3],
-    u: [f64; 3],
-    v: [f64; 3],
-    triangle: bool,
-    ray: &RaySpec,
-    _iv: [f64; 2],
-    _a: &Analysis,
-) {
+/// The exact quantities of a quad or triangle case, from its normal to the signs that decide it.
+fn plane(s: &mut String, shape: &ShapeSpec, ray: &RaySpec, iv: [f64; 2]) {
+    let (q, u, v, triangle) = match *shape {
+        ShapeSpec::Quad { q, u, v } => (q, u, v, false),
+        ShapeSpec::Triangle { a, b, c } => (a, b, c, true),
+        ShapeSpec::Sphere { .. } => return,
+    };
     let ex = exact::plane_exact(q, u, v, triangle, ray);
     let edges = if triangle {
         "(b - a) x (c - a)"
@@ -205,46 +200,57 @@ fn plane(
         return;
     }
     let _ = writeln!(s, "  n.d = {}: {}", show(&ex.nd), sign_word(ex.nd.signum()));
-    if !ex.nd.is_zero() {
-        // Exact quantities shown rounded: |unit(n).d| = |n.d| / |n|, and its ratio to |d|.
-        let nn = ex.n[0]
-            .mul(&ex.n[0])
-            .add(&ex.n[1].mul(&ex.n[1]))
-            .add(&ex.n[2].mul(&ex.n[2]));
-        let eps = Dyadic::from_f64(crate::geometry::PARALLEL_EPSILON).expect("finite");
-        let dd: f64 = ray.direction.iter().map(|x| x * x).sum();
-        let nd = ex.nd.to_f64().abs();
-        let len_n = nn.to_f64().sqrt();
-        let denom = nd / len_n;
-        let ratio = denom / dd.sqrt();
-        let _ = writeln!(
-            s,
-            "  |unit(n).d| = ~{denom:e}: {} the course's absolute parallel threshold 1e-8",
-            if ex.nd.mul(&ex.nd).cmp_value(&nn.mul(&eps.mul(&eps))) == Ordering::Less {
-                "below"
-            } else {
-                "not below"
-            }
-        );
-        let _ = writeln!(
-            s,
-            "  |unit(n).d| / |d| = ~{ratio:e} (the cosine between the ray and the normal; a hit with this below 1e-6 is not scored, grazing means <= 2^-10)"
-        );
-    }
     if ex.nd.is_zero() {
-        if ex.tn.is_zero() {
-            let _ = writeln!(
+        let _ = if ex.tn.is_zero() {
+            writeln!(
                 s,
                 "  n.d = 0 and O lies in the plane: the ray runs inside the plane (degenerate)."
-            );
+            )
         } else {
-            let _ = writeln!(
+            writeln!(
                 s,
                 "  n.d = 0 and O is off the plane: the ray is parallel to it and never meets it."
-            );
-        }
+            )
+        };
         return;
     }
+    plane_angle(s, &ex, ray);
+    plane_coordinates(s, &ex, triangle);
+    if let Some(sg) = exact::plane_signs(shape, ray, iv) {
+        plane_signs(s, &sg, triangle);
+    }
+}
+
+/// The angle between the ray and a plane it is not parallel to, against the course's threshold.
+fn plane_angle(s: &mut String, ex: &exact::PlaneExact, ray: &RaySpec) {
+    // Exact quantities shown rounded: |unit(n).d| = |n.d| / |n|, and its ratio to |d|.
+    let nn = ex.n[0]
+        .mul(&ex.n[0])
+        .add(&ex.n[1].mul(&ex.n[1]))
+        .add(&ex.n[2].mul(&ex.n[2]));
+    let eps = Dyadic::from_f64(crate::geometry::PARALLEL_EPSILON).expect("finite");
+    let dd: f64 = ray.direction.iter().map(|x| x * x).sum();
+    let nd = ex.nd.to_f64().abs();
+    let len_n = nn.to_f64().sqrt();
+    let denom = nd / len_n;
+    let ratio = denom / dd.sqrt();
+    let _ = writeln!(
+        s,
+        "  |unit(n).d| = ~{denom:e}: {} the course's absolute parallel threshold 1e-8",
+        if ex.nd.mul(&ex.nd).cmp_value(&nn.mul(&eps.mul(&eps))) == Ordering::Less {
+            "below"
+        } else {
+            "not below"
+        }
+    );
+    let _ = writeln!(
+        s,
+        "  |unit(n).d| / |d| = ~{ratio:e} (the cosine between the ray and the normal; a hit with this below 1e-6 is not scored, grazing means <= 2^-10)"
+    );
+}
+
+/// The hit parameter and the surface coordinates of the line's hit with the plane.
+fn plane_coordinates(s: &mut String, ex: &exact::PlaneExact, triangle: bool) {
     let tq = if triangle { "a" } else { "Q" };
     let _ = writeln!(
         s,
@@ -276,41 +282,35 @@ fn plane(
             "  (a hit needs alpha, beta in [0, 1], t in the closed interval, and |unit(n).d| >= 1e-8)"
         );
     }
-    if let Some(sg) = exact::plane_signs(&plane_spec(q, u, v, triangle), ray, _iv) {
-        let yes = |b: bool| if b { "yes" } else { "NO" };
-        let (e1, e2, e3) = if triangle {
-            ("beta_b >= 0", "beta_c >= 0", "beta_b + beta_c <= 1")
-        } else {
-            ("alpha >= 0", "beta >= 0", "alpha <= 1")
-        };
-        let _ = writeln!(
-            s,
-            "  exactly: t >= t_min {}, t <= t_max {}, {e1} {}, {e2} {}, {e3} {}{}",
-            yes(sg.after_min),
-            yes(sg.before_max),
-            yes(sg.alpha_ge_0),
-            yes(sg.beta_ge_0),
-            yes(sg.alpha_le_1),
-            if triangle {
-                String::new()
-            } else {
-                format!(", beta <= 1 {}", yes(sg.beta_le_1))
-            }
-        );
-        if sg.below_threshold {
-            let _ = writeln!(
-                s,
-                "  exactly |unit(n).d| < 1e-8: the course calls the ray parallel (a miss), whatever |d| is."
-            );
-        }
-    }
 }
 
-fn plane_spec(q: [f64; 3], u: [f64; 3], v: [f64; 3], triangle: bool) -> ShapeSpec {
-    if triangle {
-        ShapeSpec::Triangle { a: q, b: u, c: v }
+/// The exact signs of the comparisons that decide a plane case.
+fn plane_signs(s: &mut String, sg: &exact::PlaneSigns, triangle: bool) {
+    let yes = |b: bool| if b { "yes" } else { "NO" };
+    let (e1, e2, e3) = if triangle {
+        ("beta_b >= 0", "beta_c >= 0", "beta_b + beta_c <= 1")
     } else {
-        ShapeSpec::Quad { q, u, v }
+        ("alpha >= 0", "beta >= 0", "alpha <= 1")
+    };
+    let _ = writeln!(
+        s,
+        "  exactly: t >= t_min {}, t <= t_max {}, {e1} {}, {e2} {}, {e3} {}{}",
+        yes(sg.after_min),
+        yes(sg.before_max),
+        yes(sg.alpha_ge_0),
+        yes(sg.beta_ge_0),
+        yes(sg.alpha_le_1),
+        if triangle {
+            String::new()
+        } else {
+            format!(", beta <= 1 {}", yes(sg.beta_le_1))
+        }
+    );
+    if sg.below_threshold {
+        let _ = writeln!(
+            s,
+            "  exactly |unit(n).d| < 1e-8: the course calls the ray parallel (a miss), whatever |d| is."
+        );
     }
 }
 

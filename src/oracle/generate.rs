@@ -493,120 +493,27 @@ fn edge_coords(r: &mut Stream, triangle: bool, corner: bool) -> (f64, f64) {
     }
 }
 
+/// `Q + a u + b v`.
+fn surface_point(q: [f64; 3], u: [f64; 3], v: [f64; 3], a: f64, b: f64) -> [f64; 3] {
+    add(q, add(scale(u, a), scale(v, b)))
+}
+
+/// A random dyadic `k / 64` with `k` in `lo..=hi`.
+fn sixty_fourths(r: &mut Stream, lo: i64, hi: i64) -> f64 {
+    r.int(lo, hi) as f64 / 64.0
+}
+
+/// One case of a quad or triangle category (`i` is the case's index in its category).
 fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
     match cat {
-        "edge" | "corner" => {
-            let (q, u, v, d) = int_quad(r, 8);
-            let (a, b) = edge_coords(r, triangle, cat == "corner");
-            let p = add(q, add(scale(u, a), scale(v, b)));
-            let t = r.pow2(0, 4);
-            let mut o = sub(p, scale(d, t));
-            if i % 2 == 1 {
-                // Just inside or outside by 2^j ulps.
-                let j = r.int(0, 40);
-                let axis = r.int(0, 2) as usize;
-                o[axis] = nudge(o[axis], if r.coin() { 1 << j } else { -(1 << j) });
-            }
-            let tag = if cat == "edge" { "edge" } else { "corner" };
-            raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &[tag])
-        }
-        "skewed" | "skinny" => {
-            let (q, mut u, mut v, d) = int_quad(r, 8);
-            if cat == "skewed" {
-                // v nearly along u: a thin parallelogram leaning far over.
-                v = add(scale(u, r.int(2, 16) as f64), scale(v, r.pow2(-6, -1)));
-            } else {
-                u = scale(u, r.pow2(4, 8));
-                v = scale(v, r.pow2(-8, -4));
-            }
-            let n = cross(u, v);
-            let nd = dot(n, d);
-            let d = if nd * nd < 0.01 * dot(n, n) * dot(d, d) {
-                n
-            } else {
-                d
-            };
-            let (a, b) = (r.int(-16, 80) as f64 / 64.0, r.int(-16, 80) as f64 / 64.0);
-            let p = add(q, add(scale(u, a), scale(v, b)));
-            let o = sub(p, scale(d, r.pow2(0, 4)));
-            let tag = if cat == "skewed" { "skewed" } else { "skinny" };
-            raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &[tag])
-        }
-        "parallel" => {
-            let (q, u, v, _) = int_quad(r, 8);
-            let n = cross(u, v);
-            let (a, b) = (r.int(-4, 4) as f64, r.int(1, 4) as f64);
-            let d = add(scale(u, a), scale(v, b));
-            let p = add(
-                q,
-                add(
-                    scale(u, r.int(0, 64) as f64 / 64.0),
-                    scale(v, r.int(0, 64) as f64 / 64.0),
-                ),
-            );
-            let lift = if i % 4 == 3 {
-                0.0
-            } else {
-                r.int(-4, 4) as f64 * r.pow2(-10, 0)
-            };
-            let lift = if lift == 0.0 && i % 4 != 3 { 1.0 } else { lift };
-            let o = sub(add(p, scale(n, lift)), scale(d, r.int(1, 4) as f64));
-            raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["parallel"])
-        }
-        "grazing" => {
-            let (q, u, v, _) = int_quad(r, 8);
-            let n = cross(u, v);
-            let j = r.int(5, 60);
-            let d = add(
-                add(scale(u, r.int(-4, 4) as f64), scale(v, r.int(1, 4) as f64)),
-                scale(n, pow2(-j)),
-            );
-            let p = add(
-                q,
-                add(
-                    scale(u, r.int(8, 24) as f64 / 64.0),
-                    scale(v, r.int(8, 24) as f64 / 64.0),
-                ),
-            );
-            let o = sub(p, scale(d, r.pow2(0, 3)));
-            raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["grazing"])
-        }
-        "interval-boundary" => {
-            let (q, u, v, d) = int_quad(r, 8);
-            let p = add(
-                q,
-                add(
-                    scale(u, r.int(8, 24) as f64 / 64.0),
-                    scale(v, r.int(8, 24) as f64 / 64.0),
-                ),
-            );
-            let t = r.pow2(0, 5);
-            let o = sub(p, scale(d, t));
-            let step = 1i64 << r.int(0, 40);
-            let interval = match i % 5 {
-                0 => [t, f64::MAX],
-                1 => [1e-6, t],
-                2 => [nudge(t, if r.coin() { step } else { -step }), f64::MAX],
-                3 => [1e-6, nudge(t, if r.coin() { step } else { -step })],
-                _ => [t, t],
-            };
-            raw(
-                plane_shape(triangle, q, u, v),
-                o,
-                d,
-                interval,
-                &["interval-boundary"],
-            )
-        }
+        "edge" | "corner" => edge_case(triangle, cat == "corner", r, i),
+        "skewed" | "skinny" => lean_case(triangle, cat == "skewed", r),
+        "parallel" => parallel_case(triangle, r, i),
+        "grazing" => grazing_case(triangle, r),
+        "interval-boundary" => plane_interval_case(triangle, r, i),
         "behind" => {
             let (q, u, v, d) = int_quad(r, 8);
-            let p = add(
-                q,
-                add(
-                    scale(u, r.int(0, 64) as f64 / 64.0),
-                    scale(v, r.int(0, 32) as f64 / 64.0),
-                ),
-            );
+            let p = surface_point(q, u, v, sixty_fourths(r, 0, 64), sixty_fourths(r, 0, 32));
             let o = add(p, scale(d, r.pow2(0, 4)));
             raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["behind"])
         }
@@ -627,29 +534,129 @@ fn plane_case(cat: &str, triangle: bool, r: &mut Stream, i: usize) -> Raw {
             c.tags = vec!["unnormalised"];
             c
         }
-        "degenerate" => {
-            let (q, u, _, d) = int_quad(r, 8);
-            let v = match i % 3 {
-                0 => scale(u, r.int(-3, 3) as f64),
-                1 => [0.0; 3],
-                _ => scale(u, 0.5),
-            };
-            let o = sub(q, scale(d, 2.0));
-            let d = if i % 5 == 4 { [0.0; 3] } else { d };
-            raw(
-                plane_shape(triangle, q, u, v),
-                o,
-                d,
-                CAMERA,
-                &["degenerate"],
-            )
-        }
+        "degenerate" => degenerate_plane_case(triangle, r, i),
         "nonfinite" => {
             let c = random_plane(r, triangle);
             poison(r, &c)
         }
         _ => random_plane(r, triangle),
     }
+}
+
+/// A ray through an edge or a corner (a vertex), exactly or, for odd `i`, off it by `2^j` ulps.
+fn edge_case(triangle: bool, corner: bool, r: &mut Stream, i: usize) -> Raw {
+    let (q, u, v, d) = int_quad(r, 8);
+    let (a, b) = edge_coords(r, triangle, corner);
+    let p = surface_point(q, u, v, a, b);
+    let t = r.pow2(0, 4);
+    let mut o = sub(p, scale(d, t));
+    if i % 2 == 1 {
+        // Just inside or outside by 2^j ulps.
+        let j = r.int(0, 40);
+        let axis = r.int(0, 2) as usize;
+        o[axis] = nudge(o[axis], if r.coin() { 1 << j } else { -(1 << j) });
+    }
+    let tag = if corner { "corner" } else { "edge" };
+    raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &[tag])
+}
+
+/// A skewed primitive (`v` nearly along `u`, `skewed`) or a skinny one (one edge at least 16
+/// times the other), hit or missed near its surface.
+fn lean_case(triangle: bool, skewed: bool, r: &mut Stream) -> Raw {
+    let (q, mut u, mut v, d) = int_quad(r, 8);
+    if skewed {
+        // v nearly along u: a thin parallelogram leaning far over.
+        v = add(scale(u, r.int(2, 16) as f64), scale(v, r.pow2(-6, -1)));
+    } else {
+        u = scale(u, r.pow2(4, 8));
+        v = scale(v, r.pow2(-8, -4));
+    }
+    let n = cross(u, v);
+    let nd = dot(n, d);
+    let d = if nd * nd < 0.01 * dot(n, n) * dot(d, d) {
+        n
+    } else {
+        d
+    };
+    let (a, b) = (sixty_fourths(r, -16, 80), sixty_fourths(r, -16, 80));
+    let p = surface_point(q, u, v, a, b);
+    let o = sub(p, scale(d, r.pow2(0, 4)));
+    let tag = if skewed { "skewed" } else { "skinny" };
+    raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &[tag])
+}
+
+/// A direction in the plane (`n . d = 0` exactly), the origin lifted off it, or in it for every
+/// fourth case.
+fn parallel_case(triangle: bool, r: &mut Stream, i: usize) -> Raw {
+    let (q, u, v, _) = int_quad(r, 8);
+    let n = cross(u, v);
+    let (a, b) = (r.int(-4, 4) as f64, r.int(1, 4) as f64);
+    let d = add(scale(u, a), scale(v, b));
+    let p = surface_point(q, u, v, sixty_fourths(r, 0, 64), sixty_fourths(r, 0, 64));
+    let lift = if i % 4 == 3 {
+        0.0
+    } else {
+        r.int(-4, 4) as f64 * r.pow2(-10, 0)
+    };
+    let lift = if lift == 0.0 && i % 4 != 3 { 1.0 } else { lift };
+    let o = sub(add(p, scale(n, lift)), scale(d, r.int(1, 4) as f64));
+    raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["parallel"])
+}
+
+/// A direction in the plane tilted by `2^-j n`, aimed at the primitive's inside.
+fn grazing_case(triangle: bool, r: &mut Stream) -> Raw {
+    let (q, u, v, _) = int_quad(r, 8);
+    let n = cross(u, v);
+    let j = r.int(5, 60);
+    let d = add(
+        add(scale(u, r.int(-4, 4) as f64), scale(v, r.int(1, 4) as f64)),
+        scale(n, pow2(-j)),
+    );
+    let p = surface_point(q, u, v, sixty_fourths(r, 8, 24), sixty_fourths(r, 8, 24));
+    let o = sub(p, scale(d, r.pow2(0, 3)));
+    raw(plane_shape(triangle, q, u, v), o, d, CAMERA, &["grazing"])
+}
+
+/// An inside hit at a dyadic `t` with an interval end at `t`, or `2^j` ulps beside it.
+fn plane_interval_case(triangle: bool, r: &mut Stream, i: usize) -> Raw {
+    let (q, u, v, d) = int_quad(r, 8);
+    let p = surface_point(q, u, v, sixty_fourths(r, 8, 24), sixty_fourths(r, 8, 24));
+    let t = r.pow2(0, 5);
+    let o = sub(p, scale(d, t));
+    let step = 1i64 << r.int(0, 40);
+    let interval = match i % 5 {
+        0 => [t, f64::MAX],
+        1 => [1e-6, t],
+        2 => [nudge(t, if r.coin() { step } else { -step }), f64::MAX],
+        3 => [1e-6, nudge(t, if r.coin() { step } else { -step })],
+        _ => [t, t],
+    };
+    raw(
+        plane_shape(triangle, q, u, v),
+        o,
+        d,
+        interval,
+        &["interval-boundary"],
+    )
+}
+
+/// Collinear or zero edges, and every fifth case a zero direction.
+fn degenerate_plane_case(triangle: bool, r: &mut Stream, i: usize) -> Raw {
+    let (q, u, _, d) = int_quad(r, 8);
+    let v = match i % 3 {
+        0 => scale(u, r.int(-3, 3) as f64),
+        1 => [0.0; 3],
+        _ => scale(u, 0.5),
+    };
+    let o = sub(q, scale(d, 2.0));
+    let d = if i % 5 == 4 { [0.0; 3] } else { d };
+    raw(
+        plane_shape(triangle, q, u, v),
+        o,
+        d,
+        CAMERA,
+        &["degenerate"],
+    )
 }
 
 /// The categories of a shape and their weights in a suite.

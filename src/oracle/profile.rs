@@ -169,17 +169,6 @@ impl Judging {
             Precision::F32 => 1.0 / (1u64 << 20) as f64,
         }
     }
-
-    /// The tag of a case that is near no geometric boundary (by the definitions of
-    /// [`super::tags`]) and still ambiguous: only this judging's formulas cannot settle it.
-    pub fn ill_conditioned_tag(self) -> &'static str {
-        match (self.profile, self.precision) {
-            (Profile::Course, Precision::F64) => "naive-ill-conditioned",
-            (Profile::Robust, Precision::F64) => "ill-conditioned",
-            (Profile::Course, Precision::F32) => "naive-f32-ill-conditioned",
-            (Profile::Robust, Precision::F32) => "f32-ill-conditioned",
-        }
-    }
 }
 
 impl fmt::Display for Judging {

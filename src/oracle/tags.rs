@@ -1,7 +1,7 @@
 //! What each tag of a vector means, as a predicate decided with exact arithmetic on the `f64`
 //! inputs ([`holds`]). Classification keeps a tag only when its definition holds: a comparison
 //! that the profile's band cannot settle, far from the boundary the tag names, is tagged with
-//! [`Judging::ill_conditioned_tag`] instead (for example `naive-ill-conditioned`: a far sphere
+//! [`ill_conditioned`] instead (for example `naive-ill-conditioned`: a far sphere
 //! where only the naive `half_b^2 - a c` cancels).
 //!
 //! The definitions (`a = d.d`, `f = O - C`, `disc = (f.d)^2 - a (f.f - r^2)`, which is
@@ -38,7 +38,7 @@ use std::cmp::Ordering;
 
 use super::band::{Iv, robust_sphere_bands_in};
 use super::exact::{self, Dyadic, Num, V3};
-use super::profile::Judging;
+use super::profile::{Judging, Precision, Profile};
 use super::vectors::{RaySpec, ShapeSpec};
 use crate::geometry::PARALLEL_EPSILON;
 
@@ -362,6 +362,17 @@ fn fallbacks(tag: &str) -> &'static [&'static str] {
     }
 }
 
+/// The tag of a case that is near no geometric boundary (by the definitions above) and still
+/// ambiguous: only the judging's formulas cannot settle it.
+pub fn ill_conditioned(judging: Judging) -> &'static str {
+    match (judging.profile, judging.precision) {
+        (Profile::Course, Precision::F64) => "naive-ill-conditioned",
+        (Profile::Robust, Precision::F64) => "ill-conditioned",
+        (Profile::Course, Precision::F32) => "naive-f32-ill-conditioned",
+        (Profile::Robust, Precision::F32) => "f32-ill-conditioned",
+    }
+}
+
 /// Keeps the tags whose definitions hold. For an `ambiguous` case, a tag that does not hold is
 /// replaced by its nearest true neighbour (`tangent` by `near-tangent`, `grazing` by
 /// `parallel-threshold`, `corner` by `edge`) or by the judging's ill-conditioned tag; for other
@@ -387,7 +398,7 @@ pub fn truthful(
             .iter()
             .find(|a| holds(a, shape, ray, interval) == Some(true))
             .copied()
-            .unwrap_or(judging.ill_conditioned_tag());
+            .unwrap_or(ill_conditioned(judging));
         out.push(alt.to_string());
     }
     out.sort();

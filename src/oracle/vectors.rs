@@ -17,6 +17,7 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use crate::arithmetic::Line;
 use crate::geometry::{Interval, Quad, Ray, Sphere, Triangle};
 use crate::scene::Object;
 
@@ -147,6 +148,14 @@ impl RaySpec {
     /// The reference tracer's ray.
     pub fn ray(&self) -> Ray {
         Ray::new(DVec3::from(self.origin), DVec3::from(self.direction))
+    }
+
+    /// The ray as the exact decisions take it.
+    pub fn line(&self) -> Line {
+        Line {
+            origin: self.origin,
+            direction: self.direction,
+        }
     }
 }
 

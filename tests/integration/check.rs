@@ -331,7 +331,7 @@ fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
     let dir = assemble_fixture("bug_imports_a_module_the_grader_lacks").unwrap();
     std::fs::write(
         dir.path().join("adapter.py"),
-        rtoracle::candidate::process::PYTHON_COURSE_ADAPTER,
+        rtoracle::candidate::command::PYTHON_COURSE_ADAPTER,
     )
     .unwrap();
     let mut child = std::process::Command::new(python().unwrap())
@@ -1009,5 +1009,67 @@ fn a_candidate_flooding_stdout_times_out_with_bounded_memory() {
             .unwrap()
             .contains(r#""junk", "junk""#),
         "{first}"
+    );
+}
+
+/// `bwrap` with the crate's source folder hidden (an empty folder mounted over it), where this
+/// machine can run it; `None` otherwise.
+fn without_the_checkout() -> Option<std::process::Command> {
+    let here = env!("CARGO_MANIFEST_DIR");
+    let args = ["--dev-bind", "/", "/", "--tmpfs", here, "--"];
+    let works = std::process::Command::new("bwrap")
+        .args(args)
+        .args(["sh", "-c", &format!("test ! -e {here}/Cargo.toml")])
+        .status()
+        .is_ok_and(|s| s.success());
+    works.then(|| {
+        let mut cmd = std::process::Command::new("bwrap");
+        cmd.args(args);
+        cmd
+    })
+}
+
+/// `rtoracle bench candidate` read its fixtures from the source folder named at compile time
+/// ("assembling the fixture: No such file or directory" from an installed binary): a copy of
+/// the binary, run in an empty folder with the checkout hidden where bwrap can hide it, runs
+/// the quick benchmark through the course adapter.
+#[test]
+fn bench_candidate_runs_from_a_copy_of_the_binary_in_an_empty_folder() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let bin = tmp.path().join("bin");
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir_all(&bin).unwrap();
+    std::fs::create_dir_all(&empty).unwrap();
+    let copy = bin.join("rtoracle");
+    std::fs::copy(env!("CARGO_BIN_EXE_rtoracle"), &copy).unwrap();
+    let mut cmd = match without_the_checkout() {
+        Some(mut bwrap) => {
+            bwrap.arg(&copy);
+            bwrap
+        }
+        None => {
+            eprintln!("bwrap cannot hide the checkout here: the copy runs beside it");
+            std::process::Command::new(&copy)
+        }
+    };
+    let out = cmd
+        .args(["bench", "candidate", "--quick"])
+        .current_dir(&empty)
+        .env("RTORACLE_PYTHON", python().expect("checked"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(stdout.contains("course adapter passed: true"), "{stdout}");
+    // The quick run is no measurement: no suites.
+    assert!(!stdout.contains("default suite"), "{stdout}");
+    assert_eq!(
+        std::fs::read_dir(&empty).unwrap().count(),
+        0,
+        "nothing left"
     );
 }

@@ -1,10 +1,12 @@
 //! One integration-test binary with a module per area (as ripgrep does).
 
+mod architecture;
 mod assignment;
 mod check;
 mod cli;
 mod common;
 mod compare;
+mod course_weeks;
 mod golden;
 mod grade;
 mod oracle;

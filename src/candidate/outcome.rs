@@ -1,0 +1,42 @@
+//! What the harness got for one case of a candidate run as a process ([`Outcome`]): an answer,
+//! a protocol error, a time-out, a death, or a case not run.
+
+use super::protocol::Answer;
+
+/// What the harness got for one case.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    /// An answer line with the case's id; `junk` holds the non-answer lines printed while the
+    /// case ran (a protocol error when not empty).
+    Answered {
+        /// The answer.
+        answer: Answer,
+        /// Stray output before the answer.
+        junk: Vec<String>,
+    },
+    /// A line that is not a valid answer to this case's request (a malformed answer, an answer
+    /// with another id, an oversize line): a protocol error, decided when the line arrived.
+    Protocol {
+        /// What was wrong, with the line quoted.
+        message: String,
+        /// Stray output before it.
+        junk: Vec<String>,
+    },
+    /// No answer within the timeout: the candidate was killed and restarted.
+    Timeout {
+        /// Stray output while waiting.
+        junk: Vec<String>,
+    },
+    /// The candidate's process died (or could not be restarted) on this case.
+    Died {
+        /// How it died.
+        message: String,
+        /// Stray output before it died.
+        junk: Vec<String>,
+    },
+    /// The case was not sent: unsupported shape, or its group used up its timeouts.
+    NotRun {
+        /// Why.
+        reason: String,
+    },
+}

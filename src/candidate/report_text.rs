@@ -1,0 +1,253 @@
+//! The check report as text for a person ([`CheckReport::to_text`]): who was checked, a table
+//! of counts per shape, the verdict and what explains it, the first failures with how to
+//! reproduce each, and the end of the candidate's stderr.
+//!
+//! What the text promises about text from the candidate: each message, traceback, name and
+//! stderr line is written through [`crate::escape::terminal_line`] or
+//! [`crate::escape::terminal_text`], so nothing a candidate prints can move the cursor, colour
+//! the terminal or fake a line of the report. When every failure is the same error (a
+//! submission that cannot be imported), the text says it once.
+
+use std::fmt::Write as _;
+
+use super::report::{CheckReport, Counts, Failure};
+use crate::escape::{terminal_line, terminal_text};
+
+impl CheckReport {
+    /// A summary table and the first `max_failures` failures, each with its request and
+    /// expected answer (or its Python reproduction for the course adapter). Every text from
+    /// the candidate is escaped for the terminal.
+    pub fn to_text(&self, max_failures: usize) -> String {
+        let mut s = String::new();
+        self.write_header(&mut s);
+        self.write_table(&mut s);
+        self.write_verdict(&mut s);
+        self.write_failures(&mut s, max_failures);
+        self.write_stderr_tail(&mut s);
+        s
+    }
+
+    /// Who was checked, by what, and why it could not run, if so.
+    fn write_header(&self, s: &mut String) {
+        let _ = writeln!(s, "candidate: {}", terminal_line(&self.candidate));
+        if let Some(j) = &self.judged_by {
+            let _ = writeln!(s, "judged by: {j}");
+        }
+        if let Some(e) = &self.import_error {
+            let _ = writeln!(
+                s,
+                "the submission could not be imported: {}",
+                terminal_line(&e.to_string())
+            );
+            if !e.traceback.is_empty() {
+                for line in terminal_text(e.traceback.trim_end()).lines() {
+                    let _ = writeln!(s, "    {line}");
+                }
+            }
+        }
+        if let Some(f) = &self.start_failure {
+            let _ = writeln!(
+                s,
+                "the candidate could not be started: {}",
+                terminal_line(f)
+            );
+        }
+    }
+
+    /// The counts, one row per shape and one for all.
+    fn write_table(&self, s: &mut String) {
+        let _ = writeln!(
+            s,
+            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
+            "shape",
+            "total",
+            "passed",
+            "failed",
+            "errors",
+            "timeouts",
+            "not_run",
+            "ambiguous",
+            "any"
+        );
+        let row = |s: &mut String, name: &str, c: &Counts| {
+            let _ = writeln!(
+                s,
+                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
+                name,
+                c.total,
+                c.passed,
+                c.failed,
+                c.errors,
+                c.timeouts,
+                c.not_run,
+                c.ambiguous,
+                c.any
+            );
+        };
+        for (kind, c) in &self.by_shape {
+            row(s, kind.name(), c);
+        }
+        row(s, "all", &self.counts);
+    }
+
+    /// The verdict, and what explains it: required shapes not run, the triangles' winding,
+    /// the diagnosis, restarts, the sandbox's note, the vectors not run.
+    fn write_verdict(&self, s: &mut String) {
+        let _ = writeln!(
+            s,
+            "\nverdict: {} ({} of {} definite vectors passed{})",
+            if self.passed() { "PASS" } else { "FAIL" },
+            self.counts.passed,
+            self.counts.total,
+            if self.counts.not_run > 0 {
+                format!(", {} not run", self.counts.not_run)
+            } else {
+                String::new()
+            }
+        );
+        for k in self.required_not_run() {
+            let _ = writeln!(
+                s,
+                "required: {k}s (--require {k}), but {} {k} vectors were not run (why: below)",
+                self.by_shape[&k].not_run
+            );
+        }
+        if let Some(w) = self.triangle_winding {
+            let _ = writeln!(s, "triangles: your triangles face {}", w.formula());
+        }
+        for d in &self.diagnosis {
+            let _ = writeln!(s, "diagnosis: {}", d.sentence());
+        }
+        if self.restarts > 0 {
+            let _ = writeln!(s, "the candidate was restarted {} times", self.restarts);
+        }
+        if let Some(note) = self.sandbox.as_ref().and_then(|f| f.note.as_ref()) {
+            let _ = writeln!(s, "sandbox: {}", terminal_line(note));
+        }
+        // Vectors not run: one line per shape and reason.
+        for n in &self.not_run_summary {
+            let _ = writeln!(
+                s,
+                "not run: {} {} vectors: {}",
+                n.count,
+                n.shape,
+                terminal_line(&n.reason)
+            );
+        }
+    }
+
+    /// The first `max_failures` failures, or one cause said once when all share it.
+    fn write_failures(&self, s: &mut String, max_failures: usize) {
+        let shown = &self.failures;
+        if shown.is_empty() {
+        } else if shown.len() > 1
+            && shown
+                .iter()
+                .all(|f| f.kind == shown[0].kind && f.message == shown[0].message)
+        {
+            // One cause for all (an import error): said once, with one example.
+            let f = &shown[0];
+            let _ = writeln!(
+                s,
+                "\nall {} failures are the same: [{}] {}",
+                shown.len(),
+                f.kind.name(),
+                terminal_line(&f.message)
+            );
+            if max_failures > 0 && self.import_error.is_none() {
+                let _ = writeln!(s, "for example {} ({}):", terminal_line(&f.id), f.shape);
+                write_case(s, f);
+            }
+        } else {
+            let _ = writeln!(
+                s,
+                "\nfirst {} of {} failures:",
+                shown.len().min(max_failures),
+                shown.len()
+            );
+            for f in shown.iter().take(max_failures) {
+                write_failure(s, f);
+            }
+        }
+    }
+
+    /// The last 20 lines of the candidate's stderr.
+    fn write_stderr_tail(&self, s: &mut String) {
+        let tail = self.stderr_tail.trim_end();
+        if !tail.is_empty() {
+            let _ = writeln!(s, "\nend of the candidate's stderr:");
+            for line in tail
+                .lines()
+                .rev()
+                .take(20)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+            {
+                let _ = writeln!(s, "    {}", terminal_line(line));
+            }
+        }
+    }
+}
+
+fn write_failure(s: &mut String, f: &Failure) {
+    let _ = writeln!(
+        s,
+        "\n[{}] {} ({}): {}",
+        f.kind.name(),
+        terminal_line(&f.id),
+        f.shape,
+        terminal_line(&f.message)
+    );
+    write_case(s, f);
+}
+
+/// A failure's tags and how to reproduce it.
+fn write_case(s: &mut String, f: &Failure) {
+    if !f.tags.is_empty() {
+        let _ = writeln!(s, "  tags: {}", terminal_line(&f.tags.join(", ")));
+    }
+    if f.repro.is_empty() {
+        let _ = writeln!(s, "  request: {}", terminal_line(&f.request));
+        let _ = writeln!(s, "  expected: {}", f.expected_text);
+    } else {
+        let _ = writeln!(s, "  reproduce (run in the submission folder):");
+        for line in f.repro.lines() {
+            let _ = writeln!(s, "    {}", terminal_line(line));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::candidate::outcome::Outcome;
+    use crate::candidate::protocol::Answer;
+    use crate::candidate::report::{RunInfo, build_report};
+
+    #[test]
+    fn one_error_on_every_case_is_said_once_and_candidate_text_is_escaped() {
+        let cases = crate::candidate::test_cases::basic_cases();
+        let error = Answer::error("SyntaxError", "bad\x1b[31m input");
+        let outcomes: Vec<Outcome> = cases
+            .iter()
+            .map(|_| Outcome::Answered {
+                answer: error.clone(),
+                junk: vec![],
+            })
+            .collect();
+        let info = RunInfo {
+            candidate: "evil\nverdict: PASS".into(),
+            course_api: true,
+            ..RunInfo::default()
+        };
+        let text = build_report(&cases, &outcomes, info).to_text(10);
+        assert_eq!(text.matches("raised SyntaxError").count(), 1, "{text}");
+        assert_eq!(text.matches("reproduce").count(), 1, "{text}");
+        assert!(text.contains(&format!("all {} failures are the same", cases.len())));
+        assert!(
+            !text.contains('\x1b') && text.contains("\\x1b[31m"),
+            "{text}"
+        );
+        assert!(!text.contains("\nverdict: PASS"), "{text}");
+    }
+}

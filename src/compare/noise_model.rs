@@ -1,0 +1,320 @@
+//! The golden as the noise model reads it: per pixel and channel the mean of `M` samples, their
+//! per-sample variance, and a bound on how far one sample may lie from the mean.
+//!
+//! The goldens themselves (their files, the cache, how each scene gets one) are
+//! [`crate::golden`]'s; [`Golden::of_scene`] reads the one [`crate::golden::golden_of`] gives.
+
+use std::path::Path;
+
+use super::CompareError;
+use crate::golden::{ATTR_SPP, GoldenRecord, GoldenScene, golden_of, sha256_hex};
+use crate::image_io::ExrImage;
+use crate::render::Film;
+use crate::scene::SceneDescription;
+
+/// The scene a golden's attributes record: the TOML it holds (a scene file's golden), else the
+/// built-in scene it names, when the recorded hash is that scene's.
+pub fn recorded_scene(record: &GoldenRecord) -> Option<SceneDescription> {
+    let want = record.scene_sha256.as_deref()?;
+    if let Some(toml) = &record.scene_toml {
+        let name = record.scene.as_deref().unwrap_or("the golden's scene");
+        return (sha256_hex(toml.as_bytes()) == want)
+            .then(|| SceneDescription::from_toml(toml, name).ok())
+            .flatten();
+    }
+    let scene = GoldenScene::builtin(record.scene.as_deref()?).ok()?;
+    (scene.scene_sha256() == want).then_some(scene.description)
+}
+
+/// A golden image: per pixel and channel the mean of `samples_per_pixel` samples and their
+/// per-sample variance, plus what the comparison derives from them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Golden {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Samples per pixel `M` of the golden.
+    pub samples_per_pixel: u32,
+    /// Mean linear RGB, row-major, top row first.
+    pub mean: Vec<[f64; 3]>,
+    /// Per-sample variance of each channel.
+    pub variance: Vec<[f64; 3]>,
+    /// The scene's name, when known.
+    pub scene: Option<String>,
+    /// The vertical field of view of the scene's camera in degrees, when known (the diagnosis
+    /// names a zoom as a field of view).
+    pub vfov: Option<f64>,
+    /// Per pixel and channel, a bound on how far one sample may lie from the mean: the largest
+    /// `|mu_nb - mu| + 3 sd_nb` over the 3x3 neighbourhood, at most 1. Edge-tolerant: a pixel
+    /// beside an edge may receive samples of the other side that the golden never drew.
+    pub(crate) bound: Vec<[f64; 3]>,
+}
+
+impl Golden {
+    /// A golden from its parts; the mean and variance must have `width * height` finite entries.
+    pub fn new(
+        width: usize,
+        height: usize,
+        samples_per_pixel: u32,
+        mean: Vec<[f64; 3]>,
+        variance: Vec<[f64; 3]>,
+        scene: Option<String>,
+    ) -> Result<Self, CompareError> {
+        let n = width * height;
+        if n == 0 || mean.len() != n || variance.len() != n {
+            return Err(CompareError::Golden(format!(
+                "a {width}x{height} golden needs {n} pixels; it has {} means and {} variances",
+                mean.len(),
+                variance.len()
+            )));
+        }
+        if samples_per_pixel < 2 {
+            return Err(CompareError::Golden(
+                "a golden needs at least 2 samples per pixel".into(),
+            ));
+        }
+        let finite = |v: &[[f64; 3]]| v.iter().all(|p| p.iter().all(|x| x.is_finite()));
+        if !finite(&mean) || !finite(&variance) {
+            return Err(CompareError::Golden(
+                "the golden has a NaN or infinite value".into(),
+            ));
+        }
+        let mut golden = Golden {
+            width,
+            height,
+            samples_per_pixel,
+            mean,
+            variance: variance
+                .into_iter()
+                .map(|v| v.map(|x| x.max(0.0)))
+                .collect(),
+            scene,
+            vfov: None,
+            bound: Vec::new(),
+        };
+        golden.bound = golden.neighbourhood_bound();
+        Ok(golden)
+    }
+
+    /// The same golden with the camera's vertical field of view `vfov` (degrees) known.
+    pub fn with_vfov(mut self, vfov: Option<f64>) -> Self {
+        self.vfov = vfov;
+        self
+    }
+
+    fn neighbourhood_bound(&self) -> Vec<[f64; 3]> {
+        let (w, h) = (self.width as isize, self.height as isize);
+        let sd: Vec<[f64; 3]> = self.variance.iter().map(|v| v.map(f64::sqrt)).collect();
+        let mut out = vec![[0.0; 3]; self.mean.len()];
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let mu = self.mean[i];
+                let mut b = [0.0f64; 3];
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let (nx, ny) = (x + dx, y + dy);
+                        if nx < 0 || ny < 0 || nx >= w || ny >= h {
+                            continue;
+                        }
+                        let j = (ny * w + nx) as usize;
+                        for c in 0..3 {
+                            let v = (self.mean[j][c] - mu[c]).abs() + 3.0 * sd[j][c];
+                            b[c] = b[c].max(v);
+                        }
+                    }
+                }
+                out[i] = b.map(|v| v.min(1.0));
+            }
+        }
+        out
+    }
+
+    /// A golden from a film rendered with `variance: true`.
+    pub fn from_film(film: &Film, scene: Option<String>) -> Result<Self, CompareError> {
+        let variance = film.variance.as_ref().ok_or_else(|| {
+            CompareError::Golden("the film was rendered without its variance".into())
+        })?;
+        Golden::new(
+            film.width,
+            film.height,
+            film.samples_per_pixel,
+            film.mean.iter().map(|m| m.to_array()).collect(),
+            variance.iter().map(|v| v.to_array()).collect(),
+            scene,
+        )
+    }
+
+    /// A golden from an EXR file with a `variance` layer; `M` comes from its `rtoracle.spp`
+    /// attribute. Errors name the file.
+    pub fn from_exr(path: &Path) -> Result<Self, CompareError> {
+        let image = crate::image_io::read_exr(path)?;
+        Golden::from_exr_image(image, path)
+    }
+
+    /// A golden from an EXR already read (for instance one embedded in the binary); `source`
+    /// names it in errors. The scene it records (the TOML it holds, or the built-in scene it
+    /// names, when the hashes agree) gives its camera's field of view.
+    pub fn from_exr_image(image: ExrImage, source: &Path) -> Result<Self, CompareError> {
+        let bad = |message: String| CompareError::Input {
+            path: source.to_path_buf(),
+            message,
+        };
+        let record = GoldenRecord::of(&image);
+        let spp = image.attribute(ATTR_SPP).ok_or_else(|| {
+            bad(format!(
+                "has no '{ATTR_SPP}' attribute (the golden's samples per pixel)"
+            ))
+        })?;
+        let spp: u32 = spp
+            .trim()
+            .parse()
+            .map_err(|_| bad(format!("its '{ATTR_SPP}' attribute '{spp}' is not a count")))?;
+        let vfov = recorded_scene(&record).map(|d| d.camera.vfov);
+        let variance = image
+            .variance
+            .ok_or_else(|| bad("has no 'variance' layer, so it cannot serve as a golden".into()))?;
+        let widen = |v: Vec<[f32; 3]>| -> Vec<[f64; 3]> {
+            v.into_iter().map(|p| p.map(f64::from)).collect()
+        };
+        Golden::new(
+            image.width,
+            image.height,
+            spp,
+            widen(image.mean),
+            widen(variance),
+            record.scene,
+        )
+        .map(|g| g.with_vfov(vfov))
+        .map_err(|e| bad(e.to_string()))
+    }
+
+    /// The golden of `scene` for candidates of `candidate_spp` samples per pixel: the one
+    /// [`golden_of`] gives with [`crate::golden::golden_spp`] samples, from the cache in
+    /// `cache` (`progress`: a line and a bar on stderr when it is rendered), named after the
+    /// scene as asked (a cached golden may carry the name of another file of the same content).
+    pub fn of_scene(
+        scene: &GoldenScene,
+        candidate_spp: u32,
+        cache: Option<&Path>,
+        progress: bool,
+    ) -> Result<Self, CompareError> {
+        let spp = crate::golden::golden_spp(candidate_spp);
+        let found = golden_of(scene, spp, cache, progress)
+            .map_err(|e| CompareError::Golden(e.to_string()))?;
+        let mut golden = Golden::from_exr_image(found.image, &found.source)?;
+        golden.scene = Some(scene.name.clone());
+        golden.vfov = Some(scene.description.camera.vfov);
+        Ok(golden)
+    }
+
+    /// The golden seen through a camera shifted by half a pixel along both axes (`sign` +1:
+    /// right and down, -1: left and up): each pixel becomes the mixture of the four pixels it
+    /// straddles. An approximation used only by the diagnosis.
+    pub fn half_pixel_shifted(&self, sign: i32) -> Golden {
+        let (w, h) = (self.width as isize, self.height as isize);
+        let s = if sign >= 0 { 1 } else { -1 };
+        let mut mean = Vec::with_capacity(self.mean.len());
+        let mut variance = Vec::with_capacity(self.mean.len());
+        for y in 0..h {
+            for x in 0..w {
+                let idx = |dx: isize, dy: isize| {
+                    let nx = (x + dx * s).clamp(0, w - 1);
+                    let ny = (y + dy * s).clamp(0, h - 1);
+                    (ny * w + nx) as usize
+                };
+                let quads = [idx(0, 0), idx(1, 0), idx(0, 1), idx(1, 1)];
+                let mut m = [0.0; 3];
+                let mut v = [0.0; 3];
+                for c in 0..3 {
+                    let mus = quads.map(|q| self.mean[q][c]);
+                    let avg = mus.iter().sum::<f64>() / 4.0;
+                    let spread = mus.iter().map(|u| (u - avg).powi(2)).sum::<f64>() / 4.0;
+                    m[c] = avg;
+                    v[c] = quads.iter().map(|&q| self.variance[q][c]).sum::<f64>() / 4.0 + spread;
+                }
+                mean.push(m);
+                variance.push(v);
+            }
+        }
+        Golden::new(
+            self.width,
+            self.height,
+            self.samples_per_pixel,
+            mean,
+            variance,
+            self.scene.clone(),
+        )
+        .expect("a shifted golden has the same size and finite values")
+        .with_vfov(self.vfov)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tiny() -> Golden {
+        Golden::new(
+            2,
+            1,
+            16,
+            vec![[0.25, 0.5, 1.0], [0.0, 0.1, 0.2]],
+            vec![[0.0, 0.01, 0.0], [0.04, 0.0, 0.0]],
+            None,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn the_bound_covers_the_neighbours_and_the_spread() {
+        let g = tiny();
+        // Pixel 0, red: |0 - 0.25| + 3 * sqrt(0.04) = 0.85 from its neighbour.
+        assert!((g.bound[0][0] - 0.85).abs() < 1e-12);
+        // Green: own spread 3 * 0.1 = 0.3 beats |0.1 - 0.5| = 0.4? No: 0.4 wins.
+        assert!((g.bound[0][1] - 0.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn wrong_sizes_and_nan_are_rejected() {
+        assert!(Golden::new(2, 2, 16, vec![[0.0; 3]; 3], vec![[0.0; 3]; 4], None).is_err());
+        assert!(Golden::new(1, 1, 16, vec![[f64::NAN; 3]], vec![[0.0; 3]], None).is_err());
+    }
+
+    #[test]
+    fn exr_goldens_need_variance_and_their_sample_count() {
+        let image = |variance: bool, spp: Option<&str>| ExrImage {
+            width: 1,
+            height: 1,
+            mean: vec![[0.5; 3]],
+            variance: variance.then(|| vec![[0.01; 3]]),
+            attributes: spp
+                .map(|s| vec![("rtoracle.spp".to_string(), s.to_string())])
+                .unwrap_or_default(),
+        };
+        let src = Path::new("g.exr");
+        let g = Golden::from_exr_image(image(true, Some("4096")), src).unwrap();
+        assert_eq!(g.samples_per_pixel, 4096);
+        for (img, needle) in [
+            (image(false, Some("4096")), "variance"),
+            (image(true, None), "rtoracle.spp"),
+            (image(true, Some("many")), "not a count"),
+        ] {
+            let e = Golden::from_exr_image(img, src).unwrap_err().to_string();
+            assert!(e.starts_with("g.exr: ") && e.contains(needle), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_course_goldens_serve_20_spp_candidates() {
+        for scene in ["week04-sphere", "week04-quad"] {
+            let g = Golden::of_scene(&GoldenScene::builtin(scene).unwrap(), 20, None, false)
+                .expect("embedded");
+            assert_eq!(g.samples_per_pixel, 4096);
+            assert_eq!(g.scene.as_deref(), Some(scene));
+            let camera = crate::scene::builtin(scene).unwrap().camera(None);
+            assert_eq!((g.width, g.height), (camera.width, camera.height));
+        }
+    }
+}
