@@ -503,7 +503,7 @@ impl Rubric {
             ("file_limit_mib", self.file_limit_mib, 16_384),
         ] {
             if !(16..=most).contains(&mib) {
-                return Err(invalid(format!(
+                return Err(self.invalid(format!(
                     "{key} = {mib}: it must be at least 16 and at most {most}"
                 )));
             }

@@ -176,10 +176,13 @@ fn holds_a_needle(reader: &mut impl Read) -> bool {
     }
 }
 
+/// The binaries found in each tree walked so far, by the tree and the walk's depth.
+type Found = HashMap<(PathBuf, bool), Vec<PathBuf>>;
+
 /// The rtoracle binaries in the tree at `root` (or `root` itself when it is one), sorted, each
 /// file looked at in depth when `deep`, by its sections otherwise; cached for the process.
 pub fn found_in(root: &Path, deep: bool) -> Vec<PathBuf> {
-    static CACHE: OnceLock<Mutex<HashMap<(PathBuf, bool), Vec<PathBuf>>>> = OnceLock::new();
+    static CACHE: OnceLock<Mutex<Found>> = OnceLock::new();
     let cache = CACHE.get_or_init(Default::default);
     let key = (root.to_path_buf(), deep);
     // Held while a tree is walked: sandboxes made at once wait for one walk, not make many.
