@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod compare;
 mod course_weeks;
+mod functions;
 mod golden;
 mod grade;
 mod oracle;

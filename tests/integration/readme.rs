@@ -38,7 +38,7 @@
 //! kind (bare, `text`, fenced with `~~~`, indented in a list...) fails the test: every transcript
 //! is a `console` block, or `console,no-run` with a reason.
 //!
-//! `RTORACLE_UPDATE_README=1 cargo test --test integration -- readme::` writes the real outputs
+//! `RTORACLE_UPDATE_README=1 cargo test --release --test integration -- readme::` writes the real outputs
 //! of the examples that differ into their pages instead of comparing (the others keep their
 //! masked figures).
 //!
@@ -572,7 +572,7 @@ fn every_console_example_of_the_docs_is_real_output() {
     assert!(ran > 0, "no console block ran");
     assert!(
         failures.is_empty(),
-        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --test integration -- readme:: rewrites them):\n\n{}",
+        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --release --test integration -- readme:: rewrites them):\n\n{}",
         failures.len(),
         failures.join("\n\n")
     );
@@ -985,4 +985,89 @@ fn the_tests_resolve_the_features_of_the_release_build() {
         "`cargo test --release` would rebuild these and the library; turn their features on in [dependencies]:\n{}",
         differ.join("\n")
     );
+}
+
+/// The README's test command: the second line of the sh block under "## Set up", without its
+/// comment.
+fn readme_test_command() -> String {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let setup = readme
+        .split("\n## Set up")
+        .nth(1)
+        .expect("README has a \"## Set up\" section");
+    let block = setup
+        .split("```sh\n")
+        .nth(1)
+        .and_then(|b| b.split("```").next())
+        .expect("the set-up section has an sh block");
+    let line = block
+        .lines()
+        .nth(1)
+        .expect("the set-up block has two commands");
+    line.split('#').next().unwrap().trim().to_string()
+}
+
+/// Every `cargo test` the README and `docs/` name, except in a paragraph about "A plain
+/// `cargo test`" (the test profile's own build, named as such): `(page, line, text)` of those
+/// that do not run in the README's profile (`cargo test --release`).
+fn cargo_tests_outside_the_readme_profile(page: &str, text: &str) -> Vec<(String, usize, String)> {
+    let mut found = Vec::new();
+    let mut plain_paragraph = false;
+    for (number, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            plain_paragraph = false;
+            continue;
+        }
+        if line.contains("A plain `cargo test`") {
+            plain_paragraph = true;
+        }
+        let mut rest = line;
+        while let Some(at) = rest.find("cargo test") {
+            let after = &rest[at + "cargo test".len()..];
+            if !plain_paragraph && !after.starts_with(" --release") {
+                found.push((page.to_string(), number + 1, line.trim().to_string()));
+            }
+            rest = after;
+        }
+    }
+    found
+}
+
+/// The README's test command is the one `.ci/run` runs, and every page that names the test
+/// suite names it in the same profile, so that a reader runs what CI runs and reuses the first
+/// set-up command's build.
+#[test]
+fn the_readme_test_command_is_the_one_ci_runs_everywhere() {
+    let command = readme_test_command();
+    assert_eq!(command, "cargo test --release", "the README's test command");
+    let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
+    assert!(
+        ci.lines().any(|line| line.trim() == command),
+        ".ci/run does not run the README's test command `{command}` as a line of its own"
+    );
+    let mut found = Vec::new();
+    for page in pages() {
+        let text = std::fs::read_to_string(root().join(&page)).unwrap();
+        found.extend(cargo_tests_outside_the_readme_profile(&page, &text));
+    }
+    let found: Vec<String> = found
+        .iter()
+        .map(|(page, line, text)| format!("{page}:{line}: {text}"))
+        .collect();
+    assert!(
+        found.is_empty(),
+        "name the README's test command `{command}` (filters after it), not another profile:\n{}",
+        found.join("\n")
+    );
+}
+
+/// The check above finds a `cargo test` in another profile and lets a paragraph about the plain
+/// one be.
+#[test]
+fn a_test_command_in_another_profile_is_found() {
+    let text = "Run `cargo test --release`.\n\nOr `cargo test --lib x::`.\n\n\
+                A plain `cargo test` works,\nas `cargo test --lib y::` does.\n\nThen `cargo test`.\n";
+    let found = cargo_tests_outside_the_readme_profile("p.md", text);
+    let lines: Vec<usize> = found.iter().map(|f| f.1).collect();
+    assert_eq!(lines, vec![3, 8]);
 }
