@@ -9,6 +9,11 @@ mod cli;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // A submission that found a copy of rtoracle must not use it as an oracle.
+    if let Some(why) = rtoracle::sandbox::oracles::refusal() {
+        errln!("rtoracle: {why}");
+        return ExitCode::from(2);
+    }
     if let Err(err) = rtoracle::interrupt::install() {
         errln!("rtoracle: cannot install the signal handlers: {err}");
         return ExitCode::from(2);

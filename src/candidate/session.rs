@@ -329,6 +329,14 @@ impl Session {
                 excerpt_end(&last.join(" | "))
             ));
         }
+        if let Some(hint) = self
+            .sandbox
+            .view_hint(tail)
+            .filter(|_| !self.command.is_course_adapter())
+        {
+            message.push_str("; ");
+            message.push_str(&hint);
+        }
         message
     }
 

@@ -2,7 +2,7 @@
 //! against the week's function checks (`--week N`, or the week found from a course folder's
 //! files).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -110,6 +110,10 @@ pub struct SandboxArgs {
     /// code where no sandbox can be made; the output says so.
     #[arg(long)]
     pub unsandboxed: bool,
+    /// Show FOLDER read-only inside the sandbox too (repeatable): for an adapter that starts a
+    /// program its command line does not name (a wrapper script running ../build/tracer).
+    #[arg(long, value_name = "FOLDER")]
+    pub expose: Vec<PathBuf>,
 }
 
 impl SandboxArgs {
@@ -117,8 +121,30 @@ impl SandboxArgs {
     pub fn policy(&self) -> SandboxPolicy {
         SandboxPolicy {
             unsandboxed: self.unsandboxed,
+            shown: self
+                .expose
+                .iter()
+                .map(|p| p.canonicalize().unwrap_or_else(|_| p.clone()))
+                .collect(),
             ..SandboxPolicy::default()
         }
+    }
+
+    /// `--expose` names existing folders, and not the whole file system.
+    fn check_shown(&self) -> anyhow::Result<()> {
+        for p in &self.expose {
+            if !p.is_dir() {
+                anyhow::bail!("--expose {}: no such folder", p.display());
+            }
+            if p.canonicalize()? == Path::new("/") {
+                anyhow::bail!(
+                    "--expose {}: the whole file system cannot be shown; name the folder the \
+                     adapter needs",
+                    p.display()
+                );
+            }
+        }
+        Ok(())
     }
 }
 
@@ -137,6 +163,7 @@ impl Target {
     /// course adapter, choosing the interpreter: both before any work.
     pub fn command(&self, sandbox: &SandboxArgs) -> anyhow::Result<CandidateCommand> {
         self.check()?;
+        sandbox.check_shown()?;
         let policy = sandbox.policy();
         rtoracle::sandbox::isolation_for(&policy).map_err(with_hint)?;
         Ok(match (&self.python_course, &self.adapter) {

@@ -61,6 +61,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // Every input and the output folder are checked before any grading.
     check_inputs(&args)?;
     let code = code_checker(&args, &rubric)?;
+    // Where the code runs on the host as uids of their own (the fallback), what it must not
+    // read is made unreadable by others until grading ends.
+    let _kept = match code.python {
+        Some(_) => Some(rtoracle::sandbox::keep_from_sandboxes(&private_inputs(
+            &args, &rubric,
+        ))?),
+        None => None,
+    };
     // Said once the grading is done, so bad input stays one line on stderr.
     let public_seed = (code.python.is_some() && code.vectors.is_none() && rubric.seed == 0).then_some(
         "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
@@ -162,7 +170,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         .groups
         .iter()
         .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
-    let policy = rtoracle::sandbox::SandboxPolicy::grading();
+    let policy = rubric.sandbox_policy();
     let python = if runs_code {
         let python = rtoracle::candidate::python::choose(
             args.python.as_deref(),
@@ -240,4 +248,23 @@ fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::R
         args.out.display()
     );
     Ok(())
+}
+
+/// What the code graded must not read: the batch folder (the classmates' submissions), the
+/// rubric file (its seed), its scene files and goldens, the vector file.
+fn private_inputs(args: &Args, rubric: &Rubric) -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = [
+        args.batch.clone(),
+        args.rubric.clone(),
+        args.vectors.clone(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for scene in rubric.groups.iter().filter_map(|g| g.scene_file.as_ref()) {
+        paths.push(scene.path.clone());
+        paths.extend(scene.golden.as_ref().map(|g| g.path.clone()));
+    }
+    paths.retain(|p| p.exists());
+    paths
 }

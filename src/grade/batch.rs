@@ -48,6 +48,19 @@ pub fn submissions(dir: &Path, skip: Option<&Path>) -> Result<Vec<PathBuf>, Grad
     Ok(out)
 }
 
+/// A folder's name as the batch's rows and report folders show it: its bytes that are not
+/// UTF-8 written as `\xNN`, so two names that differ only there stay apart.
+pub fn folder_name(name: &std::ffi::OsStr) -> String {
+    let mut out = String::new();
+    for chunk in name.as_encoded_bytes().utf8_chunks() {
+        out.push_str(chunk.valid());
+        for b in chunk.invalid() {
+            let _ = write!(out, "\\x{b:02x}");
+        }
+    }
+    out
+}
+
 /// The batch's own files in its output folder: a submission folder of one of these names is
 /// an error row of the batch, not graded (its reports would take their place).
 pub const BATCH_FILES: [&str; 2] = ["gradebook.csv", "summary.md"];
@@ -79,14 +92,26 @@ pub fn grade_batch(
     } else {
         ProgressBar::hidden()
     };
+    let names: Vec<String> = subs
+        .iter()
+        .map(|s| folder_name(s.file_name().unwrap_or_default()))
+        .collect();
     let entries: Vec<BatchEntry> = subs
         .par_iter()
-        .map(|sub| {
-            let name = sub
-                .file_name()
-                .map(|n| n.to_string_lossy().to_string())
-                .unwrap_or_default();
+        .zip(names.par_iter())
+        .map(|(sub, name)| {
+            let name = name.clone();
             let result = catch_unwind(AssertUnwindSafe(|| {
+                let same = names.iter().filter(|n| **n == name).count();
+                if same > 1 {
+                    return Err(GradeError::Output {
+                        path: output.shown(&name),
+                        message: format!(
+                            "{same} submission folders have this name once their bytes that \
+                             are not UTF-8 are written as \\xNN; rename them to grade them"
+                        ),
+                    });
+                }
                 if BATCH_FILES.contains(&name.as_str()) {
                     return Err(GradeError::Output {
                         path: output.shown(&name),
@@ -606,6 +631,54 @@ mod tests {
         assert!(
             summary.contains("| `sphere.intersect` Sphere intersection | 2 |"),
             "{summary}"
+        );
+    }
+
+    /// Two folder names that differ only in bytes that are not UTF-8 were both `\u{fffd}a`: one
+    /// "not graded: File exists" and two rows no one could tell apart. They are rows of their
+    /// own, named with `\xNN`; a name that clashes once written so is an error row that says so.
+    #[test]
+    fn folder_names_that_are_not_utf8_stay_apart_and_a_clash_is_an_error_row() {
+        use std::os::unix::ffi::OsStrExt;
+        let dir = tempfile::tempdir().unwrap();
+        let raw: [&[u8]; 4] = [b"\xffa", b"\xfea", b"\xfdb", b"\\xfdb"];
+        for name in raw {
+            let path = dir.path().join(std::ffi::OsStr::from_bytes(name));
+            std::fs::create_dir(&path).unwrap();
+            fake_images(&path);
+        }
+        let code = FakeCode::new(counts(2, 2), counts(2, 2));
+        let out = dir.path().join("out");
+        let entries = grade_batch(
+            dir.path(),
+            &Rubric::week04(),
+            &code,
+            &all_pass(),
+            &out,
+            &[Format::Json],
+        )
+        .unwrap();
+        let rows: Vec<(&str, bool)> = entries
+            .iter()
+            .map(|e| (e.name.as_str(), e.result.is_ok()))
+            .collect();
+        assert_eq!(
+            rows,
+            [
+                ("\\xfdb", false),
+                ("\\xfdb", false),
+                ("\\xfea", true),
+                ("\\xffa", true),
+            ],
+            "sorted by their bytes"
+        );
+        for name in ["\\xffa", "\\xfea"] {
+            assert!(out.join(name).join("report.json").is_file(), "{name}");
+        }
+        let err = entries[0].result.as_ref().unwrap_err();
+        assert!(
+            err.contains("2 submission folders have this name once their bytes"),
+            "{err}"
         );
     }
 }

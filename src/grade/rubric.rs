@@ -5,6 +5,8 @@
 //! name = "week04"
 //! seed = 0                       # seed of the vector suite
 //! code_time_budget_seconds = 60  # wall time for all of a submission's code checks
+//! memory_limit_mib = 1024        # memory its code may hold: processes, shared memory
+//! file_limit_mib = 64            # files its code may keep (its folder, its /tmp)
 //! python_requires = ["numpy", "PIL"]  # modules the grader's Python must have (the default)
 //!
 //! [[group]]
@@ -329,6 +331,15 @@ pub struct Rubric {
     /// the course's `RT_utility.py` imports); `grade` exits 2 when no interpreter has them.
     #[serde(default = "crate::candidate::python::default_requires")]
     pub python_requires: Vec<String>,
+    /// MiB of memory a submission's code may hold, all its processes and its shared memory
+    /// together: past it the sandbox stops the code, the report says why, and the grade of what
+    /// ran before stands.
+    #[serde(default = "default_memory_limit_mib")]
+    pub memory_limit_mib: u64,
+    /// MiB of files its code may keep (its folder and its `/tmp`, which is in the host's
+    /// memory where the sandbox has a view of its own), stopped as for memory.
+    #[serde(default = "default_file_limit_mib")]
+    pub file_limit_mib: u64,
     /// The groups, in report order.
     #[serde(rename = "group")]
     pub groups: Vec<Group>,
@@ -342,6 +353,26 @@ pub struct Rubric {
 
 fn default_code_time_budget() -> f64 {
     60.0
+}
+
+fn default_memory_limit_mib() -> u64 {
+    crate::sandbox::SandboxPolicy::grading().memory_bytes >> 20
+}
+
+fn default_file_limit_mib() -> u64 {
+    crate::sandbox::SandboxPolicy::grading().disk_bytes >> 20
+}
+
+impl Rubric {
+    /// The sandbox's limits for this rubric's submissions: `grade`'s, with its memory and file
+    /// limits.
+    pub fn sandbox_policy(&self) -> crate::sandbox::SandboxPolicy {
+        crate::sandbox::SandboxPolicy {
+            memory_bytes: self.memory_limit_mib << 20,
+            disk_bytes: self.file_limit_mib << 20,
+            ..crate::sandbox::SandboxPolicy::grading()
+        }
+    }
 }
 
 /// Why a rubric cannot be used (one line, naming the file).
@@ -555,6 +586,16 @@ impl Rubric {
             return Err(self.invalid(format!(
                 "code_time_budget_seconds = {budget}: it must be more than 0 and at most 86400"
             )));
+        }
+        for (key, mib, most) in [
+            ("memory_limit_mib", self.memory_limit_mib, 65_536),
+            ("file_limit_mib", self.file_limit_mib, 16_384),
+        ] {
+            if !(16..=most).contains(&mib) {
+                return Err(self.invalid(format!(
+                    "{key} = {mib}: it must be at least 16 and at most {most}"
+                )));
+            }
         }
         let mut ids = BTreeSet::new();
         for g in &self.groups {

@@ -6,6 +6,8 @@ use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use super::ipc::Limits as IpcLimits;
+
 /// The harness's side of one bubblewrap start: the descriptors bubblewrap is given, and the
 /// harness's copies of them, which must live until the command is spawned and then close.
 #[derive(Debug)]
@@ -19,19 +21,28 @@ pub(super) struct Admission {
     pub _held: (OwnedFd, OwnedFd),
 }
 
+/// The limits set on a bubblewrap sandbox's first process before it goes on.
+#[derive(Debug)]
+pub(super) struct Limits {
+    /// `RLIMIT_NPROC` (a harness that is not root: see [`admit`]).
+    pub processes: Option<u64>,
+    /// Written inside its IPC namespace (a root harness: only root may write them there).
+    pub ipc: Option<IpcLimits>,
+}
+
 /// Starts the admission of one bubblewrap command ([`admit`] on a thread of its own), filling
 /// `slot` with what bubblewrap reports; `None` when its pipes or its thread cannot be made (the
 /// command must then fail: its processes could not be limited).
 pub(super) fn start(
     slot: Arc<InfoSlot>,
-    processes: Option<u64>,
+    limits: Limits,
     namespaces: Arc<Mutex<Vec<u64>>>,
 ) -> Option<Admission> {
     let (info_read, info_write) = cloexec_pipe().ok()?;
     let (block_read, block_write) = cloexec_pipe().ok()?;
     std::thread::Builder::new()
         .name("sandbox-admit".into())
-        .spawn(move || admit(info_read, block_write, slot, processes, namespaces))
+        .spawn(move || admit(info_read, block_write, slot, limits, namespaces))
         .ok()?;
     Some(Admission {
         info_fd: info_write.as_raw_fd(),
@@ -72,14 +83,17 @@ impl InfoSlot {
 /// sandbox's alone), and only then writes to its `--block-fd`. Where the limit cannot be set the
 /// process is killed (fail closed). A per-submission uid got the limit before bubblewrap (its
 /// processes are the sandbox's alone), and a root harness may lack `CAP_SYS_RESOURCE` (Docker
-/// drops it) to set another uid's.
+/// drops it) to set another uid's. A root harness also writes the limits of the sandbox's IPC
+/// namespace from inside it (this thread enters it, and ends soon after); where they cannot be
+/// written the watchdog still counts what the namespace holds.
 fn admit(
     info: OwnedFd,
     block: OwnedFd,
     slot: Arc<InfoSlot>,
-    processes: Option<u64>,
+    limits: Limits,
     namespaces: Arc<Mutex<Vec<u64>>>,
 ) {
+    let processes = limits.processes;
     let text = read_with_timeout(info, Duration::from_secs(10));
     let value: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
     let child = value["child-pid"]
@@ -91,6 +105,9 @@ fn admit(
         list.push(ns);
     }
     if let Some(pid) = child {
+        if let Some(ipc) = &limits.ipc {
+            let _ = ipc.write_for(pid);
+        }
         // SAFETY: plain system calls on a process bubblewrap just made and holds waiting.
         unsafe {
             let limited = processes.is_none_or(|n| {

@@ -2,11 +2,12 @@
 //! own session, no inherited descriptors, the fallback's namespaces and read-only view, the
 //! limits, the identity, and death with the harness.
 
-use std::ffi::CString;
-use std::path::Path;
-
+use super::ipc::Limits as IpcLimits;
+use super::pivot::ViewPlan;
 use super::policy::SandboxPolicy;
-use super::scratch;
+
+/// `RLIMIT_MSGQUEUE`: the bytes of POSIX message queues the code's user may hold.
+const MSGQUEUE_BYTES: u64 = 1 << 20;
 
 /// Everything the child's set-up needs, made before the fork (after it, nothing may allocate).
 #[derive(Debug)]
@@ -14,59 +15,44 @@ pub(super) struct ChildSetup {
     policy: SandboxPolicy,
     /// `(uid, gid)` to switch to.
     switch_to: Option<(u32, u32)>,
-    /// The fallback's namespaces and view are attempted.
-    fallback: bool,
-    /// A network namespace is attempted.
-    unshare_net: bool,
+    /// The fallback's namespaces are attempted, and its view where a mount namespace is made.
+    fallback: Option<Fallback>,
     /// Descriptors the child keeps open (bubblewrap's pipes); every other one but 0, 1, 2 closes.
     keep: Vec<i32>,
-    /// The grader's binary, covered with `/dev/null` in the fallback's mount namespace.
-    hide_exe: Option<CString>,
-    /// The mounts made writable again in the fallback's read-only view.
-    writable: Vec<CString>,
-    /// The sandbox folder (the working directory).
-    own_dir: Option<CString>,
+    /// The `cgroup.procs` of the sandbox's cgroup, joined first (while the path is still there).
+    cgroup: Option<std::ffi::CString>,
     /// The harness's pid, to notice it died before the parent-death signal was armed.
     parent: libc::pid_t,
 }
 
+/// What the fallback's child attempts: namespaces, the limits of its IPC namespace, its view.
+#[derive(Debug)]
+pub(super) struct Fallback {
+    /// A network namespace too.
+    pub network: bool,
+    /// Written inside its new IPC namespace.
+    pub ipc: IpcLimits,
+    /// Made in its new mount namespace.
+    pub view: ViewPlan,
+}
+
 impl ChildSetup {
-    /// The set-up of a child of the sandbox whose folder is `dir`: under `policy`, switching to
-    /// `switch_to`, with the fallback's namespaces when `fallback`, keeping `keep` open.
+    /// The set-up of a child under `policy`, switching to `switch_to`, with the fallback's
+    /// namespaces when `fallback`, keeping `keep` open, joining the cgroup whose `cgroup.procs`
+    /// is `cgroup`.
     pub(super) fn new(
         policy: &SandboxPolicy,
         switch_to: Option<(u32, u32)>,
-        fallback: bool,
-        dir: &Path,
+        fallback: Option<Fallback>,
         keep: Vec<i32>,
+        cgroup: Option<std::ffi::CString>,
     ) -> ChildSetup {
-        // The fallback's own view where a mount namespace can be made: a `/proc` that shows
-        // only the code's processes (`hidepid=2`), and the grader's binary as an empty file.
-        let hide_exe = std::env::current_exe()
-            .ok()
-            .and_then(|p| CString::new(p.into_os_string().into_encoded_bytes()).ok());
-        // ... and the host read-only but the sandbox folder and the shared folders (`/tmp`, ...:
-        // where the watchdog measures and the sweep cleans what the uid writes).
-        let mut writable: Vec<CString> = scratch::SHARED_ROOTS
-            .iter()
-            .filter(|r| Path::new(r).is_dir())
-            .filter_map(|r| CString::new(*r).ok())
-            .collect();
-        let own_dir = CString::new(dir.as_os_str().as_encoded_bytes()).ok();
-        if let Some(d) = &own_dir
-            && !scratch::SHARED_ROOTS.iter().any(|r| dir.starts_with(r))
-        {
-            writable.push(d.clone());
-        }
         ChildSetup {
             policy: policy.clone(),
             switch_to,
             fallback,
-            unshare_net: fallback && policy.isolate_network,
             keep,
-            hide_exe,
-            writable,
-            own_dir,
+            cgroup,
             parent: std::process::id() as libc::pid_t,
         }
     }
@@ -77,14 +63,22 @@ impl ChildSetup {
     ///
     /// # Safety
     /// Only in the child between `fork` and `exec` (`pre_exec`): it makes only
-    /// async-signal-safe system calls (setsid, unshare, mount, mount_setattr, chdir,
-    /// setrlimit, setgroups, setgid, setuid, prctl, getppid, fcntl, close_range) and
-    /// allocates nothing.
+    /// async-signal-safe system calls (setsid, open, write, close, unshare, mount,
+    /// mount_setattr, pivot_root, chdir, setrlimit, setgroups, setgid, setuid, prctl, getppid,
+    /// fcntl, close_range) and allocates nothing.
     pub(super) unsafe fn run(&self) -> std::io::Result<()> {
         // SAFETY: the caller's contract; each call is a plain system call on owned data.
         unsafe {
             if libc::setsid() < 0 {
                 return Err(std::io::Error::last_os_error());
+            }
+            if let Some(procs) = &self.cgroup {
+                // Best effort: the facts say whether the code was seen in it.
+                let fd = libc::open(procs.as_ptr(), libc::O_WRONLY | libc::O_CLOEXEC);
+                if fd >= 0 {
+                    libc::write(fd, b"0".as_ptr().cast(), 1);
+                    libc::close(fd);
+                }
             }
             // Every inherited descriptor but 0, 1, 2 (and bubblewrap's pipes) closes on exec: a
             // descriptor the harness inherited must not reach the code.
@@ -98,13 +92,8 @@ impl ChildSetup {
                 libc::fcntl(fd, libc::F_SETFD, 0);
             }
             #[cfg(target_os = "linux")]
-            if self.unshare_net {
-                // Best effort: fails without CAP_SYS_ADMIN, which the facts show.
-                let _ = libc::unshare(libc::CLONE_NEWNET);
-            }
-            #[cfg(target_os = "linux")]
-            if self.fallback {
-                self.fallback_view();
+            if let Some(fallback) = &self.fallback {
+                fallback.apply()?;
             }
             self.set_limits();
             if let Some((uid, gid)) = self.switch_to {
@@ -129,80 +118,6 @@ impl ChildSetup {
         Ok(())
     }
 
-    /// The fallback's namespaces, each best effort and verified by the facts: an IPC namespace
-    /// (System V objects die with it), and a mount namespace whose mounts never reach the
-    /// host's (made private first, or nothing is mounted), with a `/proc` mounted `hidepid=2`,
-    /// the grader's binary covered, every mount read-only (`mount_setattr`, Linux 5.12) but the
-    /// folder and the shared folders, made writable again at their own paths, and the working
-    /// directory moved onto those mounts.
-    ///
-    /// # Safety
-    /// As [`ChildSetup::run`].
-    #[cfg(target_os = "linux")]
-    unsafe fn fallback_view(&self) {
-        // SAFETY: the caller's contract; each call is a plain system call on owned data.
-        unsafe {
-            let _ = libc::unshare(libc::CLONE_NEWIPC);
-            let null = std::ptr::null::<libc::c_char>();
-            if libc::unshare(libc::CLONE_NEWNS) != 0
-                || libc::mount(
-                    null,
-                    c"/".as_ptr(),
-                    null,
-                    libc::MS_REC | libc::MS_PRIVATE,
-                    std::ptr::null(),
-                ) != 0
-            {
-                return;
-            }
-            libc::mount(
-                c"proc".as_ptr(),
-                c"/proc".as_ptr(),
-                c"proc".as_ptr(),
-                libc::MS_NOSUID | libc::MS_NODEV | libc::MS_NOEXEC,
-                c"hidepid=2".as_ptr().cast(),
-            );
-            if let Some(exe) = &self.hide_exe {
-                libc::mount(
-                    c"/dev/null".as_ptr(),
-                    exe.as_ptr(),
-                    null,
-                    libc::MS_BIND,
-                    std::ptr::null(),
-                );
-            }
-            let Some(dir) = &self.own_dir else {
-                return;
-            };
-            const MOUNT_ATTR_RDONLY: u64 = 1;
-            let attr: [u64; 4] = [MOUNT_ATTR_RDONLY, 0, 0, 0];
-            if libc::syscall(
-                libc::SYS_mount_setattr,
-                libc::AT_FDCWD,
-                c"/".as_ptr(),
-                libc::AT_RECURSIVE as libc::c_uint,
-                attr.as_ptr(),
-                std::mem::size_of_val(&attr),
-            ) != 0
-            {
-                return;
-            }
-            for path in &self.writable {
-                let p = path.as_ptr();
-                if libc::mount(p, p, null, libc::MS_BIND | libc::MS_REC, std::ptr::null()) == 0 {
-                    libc::mount(
-                        null,
-                        p,
-                        null,
-                        libc::MS_REMOUNT | libc::MS_BIND | libc::MS_NOSUID | libc::MS_NODEV,
-                        std::ptr::null(),
-                    );
-                }
-            }
-            libc::chdir(dir.as_ptr());
-        }
-    }
-
     /// CPU time, address space, open files, file size, no core files.
     fn set_limits(&self) {
         let p = &self.policy;
@@ -211,6 +126,48 @@ impl ChildSetup {
         limit(libc::RLIMIT_NOFILE, p.open_files);
         limit(libc::RLIMIT_FSIZE, p.file_size_bytes);
         limit(libc::RLIMIT_CORE, 0);
+        limit(libc::RLIMIT_MSGQUEUE, MSGQUEUE_BYTES);
+    }
+}
+
+impl Fallback {
+    /// The fallback's namespaces, each best effort and verified by the facts: a network
+    /// namespace (when asked), an IPC namespace (System V objects die with it) with its limits
+    /// written, and a mount namespace whose mounts never reach the host's (made private first)
+    /// holding the sandbox's own view. Once a mount namespace is made, its view must be made
+    /// whole, or the code does not run.
+    ///
+    /// # Safety
+    /// As [`ChildSetup::run`].
+    #[cfg(target_os = "linux")]
+    unsafe fn apply(&self) -> std::io::Result<()> {
+        // SAFETY: the caller's contract; each call is a plain system call on owned data.
+        unsafe {
+            if self.network {
+                // Fails without CAP_SYS_ADMIN, which the facts show.
+                let _ = libc::unshare(libc::CLONE_NEWNET);
+            }
+            if libc::unshare(libc::CLONE_NEWIPC) == 0 {
+                // Written before the mounts (which make `/proc` read-only); the watchdog counts
+                // what a namespace whose limits could not be written holds.
+                let _ = self.ipc.write_in_child();
+            }
+            let null = std::ptr::null::<libc::c_char>();
+            if libc::unshare(libc::CLONE_NEWNS) != 0 {
+                return Ok(());
+            }
+            if libc::mount(
+                null,
+                c"/".as_ptr(),
+                null,
+                libc::MS_REC | libc::MS_PRIVATE,
+                std::ptr::null(),
+            ) != 0
+            {
+                return Err(std::io::Error::last_os_error());
+            }
+            self.view.apply()
+        }
     }
 }
 

@@ -11,9 +11,13 @@ use std::sync::Arc;
 
 use super::admission::{self, InfoSlot};
 use super::bwrap;
-use super::child::ChildSetup;
+use super::child::{ChildSetup, Fallback};
+use super::identity::running_as_root;
+use super::ipc::Limits as IpcLimits;
 use super::lifecycle::Sandbox;
+use super::pivot::ViewPlan;
 use super::policy::Isolation;
+use super::view::{self, View};
 
 /// The `PATH` inside the sandbox (the harness's own `PATH` may lead to a root-only Python).
 pub const SANDBOX_PATH: &str = "/usr/local/bin:/usr/bin:/bin";
@@ -56,6 +60,14 @@ impl Sandbox {
         env
     }
 
+    /// What the code sees of the host where it has a view of its own: the exposed paths and
+    /// `program`'s, with the rtoracle binaries among them covered.
+    fn view_of(&self, program: &Path) -> View {
+        let mut exposed = self.exposed.clone();
+        exposed.extend(view::exposure(program));
+        View::new(exposed)
+    }
+
     /// A command for `program` that runs inside the sandbox: under bubblewrap (`bwrap ...
     /// program`) or directly, with the folder as working directory, a cleared environment, its
     /// own session and process group, the limits and the identity. A bare program name is looked
@@ -73,13 +85,21 @@ impl Sandbox {
                 (cmd, Vec::new())
             }
         };
-        let setup = ChildSetup::new(
-            &self.policy,
-            self.switch_to,
-            self.isolation == Isolation::FallbackUid,
-            self.dir(),
-            keep,
-        );
+        let fallback = match (self.isolation, &self.view_root) {
+            (Isolation::FallbackUid, Some(root)) => Some(Fallback {
+                network: self.policy.isolate_network,
+                ipc: IpcLimits::for_memory(self.policy.memory_bytes),
+                view: ViewPlan::new(
+                    &self.view_of(program),
+                    self.dir(),
+                    root.path(),
+                    self.policy.tmp_bytes(),
+                ),
+            }),
+            _ => None,
+        };
+        let cgroup = self.cgroup.as_ref().map(|g| g.procs_file().clone());
+        let setup = ChildSetup::new(&self.policy, self.switch_to, fallback, keep, cgroup);
         // SAFETY: `run` is made for this place (see its contract): it only makes
         // async-signal-safe system calls and allocates nothing.
         unsafe {
@@ -98,31 +118,30 @@ impl Sandbox {
     ) -> (Command, Vec<i32>) {
         let bwrap = bwrap::program().unwrap_or_else(|| PathBuf::from("/usr/bin/bwrap"));
         let mut cmd = Command::new(bwrap);
-        let mut exposed = self.exposed.clone();
-        for p in bwrap::exposure(program) {
-            if !exposed.contains(&p) {
-                exposed.push(p);
-            }
-        }
+        let view = self.view_of(program);
         let (uid, gid) = self.switch_to.unwrap_or_else(|| {
             // SAFETY: getuid and getgid have no preconditions.
             unsafe { (libc::getuid(), libc::getgid()) }
         });
         let slot = Arc::new(InfoSlot::default());
-        let processes = self.switch_to.is_none().then_some(self.policy.processes);
-        let admission = admission::start(slot.clone(), processes, self.pid_namespaces.clone());
+        let limits = admission::Limits {
+            processes: self.switch_to.is_none().then_some(self.policy.processes),
+            ipc: running_as_root().then(|| IpcLimits::for_memory(self.policy.memory_bytes)),
+        };
+        let admission = admission::start(slot.clone(), limits, self.pid_namespaces.clone());
         if admission.is_some() {
             *self.info.lock().unwrap_or_else(|e| e.into_inner()) = Some(slot);
         }
-        let words = bwrap::args(
-            self.dir(),
+        let words = bwrap::args(&bwrap::Args {
+            dir: self.dir(),
             uid,
             gid,
-            &exposed,
+            view: &view,
+            tmp_bytes: self.policy.tmp_bytes(),
             env,
-            admission.as_ref().map(|a| a.info_fd),
-            admission.as_ref().map(|a| a.block_fd),
-        );
+            info_fd: admission.as_ref().map(|a| a.info_fd),
+            block_fd: admission.as_ref().map(|a| a.block_fd),
+        });
         // The options go through a pipe (`--args FD`), so the sandbox's `/proc/1/cmdline` shows
         // none of the host's paths.
         let args_read = args_pipe(&words);

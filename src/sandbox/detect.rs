@@ -95,6 +95,7 @@ pub fn isolation_for(policy: &SandboxPolicy) -> Result<Isolation, SandboxError> 
                 SandboxError::Unavailable(format!("RTORACLE_SANDBOX=bubblewrap: {why}"))
             }),
         Mode::Uid => fallback("RTORACLE_SANDBOX=uid".into()),
+        Mode::UidBare => fallback("RTORACLE_SANDBOX=uid-bare".into()),
         Mode::None if root => Err(SandboxError::Unavailable(
             "RTORACLE_SANDBOX=none: no sandbox may be made, and untrusted code never runs as root"
                 .into(),
@@ -115,6 +116,11 @@ impl Sandbox {
             Isolation::FallbackUid | Isolation::CurrentUser => bubblewrap_works().err(),
             _ => None,
         };
-        Sandbox::with_isolation(policy, isolation, files, note)
+        let mut sandbox = Sandbox::with_isolation(policy, isolation, files, note)?;
+        if Mode::from_env() == Ok(Mode::UidBare) {
+            // No namespace at all: no view to mount a root on.
+            sandbox.view_root = None;
+        }
+        Ok(sandbox)
     }
 }

@@ -29,6 +29,10 @@ pub struct SandboxFacts {
     pub note: Option<String>,
     /// Whether the candidate was seen in a network namespace of its own (`None`: not verified).
     pub network_isolated: Option<bool>,
+    /// The code's cgroup v2 and its limits, where cgroups are delegated and the code was seen
+    /// in it (absent otherwise: the other limits hold alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cgroup: Option<String>,
     /// Files of the submission not copied into the sandbox, each named (control characters
     /// escaped) with why: links, FIFOs, devices, files over the size caps.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -89,6 +93,13 @@ pub fn announce_on_stderr() {
     ANNOUNCE.store(true, Ordering::SeqCst);
 }
 
+/// Prints `line` (already escaped) on stderr when [`announce_on_stderr`] was called.
+pub fn say(line: &str) {
+    if ANNOUNCE.load(Ordering::SeqCst) {
+        crate::output::stderr_line(line);
+    }
+}
+
 /// Prints `facts` once per process when [`announce_on_stderr`] was called.
 pub fn announce(facts: &SandboxFacts) {
     if ANNOUNCE.load(Ordering::SeqCst) && !ANNOUNCED.swap(true, Ordering::SeqCst) {
@@ -142,7 +153,19 @@ impl Sandbox {
             )),
             _ => self.note.clone(),
         };
+        let cgroup = match (&self.cgroup, child) {
+            (Some(group), Some(pid)) if group.holds(pid) => Some(format!(
+                "{} (memory.max {}, cpu.weight {})",
+                group.path().display(),
+                std::fs::read_to_string(group.path().join("memory.max"))
+                    .unwrap_or_default()
+                    .trim(),
+                super::cgroup::CPU_WEIGHT
+            )),
+            _ => None,
+        };
         SandboxFacts {
+            cgroup,
             policy: self.policy.clone(),
             isolation: self.isolation,
             namespaces,

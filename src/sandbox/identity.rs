@@ -38,6 +38,11 @@ const BASE: u32 = 1 << 30;
 
 static COUNTER: AtomicU32 = AtomicU32::new(0);
 
+/// Whether `uid` is in the range [`allocate`] hands out: a sandbox's identity.
+pub fn is_sandbox_uid(uid: u32) -> bool {
+    (BASE..1u32 << 31).contains(&uid)
+}
+
 /// Whether `uid` has a `passwd` entry.
 fn has_account(uid: u32) -> bool {
     // SAFETY: getpwuid returns a pointer to static storage or null; only its nullness is read.

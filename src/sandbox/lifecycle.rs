@@ -11,7 +11,7 @@ use super::admission::InfoSlot;
 use super::identity::{self, running_as_root};
 use super::policy::{Isolation, SandboxError, SandboxPolicy};
 use super::reaper::Reaper;
-use super::{bwrap, scratch};
+use super::{bwrap, cgroup, held, ipc, scratch, view, watchdog};
 
 /// A prepared sandbox: a temporary folder holding copies of the files, the policy, the
 /// isolation and the identity the code runs as.
@@ -22,8 +22,13 @@ pub struct Sandbox {
     pub(super) dir: Option<tempfile::TempDir>,
     /// `(uid, gid)` to switch to (a per-submission id of a root harness).
     pub(super) switch_to: Option<(u32, u32)>,
-    /// Paths shown read-only inside bubblewrap besides the system view.
+    /// Paths shown read-only in the sandbox's view besides the system view.
     pub(super) exposed: Vec<PathBuf>,
+    /// The empty folder the fallback's child mounts its new root on; `None` where the fallback
+    /// makes no namespace (`RTORACLE_SANDBOX=uid-bare`) or another isolation is used.
+    pub(super) view_root: Option<tempfile::TempDir>,
+    /// The code's cgroup, where cgroups v2 are delegated (dropped after the code is ended).
+    pub(super) cgroup: Option<cgroup::Group>,
     /// What bubblewrap reports (`--info-fd`) for the last command, filled by its admission.
     pub(super) info: Mutex<Option<Arc<InfoSlot>>>,
     /// The PID namespaces of the bubblewrap sandboxes started so far (their processes are the
@@ -33,7 +38,7 @@ pub struct Sandbox {
     pub(super) note: Option<String>,
     pub(super) skipped: Vec<String>,
     /// Measures what the code writes (dropped, and so stopped, before the folder is removed).
-    pub(super) watchdog: Option<scratch::Watchdog>,
+    pub(super) watchdog: Option<watchdog::Watchdog>,
     pub(super) _cleanup: crate::interrupt::CleanupGuard,
 }
 
@@ -108,53 +113,79 @@ impl Sandbox {
             std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o644))
                 .map_err(io)?;
         }
-        let tmp = dir.path().join(scratch::TMP_DIR);
-        std::fs::create_dir(&tmp).map_err(io)?;
-        for folder in [&tmp, &dir.path().to_path_buf()] {
-            std::fs::set_permissions(folder, std::fs::Permissions::from_mode(0o700)).map_err(io)?;
-            if let Some((uid, gid)) = switch_to {
-                std::os::unix::fs::chown(folder, Some(uid), Some(gid)).map_err(io)?;
-            }
+        std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o700)).map_err(io)?;
+        if let Some((uid, gid)) = switch_to {
+            std::os::unix::fs::chown(dir.path(), Some(uid), Some(gid)).map_err(io)?;
         }
+        // The fallback's child mounts its new root on an empty folder of the harness's.
+        let view_root = match isolation {
+            Isolation::FallbackUid => Some(
+                tempfile::Builder::new()
+                    .prefix("rtoracle-view-")
+                    .tempdir()
+                    .map_err(io)?,
+            ),
+            _ => None,
+        };
+        // Where cgroups are not delegated (or the group cannot be made) the other limits hold
+        // alone, and the facts name no cgroup.
+        let cgroup = cgroup::delegation().ok().and_then(|base| {
+            cgroup::Group::make(
+                base,
+                policy.memory_bytes,
+                policy.tmp_bytes(),
+                policy.processes,
+            )
+            .ok()
+        });
         let reaper = Reaper {
             uid: switch_to.map(|s| s.0),
             groups: Arc::new(Mutex::new(Vec::new())),
+            cgroup: cgroup.as_ref().map(|g| g.path().to_path_buf()),
         };
         let cleanup = {
             let reaper = reaper.clone();
             let path = dir.path().to_path_buf();
+            let root = view_root.as_ref().map(|r| r.path().to_path_buf());
             crate::interrupt::on_interrupt(move || {
                 reaper.reap();
+                if let Some(group) = &reaper.cgroup {
+                    cgroup::remove(group);
+                }
                 if let Some(uid) = reaper.uid {
                     scratch::sweep(uid);
-                    scratch::sweep_ipc(uid);
+                    ipc::sweep_ipc(uid);
                 }
                 remove_tree(&path);
+                if let Some(root) = &root {
+                    let _ = std::fs::remove_dir(root);
+                }
             })
         };
         let pid_namespaces = Arc::new(Mutex::new(Vec::new()));
         let members = match (reaper.uid, isolation) {
-            (Some(uid), _) => scratch::Members::Uid(uid),
-            (None, Isolation::Bubblewrap) => {
-                scratch::Members::PidNamespaces(pid_namespaces.clone())
-            }
-            (None, _) => scratch::Members::Sessions(reaper.groups.clone()),
+            (Some(uid), _) => held::Members::Uid(uid),
+            (None, Isolation::Bubblewrap) => held::Members::PidNamespaces(pid_namespaces.clone()),
+            (None, _) => held::Members::Sessions(reaper.groups.clone()),
         };
-        let watchdog = scratch::Watchdog::start(
+        let watchdog = watchdog::Watchdog::start(
             dir.path().to_path_buf(),
             members,
-            scratch::Limits {
+            watchdog::Limits {
                 disk_bytes: policy.disk_bytes,
                 memory_bytes: policy.memory_bytes,
             },
             reaper.clone(),
         );
+        let exposed = policy.shown.clone();
         Ok(Sandbox {
             policy,
             isolation,
             dir: Some(dir),
             switch_to,
-            exposed: Vec::new(),
+            exposed,
+            view_root,
+            cgroup,
             info: Mutex::new(None),
             pid_namespaces,
             reaper,
@@ -203,12 +234,12 @@ impl Sandbox {
         self.switch_to.is_some()
     }
 
-    /// Why the code was stopped for what it wrote ([`scratch::Watchdog`]), if it was: then
+    /// Why the code was stopped for what it wrote ([`watchdog::Watchdog`]), if it was: then
     /// nothing more should be started in this sandbox.
     pub fn violation(&self) -> Option<String> {
         self.watchdog
             .as_ref()
-            .and_then(scratch::Watchdog::violation)
+            .and_then(watchdog::Watchdog::violation)
     }
 
     /// What ends the code's processes (for a restart or the end of a session).
@@ -224,16 +255,54 @@ impl Sandbox {
         Ok(path)
     }
 
+    /// Whether the code has a view of its own (bubblewrap's, or the fallback's where it makes a
+    /// mount namespace) that shows only some folders of the host.
+    pub fn has_view(&self) -> bool {
+        match self.isolation {
+            Isolation::Bubblewrap => true,
+            Isolation::FallbackUid => self.view_root.is_some(),
+            _ => false,
+        }
+    }
+
+    /// When a program of the sandbox failed to find a file (`stderr` says "No such file or
+    /// directory" or "not found") and the sandbox has a view: that the view shows only some
+    /// folders, which, and how to show another.
+    pub fn view_hint(&self, stderr: &str) -> Option<String> {
+        let missing = ["No such file or directory", "not found"]
+            .iter()
+            .any(|m| stderr.contains(m));
+        if !missing || !self.has_view() {
+            return None;
+        }
+        let shown: Vec<String> = self
+            .exposed
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        Some(format!(
+            "the sandbox shows only the system's folders and the folders of the files on the \
+             command line ({}): a program started from elsewhere is not there; pass \
+             --expose FOLDER to show a folder read-only",
+            if shown.is_empty() {
+                "none".to_string()
+            } else {
+                shown.join(", ")
+            }
+        ))
+    }
+
     /// Records the files of the submission that were not copied in, each named (escaped) with
     /// why, for the facts.
     pub fn set_skipped(&mut self, skipped: Vec<String>) {
         self.skipped = skipped;
     }
 
-    /// Shows `path` read-only inside bubblewrap (see [`bwrap::exposure`]: its folder, or the
-    /// file alone in a shared folder). Other modes see the host anyway.
+    /// Shows `path` read-only inside the sandbox's view (see [`view::exposure`]: its folder,
+    /// an interpreter's library tree, or the file alone in a shared folder). Without a view
+    /// (the fallback without a mount namespace) the code sees the host anyway.
     pub fn expose(&mut self, path: &Path) {
-        for p in bwrap::exposure(path) {
+        for p in view::exposure(path) {
             if !self.exposed.contains(&p) {
                 self.exposed.push(p);
             }
@@ -247,7 +316,7 @@ impl Drop for Sandbox {
         self.reaper.reap();
         if let Some(uid) = self.reaper.uid {
             scratch::sweep(uid);
-            scratch::sweep_ipc(uid);
+            ipc::sweep_ipc(uid);
         }
         if let Some(dir) = self.dir.take() {
             let path = dir.path().to_path_buf();
@@ -255,5 +324,7 @@ impl Drop for Sandbox {
                 remove_tree(&path);
             }
         }
+        // Killed and removed once empty.
+        self.cgroup = None;
     }
 }

@@ -15,53 +15,62 @@
 //!   is probed once per process (it fails in containers that refuse user namespaces). The code
 //!   runs in new user, PID, mount, IPC, network, UTS (and cgroup, where allowed) namespaces, with
 //!   `--die-with-parent`, `--new-session`, `--disable-userns`, `--cap-drop ALL`, a cleared
-//!   environment and a minimal read-only view ([`bwrap`]): the system's `/usr` and `/lib*`, the
-//!   loader's `/etc` files, a read-only `/dev`, the sandbox folder at `/sandbox` (its `.tmp` is
-//!   the code's `/tmp`: [`scratch`]), and
-//!   for an `--adapter` its program's and its files' folders. Nothing of the grader is visible:
-//!   not its binary, the rubric, the vectors, the reports, the batch folder, another submission,
-//!   `/root` or `/home`. bubblewrap itself runs as the submission's uid (the switch happens before
-//!   it is executed), so even outside its user namespace the code is that uid.
-//! - **A fallback where no namespace can be made** ([`Isolation::FallbackUid`], root only): the
+//!   environment and a view of its own ([`view`], [`bwrap`]): the system's `/usr` and `/lib*`,
+//!   the loader's `/etc` files, a read-only `/dev`, a `/tmp` that is a tmpfs of bounded size, the
+//!   sandbox folder at `/sandbox`, and the paths exposed read-only (an interpreter and its
+//!   library tree; for an `--adapter` its program's and its files' folders, and those
+//!   `--expose` names). Its root is read-only. Nothing of the grader is visible: not its binary,
+//!   the rubric, the vectors, the reports, the batch folder, another submission, `/root` or
+//!   `/home`. bubblewrap itself runs as the submission's uid (the switch happens before it is
+//!   executed), so even outside its user namespace the code is that uid.
+//! - **A fallback where bubblewrap cannot run** ([`Isolation::FallbackUid`], root only): the
 //!   limits, its own session, the per-submission uid and gid, with the sandbox folder owned by
 //!   that uid, mode `0700`, and, each where the kernel allows it (attempted, verified from
-//!   `/proc/<pid>/ns`, never assumed): a network namespace, an IPC namespace (System V objects
-//!   die with it; they are swept by owner where it cannot be made), and a private mount
-//!   namespace whose `/proc` is mounted `hidepid=2` (the code sees only its own processes: not
-//!   the grader's command line, which names its binary, rubric and folders), whose grader
-//!   binary is covered with `/dev/null` (the code found it in `/proc/*/cmdline` and ran
-//!   `rtoracle explain` as an oracle), and where every mount is read-only but the sandbox
-//!   folder and the shared folders the watchdog measures and the sweep cleans (`/tmp`,
-//!   `/var/tmp`, `/dev/shm`, ...): it could write a classmate's world-writable submission. [`Isolation::CurrentUser`] is the same without the uid
-//!   switch and the namespaces, for a harness that is not root. Without namespaces the code can
-//!   see the host's world-readable files and processes; bubblewrap is what hides them.
+//!   `/proc/<pid>/ns`, never assumed): a network namespace, an IPC namespace with its limits
+//!   ([`ipc`]; System V objects die with it, and are swept by owner where it cannot be made),
+//!   and a mount namespace in which the child builds the same view as bubblewrap's on a new root
+//!   (`pivot_root`, `pivot`), with a `/proc` mounted `hidepid=2` (the code sees only its own
+//!   processes: not the grader's command line, which names its binary, rubric and folders).
+//!   Where no namespace can be made (`RTORACLE_SANDBOX=uid-bare`) the code sees the host's
+//!   world-readable files and processes: what it must not read is made unreadable by others
+//!   while `grade` runs ([`keep_from_sandboxes`]), and no rtoracle binary runs for it
+//!   ([`oracles::refusal`]). [`Isolation::CurrentUser`] is the fallback without the uid switch
+//!   and the namespaces, for a harness that is not root.
 //! - **Limits** in every mode, set with `setrlimit` between `fork` and `exec` (inherited through
-//!   bubblewrap): CPU time, address space, open files, file size, no core files, and a process
-//!   count (threads included) for a per-submission uid. Under bubblewrap the count holds for any
-//!   harness: bubblewrap's first process waits (`--block-fd`) until the harness has set
-//!   `RLIMIT_NPROC` on it, which inside its own user namespace counts the sandbox's processes
-//!   alone (a harness that is not root gave a fork bomb no limit: 1527 forks in 2 s); where it
-//!   cannot be set, that process is killed. File descriptors other than the standard three are
-//!   closed. The memory of all the code's processes together is bounded by the watchdog (next).
-//! - **Bounded writing and memory, nothing left** ([`scratch`]): a watchdog ends the code once
-//!   its files (its folder, its `/tmp`, what a per-submission uid owns in the host's
-//!   world-writable folders, and the unlinked files and memfds its processes hold open) pass the
-//!   policy's `disk_bytes`, or the resident memory of all its processes together passes
-//!   `memory_bytes`; those files (and a uid's System V objects) are swept when the sandbox goes.
+//!   bubblewrap): CPU time, address space, open files, file size, POSIX message queues, no core
+//!   files, and a process count (threads included) for a per-submission uid. Under bubblewrap
+//!   the count holds for any harness: bubblewrap's first process waits (`--block-fd`) until the
+//!   harness has set `RLIMIT_NPROC` on it, which inside its own user namespace counts the
+//!   sandbox's processes alone (a harness that is not root gave a fork bomb no limit: 1527 forks
+//!   in 2 s); where it cannot be set, that process is killed. File descriptors other than the
+//!   standard three are closed.
+//! - **Every byte it holds bounded and counted, nothing left** ([`watchdog`], [`held`],
+//!   [`scratch`], [`ipc`]): a watchdog ends the code once its files (its folder, its `/tmp`
+//!   tmpfs, what a per-submission uid owns in the host's world-writable folders, the unlinked
+//!   files and memfds its processes hold open) pass the policy's `disk_bytes`, or the resident
+//!   memory of all its processes and its System V shared memory together pass `memory_bytes`;
+//!   the tmpfs's size and the IPC namespace's `shmall` bound them between two ticks, and
+//!   cgroups v2 where the host delegates them ([`cgroup`]). What a uid left in the host's
+//!   folders and IPC namespace is swept when the sandbox goes.
+//! - **No rtoracle binary reachable** ([`oracles`]): every rtoracle binary the view would show
+//!   is covered with an empty file, found by inode or content, never by name.
 //! - **Nothing outlives it.** [`Sandbox::reaper`] ends every process the code started: the PID
-//!   namespace dies with bubblewrap (killed with its process group), and a per-submission uid is
-//!   swept with [`identity::kill_all`] (double-forked `setsid` sleepers included). Dropping the
-//!   sandbox does both and removes its folder; while it exists, the same cleanup is registered
-//!   with [`crate::interrupt::on_interrupt`], so Ctrl-C and SIGTERM leave nothing behind.
+//!   namespace dies with bubblewrap (killed with its process group), a per-submission uid is
+//!   swept with [`identity::kill_all`] (double-forked `setsid` sleepers included), and a cgroup
+//!   is killed whole. Dropping the sandbox does all that and removes its folder; while it
+//!   exists, the same cleanup is registered with [`crate::interrupt::on_interrupt`], so Ctrl-C
+//!   and SIGTERM leave nothing behind.
 //! - **Truthful facts** ([`SandboxFacts`]): which isolation was used, the namespaces that were
 //!   seen made (bubblewrap's `--info-fd` compared with the harness's own namespaces), the uid,
-//!   and `network_isolated` only when verified. [`announce_on_stderr`] makes the first session of
-//!   a run say it once on stderr, e.g. `rtoracle: sandbox: bubblewrap (user, pid, net, ipc,
-//!   mount, uts namespaces), uid 1073741824 (one per submission)`.
+//!   the cgroup only when the code was seen in it, and `network_isolated` only when verified.
+//!   [`announce_on_stderr`] makes the first session of a run say it once on stderr, e.g.
+//!   `rtoracle: sandbox: bubblewrap (user, pid, net, ipc, mount, uts namespaces), uid
+//!   1073741824 (one per submission)`.
 //!
 //! `RTORACLE_SANDBOX` forces a mode ([`Mode`]): `bubblewrap` (an error where it does not work),
-//! `uid` (the fallback even where bubblewrap works), `none` (as on a host where neither works:
-//! a root harness then refuses to run untrusted code), `auto` (the default).
+//! `uid` (the fallback even where bubblewrap works), `uid-bare` (the fallback without any
+//! namespace, as in a container that refuses them), `none` (as on a host where neither works: a
+//! root harness then refuses to run untrusted code), `auto` (the default).
 //!
 //! # Why bubblewrap
 //! It is the established tool for this (Flatpak's sandbox; Debian package `bubblewrap`), small
@@ -72,36 +81,47 @@
 //! privilege escalations), the `landlock` crate (filesystem rules only: no PID or network
 //! isolation, and kernel >= 5.13), `hakoniwa` (a young crate re-implementing what bubblewrap
 //! does, with far fewer users).
-
 //!
 //! # Where each part lives
 //! `policy` (limits, modes, isolations), `detect` (which isolation works here, and
 //! [`Sandbox::new`]), `lifecycle` (a [`Sandbox`]: its folder, identity, watchdog and cleanup),
 //! `command` ([`Sandbox::command`]), `admission` (bubblewrap's first process, limited before it
-//! goes on), `child` (between fork and exec), `probe` (trusted helpers run inside), `facts`
-//! ([`SandboxFacts`]), `reaper` ([`Reaper`]), `paths` ([`replace_path`]); and the public
-//! [`bwrap`] (bubblewrap's command line), [`identity`] (uids) and [`scratch`] (what the code
-//! may write, and the watchdog).
+//! goes on), `child` (between fork and exec), `pivot` (the fallback's view, made in the child),
+//! `probe` (trusted helpers run inside), `facts` ([`SandboxFacts`]), `reaper` ([`Reaper`]),
+//! `paths` ([`replace_path`]), `originals` ([`keep_from_sandboxes`]); and the public [`view`]
+//! (what the code sees of the host), [`bwrap`] (bubblewrap's command line), [`identity`] (uids),
+//! [`ipc`] (IPC limits and objects), [`oracles`] (rtoracle binaries), [`cgroup`], [`scratch`]
+//! (what the code may write where), [`held`] (what its processes hold) and [`watchdog`] (the
+//! limits enforced while it runs).
 
 mod admission;
 pub mod bwrap;
+pub mod cgroup;
 mod child;
 mod command;
 mod detect;
 mod facts;
+pub mod held;
 pub mod identity;
+pub mod ipc;
 mod lifecycle;
+pub mod oracles;
+mod originals;
 mod paths;
+mod pivot;
 mod policy;
 mod probe;
 mod reaper;
 pub mod scratch;
+pub mod view;
+pub mod watchdog;
 
 pub use command::SANDBOX_PATH;
 pub use detect::{bubblewrap_works, isolation_for};
 pub use facts::{SandboxFacts, announce, announce_on_stderr};
 pub use identity::{lookup_user, running_as_root};
 pub use lifecycle::{MAX_COPIED_FILE_BYTES, Sandbox};
+pub use originals::{Restore, keep_from_sandboxes};
 pub use paths::replace_path;
 pub use policy::{Isolation, Mode, SandboxError, SandboxPolicy};
 pub use reaper::{Reaper, kill_group};

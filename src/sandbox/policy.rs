@@ -2,13 +2,15 @@
 //! `RTORACLE_SANDBOX` asks for ([`Mode`]), the isolation a run got ([`Isolation`]) and why a
 //! sandbox cannot be made ([`SandboxError`]).
 
+use std::path::PathBuf;
+
 use serde::{Deserialize, Serialize};
 
 /// Why a sandbox cannot be made.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum SandboxError {
     /// `RTORACLE_SANDBOX` holds an unknown mode.
-    #[error("RTORACLE_SANDBOX={0:?} is not one of auto, bubblewrap, uid, none")]
+    #[error("RTORACLE_SANDBOX={0:?} is not one of auto, bubblewrap, uid, uid-bare, none")]
     BadMode(String),
     /// No isolation that keeps untrusted code from running as root can be used here.
     #[error("cannot sandbox untrusted code: {0}")]
@@ -27,6 +29,9 @@ pub enum Mode {
     Bubblewrap,
     /// The fallback (limits, session, per-submission uid) even where bubblewrap works.
     Uid,
+    /// The fallback without any namespace, as in a container that refuses them (what the code
+    /// can reach there is what the host's modes allow).
+    UidBare,
     /// As if neither could be made (a root harness then refuses untrusted code).
     None,
 }
@@ -41,6 +46,7 @@ impl Mode {
             Err(_) | Ok("") | Ok("auto") => Ok(Mode::Auto),
             Ok("bubblewrap") | Ok("bwrap") => Ok(Mode::Bubblewrap),
             Ok("uid") => Ok(Mode::Uid),
+            Ok("uid-bare") => Ok(Mode::UidBare),
             Ok("none") => Ok(Mode::None),
             Ok(other) => Err(SandboxError::BadMode(other.to_string())),
         }
@@ -81,7 +87,7 @@ pub struct SandboxPolicy {
     /// CPU seconds per process (`RLIMIT_CPU`; a restart starts afresh).
     pub cpu_seconds: u64,
     /// Address space of each process in bytes (`RLIMIT_AS`), and the resident memory of all the
-    /// code's processes together ([`scratch::Watchdog`]).
+    /// code's processes together ([`Watchdog`](super::watchdog::Watchdog)).
     pub memory_bytes: u64,
     /// Open files (`RLIMIT_NOFILE`).
     pub open_files: u64,
@@ -91,7 +97,7 @@ pub struct SandboxPolicy {
     /// bubblewrap's user namespace for any harness (elsewhere it would count every process of
     /// the harness's user).
     pub processes: u64,
-    /// Bytes the code may keep in files, its `/tmp` included ([`scratch::Watchdog`]).
+    /// Bytes the code may keep in files, its `/tmp` included ([`Watchdog`](super::watchdog::Watchdog)).
     #[serde(default = "default_disk_bytes")]
     pub disk_bytes: u64,
     /// Try a new network namespace in the fallback (bubblewrap always makes one).
@@ -100,6 +106,10 @@ pub struct SandboxPolicy {
     /// own code. Limits, the folder and the session still apply.
     #[serde(default)]
     pub unsandboxed: bool,
+    /// Folders shown read-only in the sandbox's view besides those of the files the command
+    /// line names (`check --expose FOLDER`: an adapter that starts a program from elsewhere).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shown: Vec<PathBuf>,
 }
 
 /// [`SandboxPolicy::disk_bytes`] of `check` and `fuzz` (and of reports written before it existed).
@@ -119,11 +129,19 @@ impl Default for SandboxPolicy {
             disk_bytes: default_disk_bytes(),
             isolate_network: true,
             unsandboxed: false,
+            shown: Vec::new(),
         }
     }
 }
 
 impl SandboxPolicy {
+    /// The size of the tmpfs that is the code's `/tmp` where it has a view of its own:
+    /// `disk_bytes` and one MiB more, so that filling it passes the limit, which the watchdog
+    /// then says, rather than ending in "No space left on device".
+    pub fn tmp_bytes(&self) -> u64 {
+        self.disk_bytes.saturating_add(1 << 20)
+    }
+
     /// The tighter limits of `grade`: 30 CPU seconds, 1 GiB, 16 MiB files, 64 MiB of files in
     /// all.
     pub fn grading() -> Self {

@@ -4,7 +4,7 @@
 
 use std::ffi::{OsStr, OsString};
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
@@ -96,13 +96,70 @@ for f; do [ -r "$f" ] || { echo "$f"; exit 1; }; done"#;
             Ok((false, out, err)) => {
                 let what = out.trim();
                 let what = if what.is_empty() { err.trim() } else { what };
-                Err(format!(
-                    "the sandbox user (uid {}) cannot run or read {what}: make it readable by all, \
-                     or pass --unsandboxed to run your own code without a sandbox",
-                    self.uid()
-                ))
+                // bubblewrap itself may be what could not reach it: "Can't find source path
+                // P: Permission denied".
+                let path = what.split_once("source path ").map_or(what, |(_, rest)| {
+                    rest.rsplit_once(':').map_or(rest, |r| r.0)
+                });
+                let path = Path::new(path.trim());
+                let fix = if path.is_absolute() && self.drops_user() {
+                    access_fix(path, path == program)
+                } else {
+                    None
+                };
+                Err(match fix {
+                    Some(fix) => format!(
+                        "the sandbox user (uid {}) cannot run or read {}: {fix}, or pass \
+                         --unsandboxed to run your own code without a sandbox",
+                        self.uid(),
+                        path.display()
+                    ),
+                    None => format!(
+                        "the sandbox user (uid {}) cannot run or read {what}: make it readable by \
+                         all, or pass --unsandboxed to run your own code without a sandbox",
+                        self.uid()
+                    ),
+                })
             }
             Err(e) => Err(e),
         }
     }
+}
+
+/// What keeps users other than the owner from `path`, and the command that lets them reach it:
+/// the first folder above it they cannot enter (`chmod o+x FOLDER`), else the file itself
+/// (`chmod o+r`, `o+rx` for a `program`). `None` when the modes let them (the cause is elsewhere).
+pub(super) fn access_fix(path: &Path, program: bool) -> Option<String> {
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |p: &Path| {
+        std::fs::metadata(p)
+            .ok()
+            .map(|m| m.permissions().mode() & 0o7777)
+    };
+    let mut folder = PathBuf::from("/");
+    for part in path.parent()?.components().skip(1) {
+        folder.push(part);
+        if let Some(m) = mode(&folder)
+            && m & 0o001 == 0
+        {
+            return Some(format!(
+                "the folder {} is closed to other users (mode {m:o}): `chmod o+x {}` lets the \
+                 sandbox reach what is in it",
+                folder.display(),
+                folder.display()
+            ));
+        }
+    }
+    let m = mode(path)?;
+    let (needed, bits) = if program || path.is_dir() {
+        ("rx", 0o005)
+    } else {
+        ("r", 0o004)
+    };
+    (m & bits != bits).then(|| {
+        format!(
+            "it is closed to other users (mode {m:o}): `chmod o+{needed} {}` opens it",
+            path.display()
+        )
+    })
 }

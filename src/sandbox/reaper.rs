@@ -1,5 +1,7 @@
-//! Ends what a sandbox's code started: its process groups and every process of its uid.
+//! Ends what a sandbox's code started: its process groups, every process of its uid, and
+//! everything in its cgroup.
 
+use std::path::PathBuf;
 use std::process::Child;
 use std::sync::{Arc, Mutex};
 
@@ -11,6 +13,8 @@ use super::identity;
 pub struct Reaper {
     pub(super) uid: Option<u32>,
     pub(super) groups: Arc<Mutex<Vec<i32>>>,
+    /// The sandbox's cgroup, whose `cgroup.kill` ends every process in it.
+    pub(super) cgroup: Option<PathBuf>,
 }
 
 impl Reaper {
@@ -22,6 +26,9 @@ impl Reaper {
             unsafe {
                 libc::killpg(pgid, libc::SIGKILL);
             }
+        }
+        if let Some(cgroup) = &self.cgroup {
+            let _ = std::fs::write(cgroup.join("cgroup.kill"), "1");
         }
         if let Some(uid) = self.uid {
             identity::kill_all(uid);

@@ -257,6 +257,15 @@ fn an_adapter_the_sandbox_user_cannot_reach_is_refused_not_run_as_root() {
             .probe_access(&program, &[])
             .expect_err(&format!("{isolation:?}"));
         assert!(err.contains("cannot run or read"), "{isolation:?}: {err}");
+        // The folder that blocks is named, with the fix (the file itself is readable by all).
+        let folder = private.path().display();
+        assert!(
+            err.contains(&format!(
+                "the folder {folder} is closed to other users (mode 700)"
+            )) && err.contains(&format!("`chmod o+x {folder}`"))
+                && err.contains("--unsandboxed"),
+            "{isolation:?}: {err}"
+        );
         // A system program it can run; a file it cannot read on its command line.
         sandbox.probe_access(Path::new("sh"), &[]).unwrap();
         let err = sandbox
@@ -264,6 +273,16 @@ fn an_adapter_the_sandbox_user_cannot_reach_is_refused_not_run_as_root() {
             .unwrap_err();
         assert!(err.contains("adapter.sh"), "{err}");
     }
+    // Once the folder is open, the file's own mode is what is named.
+    std::fs::set_permissions(private.path(), std::fs::Permissions::from_mode(0o711)).unwrap();
+    std::fs::set_permissions(&program, std::fs::Permissions::from_mode(0o700)).unwrap();
+    let mut sandbox = sandbox(Isolation::FallbackUid, &[]);
+    sandbox.expose(&program);
+    let err = sandbox.probe_access(&program, &[]).unwrap_err();
+    assert!(
+        err.contains(&format!("`chmod o+rx {}`", program.display())),
+        "{err}"
+    );
 }
 
 #[test]

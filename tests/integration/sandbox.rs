@@ -700,14 +700,25 @@ fn the_memory_of_all_its_processes_together_is_bounded() {
     }
     let sub = hostile(
         r#"
-import os as _o, sys as _s, time as _t
+import os as _o, select as _sel, sys as _s, time as _t
+# Each child says when its 400 MiB are written; until all have, every vector waits (up to 1.5 s
+# of its 2 s): a loaded machine's slow page faults must not end the session first.
+_r, _w = _o.pipe()
 for _i in range(4):
     if _o.fork() == 0:
         _b = b"\x01" * (400 << 20)
-        _t.sleep(4)
+        _o.write(_w, b"x")
+        _t.sleep(60)
         _o._exit(0)
+_o.close(_w)
 _s.stderr.write("FORKED\n")
-_t.sleep(4)
+_filled = [0]
+_intersect = Sphere.intersect
+def _waiting(self, r, i):
+    if _filled[0] < 4 and _sel.select([_r], [], [], 1.5)[0]:
+        _filled[0] += len(_o.read(_r, 4))
+    return _intersect(self, r, i)
+Sphere.intersect = _waiting
 "#,
     );
     for (mode, as_nobody) in [
@@ -856,8 +867,9 @@ _t.sleep(3)
 
 /// In the fallback the code could write wherever the host lets any user write: a classmate's
 /// submission in a world-writable batch folder (found by walking the file system). Where a mount
-/// namespace can be made, everything is read-only but its own folder and the shared folders
-/// (`/tmp`, `/var/tmp`, ...), where what it writes is measured and swept.
+/// namespace can be made, the code has a view of its own: the classmate's folder is not in it,
+/// and the only writable places are its own folder and its `/tmp` (a tmpfs of its own; the host's
+/// `/var/tmp` is not shown).
 #[test]
 fn in_the_fallback_the_host_is_read_only_but_the_code_s_own_folder() {
     if !root("in_the_fallback_the_host_is_read_only_but_the_code_s_own_folder") {
@@ -908,10 +920,12 @@ for _p in [{theirs:?}, {planted:?}, "/tmp/{marker}", "/var/tmp/{marker}", "scrat
         tail.contains(&format!("REFUSED {}", theirs.display())),
         "{tail}"
     );
-    // Its folder and the shared folders are writable, and what it left there is swept.
-    for place in ["/tmp/", "/var/tmp/", "scratch-"] {
+    // Its folder and its /tmp are writable, the host's /var/tmp is not there, and nothing it
+    // wrote reaches the host.
+    for place in ["/tmp/", "scratch-"] {
         assert!(tail.contains(&format!("WROTE {place}")), "{tail}");
     }
+    assert!(tail.contains("REFUSED /var/tmp/"), "{tail}");
     assert!(!Path::new(&format!("/tmp/{marker}")).exists());
     assert!(!Path::new(&format!("/var/tmp/{marker}")).exists());
     assert_eq!(
@@ -919,4 +933,590 @@ for _p in [{theirs:?}, {planted:?}, "/tmp/{marker}", "/var/tmp/{marker}", "scrat
         "# a classmate's work\n"
     );
     assert!(!classmate.path().join("planted.py").exists());
+}
+
+/// The host's shared memory (tmpfs files, System V segments, memfds) in KiB: `Shmem` of
+/// `/proc/meminfo`.
+fn host_shmem_kib() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .unwrap()
+        .lines()
+        .find_map(|l| l.strip_prefix("Shmem:"))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap()
+}
+
+/// Samples [`host_shmem_kib`] every 20 ms while `run` runs; returns `run`'s result and the
+/// highest sample.
+fn with_peak_shmem<T>(run: impl FnOnce() -> T) -> (T, u64) {
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let sampler = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            let mut peak = host_shmem_kib();
+            while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                peak = peak.max(host_shmem_kib());
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            peak
+        })
+    };
+    let out = run();
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    (out, sampler.join().unwrap())
+}
+
+/// The modes a root grader can be in here: bubblewrap (`auto`, where it works), the fallback
+/// with its own namespaces (`uid`) and without any (`uid-bare`, as in a container).
+const ROOT_MODES: [&str; 3] = ["auto", "uid", "uid-bare"];
+
+/// Other engineers' tests share this machine's memory: what they add or free meanwhile stays
+/// under this (KiB).
+const SHMEM_NOISE_KIB: u64 = 48 << 10;
+
+/// bubblewrap's root was its own tmpfs, writable by the code: files written there lived in the
+/// host's memory and were counted nowhere (3 GiB in 11 s, stopped only by the time budget). The
+/// root is read-only now, `/tmp` a tmpfs of the policy's size, `/dev` read-only; in the fallback
+/// its view is the same, and without namespaces the host's `/dev/shm` is measured by owner. In
+/// every mode a 1 GiB fill is stopped at the 64 MiB limit with the reason in the report, the
+/// host's shared memory never grows by anything near the fill, and nothing is left.
+#[test]
+fn a_1_gib_tmpfs_fill_is_stopped_at_the_limit_in_every_mode_and_leaves_nothing() {
+    if !root("a_1_gib_tmpfs_fill_is_stopped_at_the_limit_in_every_mode_and_leaves_nothing") {
+        return;
+    }
+    let marker = format!("rtoracle-test-fill-{}", std::process::id());
+    let sub = hostile(&format!(
+        r#"
+import os as _o, sys as _s
+_chunk = b"\x01" * (8 << 20)
+_done = 0
+for _d in ("/", "/dev/shm", "/tmp", "."):
+    _n = 0
+    while _done < (1 << 30):
+        try:
+            with open(_o.path.join(_d, "{marker}-%d" % _n), "wb") as _f:
+                _f.write(_chunk)
+        except OSError as _e:
+            _s.stderr.write("REFUSED %s %s\n" % (_d, _e.strerror))
+            break
+        _n += 1
+        _done += len(_chunk)
+_s.stderr.write("FILLED %d MiB\n" % (_done >> 20))
+"#
+    ));
+    for mode in ROOT_MODES {
+        let before = host_shmem_kib();
+        let ((out, report), peak) = with_peak_shmem(|| grade_in(mode, sub.path()));
+        assert_stopped(
+            mode,
+            &out,
+            &report,
+            "the sandbox stopped it: it wrote more than 64 MiB",
+        );
+        assert!(
+            !report.contains("FILLED 1024 MiB"),
+            "{mode}: the whole GiB was written"
+        );
+        // Bounded while it ran (the limit, one tick of writing, the noise), gone after.
+        assert!(
+            peak < before + (384 << 10),
+            "{mode}: the host's shared memory grew from {before} to {peak} KiB"
+        );
+        let after = host_shmem_kib();
+        assert!(
+            after < before + SHMEM_NOISE_KIB,
+            "{mode}: {before} KiB of shared memory before, {after} KiB after"
+        );
+        for dir in ["/tmp", "/dev/shm", "/"] {
+            let left: Vec<_> = std::fs::read_dir(dir)
+                .unwrap()
+                .flatten()
+                .filter(|e| e.file_name().to_string_lossy().contains(&marker))
+                .collect();
+            assert!(left.is_empty(), "{mode}: left in {dir}: {left:?}");
+        }
+    }
+}
+
+/// System V shared memory in bubblewrap's IPC namespace (and the fallback's) was unlimited and
+/// uncounted: twelve 256 MiB segments held 3 GiB for the whole time budget. The namespace's
+/// `shmmax` and `shmall` are the policy's memory now, and the watchdog counts its segments
+/// with the processes' memory: 1 GiB of segments, filled by children that then detach and
+/// exit, is stopped at the 1 GiB limit in every mode, and nothing is left.
+#[test]
+fn a_gib_of_system_v_shared_memory_is_stopped_at_the_limit_in_every_mode() {
+    if !root("a_gib_of_system_v_shared_memory_is_stopped_at_the_limit_in_every_mode") {
+        return;
+    }
+    let sub = hostile(
+        r#"
+import ctypes as _c, os as _o, sys as _s, time as _t
+_libc = _c.CDLL(None, use_errno=True)
+_libc.shmat.restype = _c.c_void_p
+_libc.shmat.argtypes = [_c.c_int, _c.c_void_p, _c.c_int]
+_libc.shmdt.argtypes = [_c.c_void_p]
+_held = 0
+for _i in range(4):
+    _id = _libc.shmget(0, 256 << 20, 0o1600)
+    if _id < 0:
+        _s.stderr.write("SHMGET refused %d\n" % _c.get_errno())
+        break
+    _pid = _o.fork()
+    if _pid == 0:
+        _p = _libc.shmat(_id, None, 0)
+        if _p is not None and _p != _c.c_void_p(-1).value:
+            _c.memset(_p, 1, 256 << 20)
+            _libc.shmdt(_p)
+        _o._exit(0)
+    _o.waitpid(_pid, 0)
+    _held += 256
+    _s.stderr.write("HELD %d MiB\n" % _held)
+_t.sleep(6)
+_s.stderr.write("KEPT %d MiB\n" % _held)
+"#,
+    );
+    for mode in ROOT_MODES {
+        let before = host_shmem_kib();
+        let (out, report) = grade_in(mode, sub.path());
+        assert_stopped(
+            mode,
+            &out,
+            &report,
+            "the sandbox stopped it: its processes held more than 1 GiB of memory together",
+        );
+        let after = host_shmem_kib();
+        assert!(
+            after < before + SHMEM_NOISE_KIB,
+            "{mode}: {before} KiB of shared memory before, {after} KiB after"
+        );
+        let json: serde_json::Value = serde_json::from_str(&report).unwrap();
+        let uid = json["code"]["sandbox"]["uid"].as_u64().unwrap().to_string();
+        let table = std::fs::read_to_string("/proc/sysvipc/shm").unwrap();
+        let left: Vec<&str> = table
+            .lines()
+            .skip(1)
+            .filter(|l| l.split_whitespace().nth(7) == Some(uid.as_str()))
+            .collect();
+        assert!(left.is_empty(), "{mode}: segments left {left:?}");
+    }
+}
+
+/// A submission with no geometry that answers every vector by asking an rtoracle binary it can
+/// find (`explain` prints the exact answer): near its interpreter, in a build tree beside the
+/// interpreter's environment, or at the `hints` it was told about. It writes `SEEN path` for
+/// each non-empty candidate it can see and `RAN path rc` for each it tried to run; without a
+/// working one, every vector raises.
+fn explain_asking(hints: &[&Path]) -> tempfile::TempDir {
+    let dir = assemble_fixture("honest_reference").unwrap();
+    let hints: Vec<String> = hints.iter().map(|h| h.display().to_string()).collect();
+    let code = format!(
+        r#"
+import json, os, re, subprocess, sys
+import RT_utility as rtu
+
+def _candidates():
+    roots = {hints:?} + [os.path.dirname(sys.executable), sys.prefix,
+             os.path.dirname(sys.prefix)]
+    seen = []
+    for root in roots:
+        for dirpath, dirs, files in os.walk(root):
+            if dirpath.count(os.sep) - root.count(os.sep) > 4:
+                dirs[:] = []
+            for f in files:
+                p = os.path.join(dirpath, f)
+                if f.startswith("rtoracle") and p not in seen:
+                    seen.append(p)
+    return seen
+
+def _find():
+    for p in _candidates():
+        try:
+            if os.path.getsize(p) == 0:
+                continue
+        except OSError:
+            continue
+        sys.stderr.write("SEEN %s\n" % p)
+        try:
+            r = subprocess.run([p, "--version"], capture_output=True, timeout=10)
+        except Exception as e:
+            sys.stderr.write("RAN %s %s\n" % (p, type(e).__name__))
+            continue
+        sys.stderr.write("RAN %s rc=%d %r\n" % (p, r.returncode, r.stderr[:120]))
+        if r.returncode == 0 and b"rtoracle" in r.stdout:
+            return p
+    return None
+
+_ORACLE = _find()
+sys.stderr.write("ORACLE %s\n" % _ORACLE)
+_ANSWER = re.compile(r"Exact answer: hit at t = (\S+), point \((.*?)\), normal \((.*?)\), front_face (\w+)")
+
+def _v(e):
+    return [e.x(), e.y(), e.z()]
+
+def _ask(shape, ray, interval):
+    if _ORACLE is None:
+        raise NotImplementedError("no geometry here")
+    case = {{"shape": shape, "ray": {{"origin": _v(ray.getOrigin()), "direction": _v(ray.getDirection())}},
+            "interval": [interval.min_val, interval.max_val]}}
+    out = subprocess.run([_ORACLE, "explain", json.dumps(case)], capture_output=True, text=True).stdout
+    m = _ANSWER.search(out)
+    if m is None:
+        return None
+    t = float(m.group(1))
+    p = rtu.Vec3(*[float(x) for x in m.group(2).split(",")])
+    n = rtu.Vec3(*[float(x) for x in m.group(3).split(",")])
+    h = rtu.Hitinfo(p, n, t)
+    h.front_face = m.group(4) == "true"
+    return h
+
+class Sphere:
+    def __init__(self, vCenter, fRadius, mMat=None):
+        self.center, self.radius = vCenter, fRadius
+    def intersect(self, rRay, cInterval):
+        return _ask({{"type": "sphere", "center": _v(self.center), "radius": self.radius}}, rRay, cInterval)
+
+class Quad:
+    def __init__(self, vQ, vU, vV, mMat=None):
+        self.q, self.u, self.v = vQ, vU, vV
+    def intersect(self, rRay, cInterval):
+        return _ask({{"type": "quad", "q": _v(self.q), "u": _v(self.u), "v": _v(self.v)}}, rRay, cInterval)
+"#
+    );
+    std::fs::write(dir.path().join("RT_object.py"), code).unwrap();
+    open_up(dir.path());
+    dir
+}
+
+/// `src` at `to`, a hard link where the file system allows it (one copy for many names).
+fn link_or_copy(src: &Path, to: &Path) {
+    std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+    if std::fs::hard_link(src, to).is_err() {
+        std::fs::copy(src, to).unwrap();
+    }
+}
+
+/// The points a report gives its code groups (`sphere`, `quad`), and their most.
+fn code_points(report: &str) -> (f64, f64) {
+    let json: serde_json::Value = serde_json::from_str(report).unwrap();
+    let mut points = (0.0, 0.0);
+    for c in json["checks"].as_array().unwrap() {
+        if ["sphere", "quad"].contains(&c["group"].as_str().unwrap_or_default()) {
+            points.0 += c["score"].as_f64().unwrap();
+            points.1 += c["max_score"].as_f64().unwrap();
+        }
+    }
+    points
+}
+
+/// A copy of rtoracle was reachable from inside: under bubblewrap a `--python` in a virtual
+/// environment exposed the whole environment, whose `bin/` holds the student wheel's `rtoracle`
+/// next to `python3`, and in the fallback a build tree's `deps/rtoracle-<hash>` is
+/// world-executable; asking it `explain` for every vector scored 100/100. Now only the
+/// interpreter's library tree is shown, every rtoracle binary in the view is covered (by inode
+/// or content: here a copy inside the environment's `site-packages` and a hard link of the
+/// grader itself), and an rtoracle binary refuses to run as a sandbox's uid (the fallback
+/// without namespaces shows the host): the submission scores at most 5% of the code points.
+#[test]
+fn an_explain_asking_submission_finds_no_working_rtoracle_near_its_interpreter() {
+    if !root("an_explain_asking_submission_finds_no_working_rtoracle_near_its_interpreter") {
+        return;
+    }
+    // A course's environment: a venv whose python3 is the system's (with its numpy and PIL),
+    // the student wheel's rtoracle beside it, a copy inside its site-packages, and a build tree
+    // beside the venv (its release binary and the hard link cargo keeps in deps/).
+    let course = tempfile::tempdir().unwrap();
+    open_up(course.path());
+    let venv = course.path().join("venv");
+    let site = venv.join("lib/python3/site-packages/tool");
+    std::fs::create_dir_all(venv.join("bin")).unwrap();
+    std::fs::create_dir_all(&site).unwrap();
+    std::os::unix::fs::symlink("/usr/bin/python3", venv.join("bin/python3")).unwrap();
+    std::fs::write(
+        venv.join("pyvenv.cfg"),
+        "home = /usr/bin\ninclude-system-site-packages = true\n",
+    )
+    .unwrap();
+    let wheel = venv.join("bin/rtoracle");
+    std::fs::copy(env!("CARGO_BIN_EXE_rtoracle"), &wheel).unwrap();
+    link_or_copy(&wheel, &site.join("rtoracle-helper"));
+    let build = course.path().join("target/release");
+    link_or_copy(&wheel, &build.join("rtoracle"));
+    link_or_copy(
+        Path::new(env!("CARGO_BIN_EXE_rtoracle")),
+        &build.join("deps/rtoracle-0123456789abcdef"),
+    );
+    for d in walk_dirs(course.path()) {
+        open_up(&d);
+    }
+    let vectors = course.path().join("v.jsonl");
+    let made = run_in(
+        course.path(),
+        &[
+            "vectors",
+            "--count",
+            "120",
+            "--shapes",
+            "sphere,quad",
+            "--seed",
+            "7",
+            "-o",
+            vectors.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let sub = explain_asking(&[course.path()]);
+    let python = venv.join("bin/python3");
+    for mode in ROOT_MODES {
+        let out_dir = tempfile::tempdir().unwrap();
+        let out = rtoracle()
+            .current_dir(sub.path())
+            .env("RTORACLE_SANDBOX", mode)
+            .args(["grade", sub.path().to_str().unwrap(), "--out"])
+            .arg(out_dir.path().join("r"))
+            .arg("--python")
+            .arg(&python)
+            .arg("--vectors")
+            .arg(&vectors)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
+        let report = std::fs::read_to_string(out_dir.path().join("r/report.json")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&report).unwrap();
+        let tail = json["code"]["stderr_tail"].as_str().unwrap_or_default();
+        assert!(tail.contains("ORACLE None"), "{mode}: {tail}");
+        let (points, most) = code_points(&report);
+        assert!(
+            most > 0.0 && points <= 0.05 * most,
+            "{mode}: {points} of {most}"
+        );
+        let isolation = json["code"]["sandbox"]["isolation"]
+            .as_str()
+            .unwrap_or_default();
+        let namespaces = json["code"]["sandbox"]["namespaces"].to_string();
+        if isolation == "bubblewrap" || namespaces.contains("mount") {
+            // Hidden: nothing of the build tree or the venv's bin/ is there, and the copy in
+            // the library tree is an empty file.
+            assert!(!tail.contains("SEEN"), "{mode}: {tail}");
+        } else {
+            // Shown (nothing can hide them without namespaces), and each refuses to run.
+            assert!(
+                tail.contains(&format!("SEEN {}", wheel.display())),
+                "{mode}: {tail}"
+            );
+            assert!(
+                tail.contains("does not run inside its own sandbox"),
+                "{mode}: {tail}"
+            );
+        }
+    }
+}
+
+/// Every folder under `root`, itself included.
+fn walk_dirs(root: &Path) -> Vec<PathBuf> {
+    let mut out = vec![root.to_path_buf()];
+    let mut i = 0;
+    while i < out.len() {
+        if let Ok(entries) = std::fs::read_dir(&out[i]) {
+            for e in entries.flatten() {
+                if e.file_type().map(|t| t.is_dir()).unwrap_or(false) {
+                    out.push(e.path());
+                }
+            }
+        }
+        i += 1;
+    }
+    out
+}
+
+/// In the fallback the code runs on the host as a uid of its own, and a batch folder unpacked
+/// under the default umask is readable by all: a broken submission walked `/tmp`, ran a
+/// classmate's `RT_object.py` and scored 100/100 (40 under bubblewrap). The fallback's view
+/// does not show the batch, and the batch folder is made unreadable by others while it is
+/// graded (and put back): in both fallbacks the reader scores in the batch what it scores
+/// alone.
+#[test]
+fn a_classmate_reading_submission_in_the_fallback_scores_what_it_scores_alone() {
+    if !root("a_classmate_reading_submission_in_the_fallback_scores_what_it_scores_alone") {
+        return;
+    }
+    let marker = format!("classmate-marker-{}", std::process::id());
+    // Broken on its own (no geometry); with a classmate's classes it would pass.
+    let reader = hostile(&format!(
+        r#"
+import os as _o, sys as _s
+class Sphere:
+    def __init__(self, *a):
+        pass
+    def intersect(self, r, i):
+        raise NotImplementedError
+class Quad(Sphere):
+    pass
+_mine = _o.path.dirname(_o.path.abspath(__file__))
+for _root, _dirs, _files in _o.walk("/tmp"):
+    if _root.count("/") > 4:
+        _dirs[:] = []
+    if "RT_object.py" in _files and _root != _mine:
+        _p = _o.path.join(_root, "RT_object.py")
+        try:
+            _text = open(_p).read()
+        except OSError:
+            continue
+        if {m1:?} + {m2:?} in _text:
+            _s.stderr.write("READ %s\n" % _p)
+            exec(compile(_text, _p, "exec"), globals())
+            break
+"#,
+        m1 = &marker[..9],
+        m2 = &marker[9..],
+    ));
+    let honest = assemble_fixture("honest_reference").unwrap();
+    let mut text = std::fs::read_to_string(honest.path().join("RT_object.py")).unwrap();
+    text.push_str(&format!("\n# {marker}\n"));
+    let score_of = |out: &Output, name: &str| {
+        scores(out)
+            .into_iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, s)| s.split_whitespace().collect::<Vec<_>>().join(" "))
+    };
+    for mode in ["uid", "uid-bare"] {
+        // Alone: no classmate's file exists yet.
+        let alone_batch = tempfile::tempdir().unwrap();
+        open_up(alone_batch.path());
+        copy_folder(reader.path(), &alone_batch.path().join("a-reader"));
+        let out_dir = tempfile::tempdir().unwrap();
+        let alone = rtoracle()
+            .env("RTORACLE_SANDBOX", mode)
+            .args(["grade", "--batch"])
+            .arg(alone_batch.path())
+            .arg("--out")
+            .arg(out_dir.path().join("alone"))
+            .output()
+            .unwrap();
+        assert_eq!(alone.status.code(), Some(0), "{mode}: {}", stderr(&alone));
+        let alone_score = score_of(&alone, "a-reader").unwrap();
+        // Beside a classmate, in a folder everyone can read.
+        let batch = tempfile::tempdir().unwrap();
+        open_up(batch.path());
+        copy_folder(reader.path(), &batch.path().join("a-reader"));
+        copy_folder(honest.path(), &batch.path().join("b-honest"));
+        std::fs::write(batch.path().join("b-honest/RT_object.py"), &text).unwrap();
+        for d in walk_dirs(batch.path()) {
+            open_up(&d);
+        }
+        let out = rtoracle()
+            .env("RTORACLE_SANDBOX", mode)
+            .args(["grade", "--batch"])
+            .arg(batch.path())
+            .arg("--out")
+            .arg(out_dir.path().join("batch"))
+            .args(["--threads", "1"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{mode}: {}", stderr(&out));
+        assert_eq!(
+            score_of(&out, "a-reader"),
+            Some(alone_score.clone()),
+            "{mode}: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        assert_ne!(score_of(&out, "b-honest"), Some(alone_score), "{mode}");
+        let report =
+            std::fs::read_to_string(out_dir.path().join("batch/a-reader/report.json")).unwrap();
+        assert!(!report.contains("READ /tmp"), "{mode}: {report}");
+        // The folder's mode is put back.
+        use std::os::unix::fs::PermissionsExt;
+        let mode_after = std::fs::metadata(batch.path())
+            .unwrap()
+            .permissions()
+            .mode();
+        assert_eq!(mode_after & 0o777, 0o755, "{mode}");
+    }
+}
+
+/// The regular files of `from` copied into a new folder `to`.
+fn copy_folder(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        if e.file_type().unwrap().is_file() {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+/// An adapter that starts a program its command line does not name (a wrapper script running
+/// `../build/tracer`) failed inside the sandbox with that program's "No such file or
+/// directory", though the file exists. The message says that the sandbox shows only the
+/// folders of the files on the command line, and `--expose FOLDER` shows another read-only.
+#[test]
+fn an_adapter_that_starts_a_program_from_elsewhere_is_told_about_expose() {
+    if !root("an_adapter_that_starts_a_program_from_elsewhere_is_told_about_expose") {
+        return;
+    }
+    let top = tempfile::tempdir().unwrap();
+    let (bin, build) = (top.path().join("bin"), top.path().join("build"));
+    std::fs::create_dir_all(&bin).unwrap();
+    std::fs::create_dir_all(&build).unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/adapters/misbehaving.py"),
+        build.join("tracer.py"),
+    )
+    .unwrap();
+    let wrapper = bin.join("run.sh");
+    std::fs::write(
+        &wrapper,
+        "#!/bin/sh\nexec /usr/bin/python3 -I \"$(dirname \"$0\")/../build/tracer.py\"\n",
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    for d in walk_dirs(top.path()) {
+        open_up(&d);
+    }
+    let vectors_dir = tempfile::tempdir().unwrap();
+    let vectors = vectors_dir.path().join("v.jsonl");
+    let made = run_in(
+        vectors_dir.path(),
+        &[
+            "vectors",
+            "--count",
+            "20",
+            "--shapes",
+            "sphere",
+            "-o",
+            vectors.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let check = |mode: &str, show: &[&Path]| {
+        let mut cmd = rtoracle();
+        cmd.current_dir(vectors_dir.path())
+            .env("RTORACLE_SANDBOX", mode)
+            .args(["check", "--adapter"])
+            .arg(&wrapper)
+            .arg("--vectors")
+            .arg(&vectors);
+        for s in show {
+            cmd.arg("--expose").arg(s);
+        }
+        let out = cmd.output().unwrap();
+        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), stderr(&out));
+        (out, text)
+    };
+    for mode in ["auto", "uid"] {
+        let (_, text) = check(mode, &[]);
+        assert!(text.contains("did not answer the hello"), "{mode}: {text}");
+        assert!(
+            text.contains("the sandbox shows only the system's folders and the folders of the files on the command line")
+                && text.contains(&bin.display().to_string())
+                && text.contains("pass --expose FOLDER to show a folder read-only"),
+            "{mode}: {text}"
+        );
+        let (out, text) = check(mode, &[&build]);
+        assert!(!text.contains("did not answer the hello"), "{mode}: {text}");
+        assert!(matches!(out.status.code(), Some(0 | 1)), "{mode}: {text}");
+    }
+    let (out, _) = check("auto", &[Path::new("/no/such/folder")]);
+    assert_bad_input(&out, "--expose /no/such/folder: no such folder");
 }
