@@ -163,7 +163,9 @@ pub fn judge(case: &Case, outcome: &Outcome) -> Verdict {
         return Verdict::NotScored;
     }
     match outcome {
-        Outcome::NotRun { reason } => fail(FailureKind::NotRun, reason.clone()),
+        Outcome::NotRun { reason } | Outcome::Unsupported { reason } => {
+            fail(FailureKind::NotRun, reason.clone())
+        }
         Outcome::Timeout { junk } => fail(
             FailureKind::Timeout,
             with_junk("no answer within the timeout".into(), junk),

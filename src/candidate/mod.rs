@@ -71,6 +71,7 @@ pub fn check_session(session: &mut Session, cases: &[Case]) -> Result<CheckRepor
             restarts: session.restarts(),
             sandbox: Some(session.sandbox_facts()),
             course_api: session.command().is_course_adapter(),
+            notes: session.notes().to_vec(),
         },
     ))
 }
