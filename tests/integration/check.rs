@@ -834,6 +834,12 @@ fn fuzz_finds_shrinks_and_prints_a_reproduction() {
         "{text}"
     );
     assert!(text.contains("from RT_object import Quad"), "{text}");
+    // What it judged by, and the mistake (the fuzz report named neither).
+    assert!(text.starts_with("judged by: course/f64\n"), "{text}");
+    assert!(
+        text.contains("diagnosis: ") && text.contains("taking w as the unit normal"),
+        "{text}"
+    );
     assert!(!text.contains("(sphere)"), "{text}");
 
     let honest = assemble_fixture("honest_full_quadratic").unwrap();
