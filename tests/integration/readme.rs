@@ -38,7 +38,7 @@
 //! kind (bare, `text`, fenced with `~~~`, indented in a list...) fails the test: every transcript
 //! is a `console` block, or `console,no-run` with a reason.
 //!
-//! `RTORACLE_UPDATE_README=1 cargo test --test integration -- readme::` writes the real outputs
+//! `RTORACLE_UPDATE_README=1 cargo test --release --test integration -- readme::` writes the real outputs
 //! of the examples that differ into their pages instead of comparing (the others keep their
 //! masked figures).
 //!
@@ -572,7 +572,7 @@ fn every_console_example_of_the_docs_is_real_output() {
     assert!(ran > 0, "no console block ran");
     assert!(
         failures.is_empty(),
-        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --test integration -- readme:: rewrites them):\n\n{}",
+        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --release --test integration -- readme:: rewrites them):\n\n{}",
         failures.len(),
         failures.join("\n\n")
     );
@@ -932,4 +932,142 @@ fn nothing_names_a_design_note_outside_the_repository() {
         "point to docs/ instead (write what is needed there):\n{}",
         found.join("\n")
     );
+}
+
+/// Each package of `cargo tree` with the features it is built with, for the dependency `edges`
+/// given (`no-dev`: what `cargo run --release` builds; `all`: what `cargo test` builds).
+fn resolved_features(edges: &str) -> std::collections::BTreeMap<String, String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = Command::new(cargo)
+        .args(["tree", "--offline", "--locked", "--prefix", "none"])
+        .args(["-e", edges, "-f", "{p}|{f}"])
+        .current_dir(root())
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|line| {
+            let (package, features) = line.trim_end_matches(" (*)").split_once('|')?;
+            Some((package.trim().to_string(), features.trim().to_string()))
+        })
+        .collect()
+}
+
+/// The README's two set-up commands share one build: `cargo test --release` resolves, for every
+/// dependency, the features `cargo run --release` resolved. Cargo turns on the features that
+/// dev-dependencies ask of a shared dependency only when it builds tests, so a dev-dependency
+/// that asks for one makes the second command rebuild that dependency, everything above it and
+/// the library. The fix is to turn the same features on in `[dependencies]` (as `Cargo.toml`
+/// does for getrandom and once_cell).
+#[test]
+fn the_tests_resolve_the_features_of_the_release_build() {
+    let release = resolved_features("no-dev");
+    let tests = resolved_features("all");
+    assert!(release.len() > 20, "cargo tree listed {release:?}");
+    let differ: Vec<String> = release
+        .iter()
+        .filter_map(|(package, features)| {
+            let with_dev = tests.get(package)?;
+            (with_dev != features).then(|| {
+                format!(
+                    "{package}: [{features}] without the dev-dependencies, [{with_dev}] with them"
+                )
+            })
+        })
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "`cargo test --release` would rebuild these and the library; turn their features on in [dependencies]:\n{}",
+        differ.join("\n")
+    );
+}
+
+/// The README's test command: the second line of the sh block under "## Set up", without its
+/// comment.
+fn readme_test_command() -> String {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let setup = readme
+        .split("\n## Set up")
+        .nth(1)
+        .expect("README has a \"## Set up\" section");
+    let block = setup
+        .split("```sh\n")
+        .nth(1)
+        .and_then(|b| b.split("```").next())
+        .expect("the set-up section has an sh block");
+    let line = block
+        .lines()
+        .nth(1)
+        .expect("the set-up block has two commands");
+    line.split('#').next().unwrap().trim().to_string()
+}
+
+/// Every `cargo test` the README and `docs/` name, except in a paragraph about "A plain
+/// `cargo test`" (the test profile's own build, named as such): `(page, line, text)` of those
+/// that do not run in the README's profile (`cargo test --release`).
+fn cargo_tests_outside_the_readme_profile(page: &str, text: &str) -> Vec<(String, usize, String)> {
+    let mut found = Vec::new();
+    let mut plain_paragraph = false;
+    for (number, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            plain_paragraph = false;
+            continue;
+        }
+        if line.contains("A plain `cargo test`") {
+            plain_paragraph = true;
+        }
+        let mut rest = line;
+        while let Some(at) = rest.find("cargo test") {
+            let after = &rest[at + "cargo test".len()..];
+            if !plain_paragraph && !after.starts_with(" --release") {
+                found.push((page.to_string(), number + 1, line.trim().to_string()));
+            }
+            rest = after;
+        }
+    }
+    found
+}
+
+/// The README's test command is the one `.ci/run` runs, and every page that names the test
+/// suite names it in the same profile, so that a reader runs what CI runs and reuses the first
+/// set-up command's build.
+#[test]
+fn the_readme_test_command_is_the_one_ci_runs_everywhere() {
+    let command = readme_test_command();
+    assert_eq!(command, "cargo test --release", "the README's test command");
+    let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
+    assert!(
+        ci.lines().any(|line| line.trim() == command),
+        ".ci/run does not run the README's test command `{command}` as a line of its own"
+    );
+    let mut found = Vec::new();
+    for page in pages() {
+        let text = std::fs::read_to_string(root().join(&page)).unwrap();
+        found.extend(cargo_tests_outside_the_readme_profile(&page, &text));
+    }
+    let found: Vec<String> = found
+        .iter()
+        .map(|(page, line, text)| format!("{page}:{line}: {text}"))
+        .collect();
+    assert!(
+        found.is_empty(),
+        "name the README's test command `{command}` (filters after it), not another profile:\n{}",
+        found.join("\n")
+    );
+}
+
+/// The check above finds a `cargo test` in another profile and lets a paragraph about the plain
+/// one be.
+#[test]
+fn a_test_command_in_another_profile_is_found() {
+    let text = "Run `cargo test --release`.\n\nOr `cargo test --lib x::`.\n\n\
+                A plain `cargo test` works,\nas `cargo test --lib y::` does.\n\nThen `cargo test`.\n";
+    let found = cargo_tests_outside_the_readme_profile("p.md", text);
+    let lines: Vec<usize> = found.iter().map(|f| f.1).collect();
+    assert_eq!(lines, vec![3, 8]);
 }
