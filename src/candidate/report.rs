@@ -15,7 +15,9 @@
 //! must answer every vector, whatever it answers), and a definite vector left unrun for any
 //! reason but a shape the candidate said it does not implement (`not_run - unsupported`: after
 //! a group's time-outs or crashes, past the time budget). Such unscored vectors are listed in
-//! `failures` too, with their class in `expected`.
+//! `failures` too, with their class in `expected`. And a watertight group whose ray hit none of
+//! its shapes (`watertight_cracked`, of `watertight` groups judged; [`super::watertight`]):
+//! listed in `failures` under its first member's id.
 //!
 //! Every message, traceback, name and stderr line from the candidate was capped by the harness
 //! when it was read ([`super::protocol`], [`super::session`]).
@@ -34,6 +36,7 @@ use super::diagnose::Diagnosis;
 use super::outcome::Outcome;
 use super::protocol::{Answer, CandidateError};
 pub use super::repro::{expected_in_words, python_repro};
+use super::watertight::{GroupResult, crack_message, judge_groups};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
 use crate::sandbox::SandboxFacts;
 
@@ -72,6 +75,13 @@ pub struct Counts {
     /// crash fails the check.
     #[serde(default)]
     pub unscored_crashes: usize,
+    /// Watertight groups of class `hit` judged ([`super::watertight`]), counted under the
+    /// shape of their first member.
+    #[serde(default)]
+    pub watertight: usize,
+    /// Of those, the groups whose ray hit none of their shapes (a crack): each fails the check.
+    #[serde(default)]
+    pub watertight_cracked: usize,
 }
 
 impl Counts {
@@ -116,6 +126,7 @@ impl Counts {
             && self.unscored_timeouts == 0
             && self.unscored_crashes == 0
             && self.not_run == self.unsupported
+            && self.watertight_cracked == 0
             && (self.total == 0 || self.passed > 0)
     }
 
@@ -335,6 +346,24 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
             }
             Verdict::Pass => {}
         }
+    }
+    for g in judge_groups(cases, outcomes) {
+        let first = &cases[g.members[0]];
+        let group = by_shape.get_mut(&first.shape.kind()).expect("every kind");
+        match g.result {
+            GroupResult::Unjudged => continue,
+            GroupResult::Held => {}
+            GroupResult::Cracked => {
+                counts.watertight_cracked += 1;
+                group.watertight_cracked += 1;
+                let message = crack_message(&g, cases);
+                let outcome = &outcomes[g.members[0]];
+                let kind = FailureKind::Mismatch;
+                failures.push(failure(first, outcome, kind, message, info.course_api));
+            }
+        }
+        counts.watertight += 1;
+        group.watertight += 1;
     }
     CheckReport {
         candidate: info.candidate,

@@ -121,6 +121,14 @@ impl CheckReport {
                 c.unscored_timeouts, c.unscored_crashes
             );
         }
+        if c.watertight > 0 {
+            let _ = writeln!(
+                s,
+                "watertight groups: {} judged, {} cracked (a ray through an edge or vertex that \
+                 shapes share hit none of them)",
+                c.watertight, c.watertight_cracked
+            );
+        }
         if c.left_unrun() > 0 {
             let _ = writeln!(
                 s,

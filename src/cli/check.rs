@@ -233,6 +233,10 @@ pub struct Args {
     /// can still pass (the course's week 4 has no triangles).
     #[arg(long, value_name = "SHAPE", value_delimiter = ',', value_parser = shape_kind)]
     require: Vec<rtoracle::oracle::vectors::ShapeKind>,
+    /// Score the ambiguous vectors too, each by its exact answer (as a grading rubric's
+    /// `score_ambiguous` does): edges, corners and tangents answered otherwise then fail.
+    #[arg(long)]
+    score_ambiguous: bool,
 }
 
 /// A shape kind named on the command line.
@@ -298,6 +302,15 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
         anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
     }
+    let (cases, judged_by) = if args.score_ambiguous {
+        let scored = rtoracle::candidate::check::score_ambiguous(cases);
+        (
+            scored,
+            format!("{judged_by}; ambiguous vectors scored by their exact answers"),
+        )
+    } else {
+        (cases, judged_by)
+    };
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
         hello_timeout: Duration::from_millis(args.hello_timeout_ms),
