@@ -163,7 +163,9 @@ pub fn judge(case: &Case, outcome: &Outcome) -> Verdict {
         return Verdict::NotScored;
     }
     match outcome {
-        Outcome::NotRun { reason } => fail(FailureKind::NotRun, reason.clone()),
+        Outcome::NotRun { reason } | Outcome::Unsupported { reason } => {
+            fail(FailureKind::NotRun, reason.clone())
+        }
         Outcome::Timeout { junk } => fail(
             FailureKind::Timeout,
             with_junk("no answer within the timeout".into(), junk),
@@ -204,6 +206,26 @@ pub fn judge_exact(case: &Case, outcome: &Outcome) -> Verdict {
         Class::Miss
     };
     judge(&exact, outcome)
+}
+
+/// `cases` with every `ambiguous` case made definite by its exact answer (a hit when it
+/// records an exact `t`, else a miss), as `check --score-ambiguous` scores them: a candidate
+/// that gets an edge or a tangent wrong then fails, as [`judge_exact`] would say. The
+/// watertight groups' rules are unchanged (a group in the plane stays unscored).
+pub fn score_ambiguous(cases: Vec<Case>) -> Vec<Case> {
+    cases
+        .into_iter()
+        .map(|mut c| {
+            if c.expect.class == Class::Ambiguous {
+                c.expect.class = if c.expect.t.is_some() {
+                    Class::Hit
+                } else {
+                    Class::Miss
+                };
+            }
+            c
+        })
+        .collect()
 }
 
 /// Judges a well-delivered answer for a definite `case`.
@@ -359,6 +381,7 @@ mod tests {
                 normal: Some([0.0, 0.0, 1.0]),
                 normal_tol: None,
                 front_face: Some(true),
+                watertight: None,
             },
         }
     }
@@ -459,6 +482,10 @@ mod tests {
             junk: vec![],
         };
         assert!(matches!(judge_exact(&amb, &missed), Verdict::Fail { .. }));
+        // Scored as asked (`check --score-ambiguous`): the same verdicts, as definite ones.
+        let scored = score_ambiguous(vec![amb.clone()]).remove(0);
+        assert_eq!(judge(&scored, &right), Verdict::Pass);
+        assert!(matches!(judge(&scored, &missed), Verdict::Fail { .. }));
         amb.expect.t = None;
         assert_eq!(judge_exact(&amb, &missed), Verdict::Pass);
         assert_eq!(judge_exact(&case, &right), Verdict::NotScored);

@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_wound};
+use super::diagnose::{Diagnosis, SAMPLE, diagnose};
 use super::error::HarnessError;
 use super::generate::random_cases_with;
 use super::outcome::Outcome;
@@ -155,8 +156,11 @@ pub struct FuzzFailure {
     pub message: String,
     /// The random case that failed first.
     pub original: Case,
-    /// The minimal case that still fails the same way.
+    /// The smallest case found that still fails the same way: the original when it was not
+    /// shrunk ([`FuzzFailure::shrinking`] says whether and why not).
     pub minimal: Case,
+    /// What shrinking did.
+    pub shrinking: Shrinking,
     /// The minimal case's expected answer in words.
     pub expected_text: String,
     /// A Python snippet reproducing the minimal case with the course's API (course adapter
@@ -165,9 +169,41 @@ pub struct FuzzFailure {
     pub repro: String,
 }
 
+/// What shrinking did to a failure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Shrinking {
+    /// A smaller case fails the same way.
+    Shrunk,
+    /// The shrinker tried and found no smaller case failing the same way.
+    NothingSmaller,
+    /// Not tried: a time-out or a crash costs a restart per try, so it is kept as found.
+    KeptAsFound,
+    /// Not tried (or not finished): the time for shrinking was used up.
+    OutOfTime,
+}
+
+impl Shrinking {
+    /// How the report introduces the case.
+    pub fn label(self) -> &'static str {
+        match self {
+            Shrinking::Shrunk => "minimal case",
+            Shrinking::NothingSmaller => {
+                "case as found (the shrinker found no smaller one failing the same way)"
+            }
+            Shrinking::KeptAsFound => {
+                "case as found (not shrunk: a time-out or crash costs a restart per try)"
+            }
+            Shrinking::OutOfTime => "case as found (not shrunk: the time for shrinking ran out)",
+        }
+    }
+}
+
 /// The result of a fuzz run.
 #[derive(Clone, Debug, Serialize)]
 pub struct FuzzReport {
+    /// What the cases were classified by (`"course/f64"`, ...; see [`Judging`]).
+    pub judged_by: String,
     /// Cases run (not counting shrinking).
     pub cases_run: usize,
     /// Cases that failed.
@@ -178,6 +214,13 @@ pub struct FuzzReport {
     pub by_kind: Vec<KindCount>,
     /// One shrunk failure per shape group and kind, in the order found.
     pub failures: Vec<FuzzFailure>,
+    /// The known mistakes that explain the failures, per shape group ([`super::diagnose`], on
+    /// the failing cases and a sample of the passing ones).
+    pub diagnosis: Vec<Diagnosis>,
+    /// What the harness noticed about the candidate's use of the protocol (filled in by the
+    /// caller from [`Session::notes`](super::session::Session::notes)).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// How many cases of one shape failed one way.
@@ -195,10 +238,14 @@ impl FuzzReport {
     /// A text rendering with every reproduction (candidate text escaped for the terminal).
     pub fn to_text(&self) -> String {
         use crate::escape::terminal_line;
-        let mut s = format!(
+        let mut s = format!("judged by: {}\n", self.judged_by);
+        for note in &self.notes {
+            s.push_str(&format!("note: {}\n", terminal_line(note)));
+        }
+        s.push_str(&format!(
             "{} random definite cases run in {:.1} s, {} failed\n",
             self.cases_run, self.search_seconds, self.failed
-        );
+        ));
         for k in &self.by_kind {
             s.push_str(&format!(
                 "  {} {}: {} failed\n",
@@ -207,13 +254,17 @@ impl FuzzReport {
                 k.count
             ));
         }
+        for d in &self.diagnosis {
+            s.push_str(&format!("diagnosis: {}\n", d.sentence()));
+        }
         for f in &self.failures {
             s.push_str(&format!(
-                "\n[{}] {} ({}): {}\n  minimal case (vector line):\n    {}\n  expected: {}\n",
+                "\n[{}] {} ({}): {}\n  {} (vector line):\n    {}\n  expected: {}\n",
                 f.detail.name(),
                 terminal_line(&f.minimal.id),
                 f.minimal.shape.kind(),
                 terminal_line(&f.message),
+                f.shrinking.label(),
                 f.minimal.to_json_line(),
                 f.expected_text
             ));
@@ -232,18 +283,55 @@ impl FuzzReport {
 /// the check report counts it).
 type Found = (Case, FuzzKind, FailureKind);
 
+/// Most failing cases of a shape kept for the diagnosis.
+const DIAGNOSIS_FAILURES: usize = 500;
+
+/// What the diagnosis is made from: the first [`DIAGNOSIS_FAILURES`] failing cases of each
+/// shape and the first [`SAMPLE`] passing ones, with their outcomes.
+#[derive(Default)]
+struct Evidence {
+    cases: Vec<Case>,
+    outcomes: Vec<Outcome>,
+    /// Failing and passing cases kept, per shape.
+    kept: std::collections::BTreeMap<ShapeKind, (usize, usize)>,
+}
+
+impl Evidence {
+    fn keep(&mut self, case: &Case, outcome: &Outcome, failed: bool) {
+        let (failing, passing) = self.kept.entry(case.shape.kind()).or_default();
+        let room = if failed {
+            failing
+        } else if matches!(outcome, Outcome::Answered { .. }) {
+            passing
+        } else {
+            return;
+        };
+        let cap = if failed { DIAGNOSIS_FAILURES } else { SAMPLE };
+        if *room < cap {
+            *room += 1;
+            self.cases.push(case.clone());
+            self.outcomes.push(outcome.clone());
+        }
+    }
+}
+
 /// Runs the fuzzer with `run` as the candidate (a batch of cases in, one outcome per case out).
 pub fn fuzz(run: &mut RunBatch<'_>, options: &FuzzOptions) -> Result<FuzzReport, HarnessError> {
     let start = Instant::now();
     let mut report = FuzzReport {
+        judged_by: options.judging.to_string(),
         cases_run: 0,
         failed: 0,
         search_seconds: 0.0,
         by_kind: Vec::new(),
         failures: Vec::new(),
+        diagnosis: Vec::new(),
+        notes: Vec::new(),
     };
-    let (found, winding) = search(run, options, &mut report, start)?;
+    let mut evidence = Evidence::default();
+    let (found, winding) = search(run, options, &mut report, &mut evidence, start)?;
     report.search_seconds = start.elapsed().as_secs_f64();
+    report.diagnosis = diagnose(&evidence.cases, &evidence.outcomes, winding);
     // With a time limit T, shrinking gets a tenth of it more (at least 0.2 s, at most
     // SHRINK_TIME), so `--time 6` ends by about 6.6 s; without one, SHRINK_TIME.
     let shrink_time = match options.time {
@@ -265,6 +353,7 @@ fn search(
     run: &mut RunBatch<'_>,
     options: &FuzzOptions,
     report: &mut FuzzReport,
+    evidence: &mut Evidence,
     start: Instant,
 ) -> Result<(Vec<Found>, Option<Winding>), HarnessError> {
     let mut found: Vec<Found> = Vec::new();
@@ -291,13 +380,18 @@ fn search(
         }
         let outcomes = run(&cases)?;
         // Nothing can run any more (every group used up its timeouts or crashes): stop.
-        if outcomes.iter().all(|o| matches!(o, Outcome::NotRun { .. })) {
+        if outcomes
+            .iter()
+            .all(|o| matches!(o, Outcome::NotRun { .. } | Outcome::Unsupported { .. }))
+        {
             break;
         }
         report.cases_run += cases.len();
         winding = winding.or_else(|| decide_winding(&cases, &outcomes));
         for (case, outcome) in cases.iter().zip(&outcomes) {
-            let Some(detail) = FuzzKind::of_wound(case, outcome, winding) else {
+            let detail = FuzzKind::of_wound(case, outcome, winding);
+            evidence.keep(case, outcome, detail.is_some());
+            let Some(detail) = detail else {
                 continue;
             };
             report.failed += 1;
@@ -338,7 +432,14 @@ fn shrunk(
     shrink_until: Instant,
 ) -> Result<FuzzFailure, HarnessError> {
     let keep = matches!(detail, FuzzKind::Timeout | FuzzKind::Crash);
-    let minimal = if keep || Instant::now() >= shrink_until {
+    let mut shrinking = if keep {
+        Shrinking::KeptAsFound
+    } else if Instant::now() >= shrink_until {
+        Shrinking::OutOfTime
+    } else {
+        Shrinking::Shrunk
+    };
+    let minimal = if shrinking != Shrinking::Shrunk {
         case.clone()
     } else {
         let mut fails = |batch: &[Case]| -> Vec<Option<FuzzKind>> {
@@ -354,13 +455,21 @@ fn shrunk(
                 Err(_) => vec![None; batch.len()],
             }
         };
-        super::shrink::shrink_with(
+        let minimal = super::shrink::shrink_with(
             &case,
             detail,
             &mut fails,
             options.shrink_budget,
             options.judging,
-        )
+        );
+        if minimal == case {
+            shrinking = if Instant::now() >= shrink_until {
+                Shrinking::OutOfTime
+            } else {
+                Shrinking::NothingSmaller
+            };
+        }
+        minimal
     };
     let message = match run(std::slice::from_ref(&minimal))?
         .first()
@@ -381,6 +490,7 @@ fn shrunk(
         },
         original: case,
         minimal,
+        shrinking,
     })
 }
 
@@ -519,6 +629,61 @@ mod tests {
         let report = fuzz(&mut exhausted, &options).unwrap();
         assert!(start.elapsed() < Duration::from_secs(5));
         assert_eq!((report.cases_run, report.failed), (0, 0));
+    }
+
+    /// The report called every case "minimal", time-outs never shrunk included, and did not
+    /// say what it judged by nor which mistake explains the failures.
+    #[test]
+    fn only_shrunk_cases_are_called_minimal_and_the_report_says_its_judging_and_diagnosis() {
+        let options = FuzzOptions {
+            cases: Some(2000),
+            seed: 1,
+            course_api: false,
+            ..FuzzOptions::default()
+        };
+        // Times out on every sphere hit seen from outside, answers the rest as NoFlip does.
+        let mut hangs = |c: &[Case]| {
+            let mut outcomes = run_candidate(&mut NoFlip, c);
+            for (case, o) in c.iter().zip(outcomes.iter_mut()) {
+                let front = case.expect.front_face == Some(true);
+                if matches!(case.shape, ShapeSpec::Sphere { .. }) && front {
+                    *o = Outcome::Timeout { junk: vec![] };
+                }
+            }
+            Ok(outcomes)
+        };
+        let report = fuzz(&mut hangs, &options).unwrap();
+        let text = report.to_text();
+        assert!(text.starts_with("judged by: course/f64\n"), "{text}");
+        let timeout = report
+            .failures
+            .iter()
+            .find(|f| f.detail == FuzzKind::Timeout)
+            .expect("a time-out");
+        assert_eq!(timeout.shrinking, Shrinking::KeptAsFound);
+        assert_eq!(timeout.minimal, timeout.original);
+        let normal = report
+            .failures
+            .iter()
+            .find(|f| f.detail == FuzzKind::Normal)
+            .expect("a wrong normal");
+        assert_eq!(normal.shrinking, Shrinking::Shrunk);
+        assert_ne!(normal.minimal, normal.original);
+        assert_eq!(
+            text.matches("minimal case (vector line)").count(),
+            1,
+            "{text}"
+        );
+        assert!(text.contains(
+            "case as found (not shrunk: a time-out or crash costs a restart per try) (vector line)"
+        ));
+        // NoFlip's wrong normals are the catalogue's unflipped normal.
+        assert_eq!(report.diagnosis.len(), 1, "{text}");
+        assert_eq!(report.diagnosis[0].shape, ShapeKind::Sphere);
+        assert!(text.contains("diagnosis: "), "{text}");
+        let json = serde_json::to_value(&report).unwrap();
+        assert_eq!(json["judged_by"], "course/f64");
+        assert!(json["failures"][0]["shrinking"].is_string());
     }
 
     #[test]

@@ -15,7 +15,8 @@
 //!   runnable in the sandbox).
 //! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and
 //!   [`build_report`]; [`report_text`]: its text; [`repro`]: expected answers in words and
-//!   Python reproductions.
+//!   Python reproductions; [`watertight`]: the rule of the watertight groups (a ray through an
+//!   edge shared by two shapes hits at least one).
 //! - [`diagnose`]: the known mistake (a buggy variant of the oracle) that explains the failures.
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
 //! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
@@ -46,6 +47,7 @@ pub mod session;
 pub mod shrink;
 #[cfg(test)]
 pub(crate) mod test_cases;
+pub mod watertight;
 
 pub use crate::sandbox::SandboxPolicy;
 pub use check::{FailureKind, Verdict, judge};
@@ -77,6 +79,7 @@ pub fn run_info(session: &Session) -> RunInfo {
         restarts: session.restarts(),
         sandbox: Some(session.sandbox_facts()),
         course_api: session.command().is_course_adapter(),
+        notes: session.notes().to_vec(),
     }
 }
 

@@ -1,5 +1,6 @@
 //! What the harness got for one case of a candidate run as a process ([`Outcome`]): an answer,
-//! a protocol error, a time-out, a death, or a case not run.
+//! a protocol error, a time-out, a death, a case of a shape the candidate does not implement,
+//! or a case the harness stopped running.
 
 use super::protocol::Answer;
 
@@ -34,9 +35,18 @@ pub enum Outcome {
         /// Stray output before it died.
         junk: Vec<String>,
     },
-    /// The case was not sent: unsupported shape, or its group used up its timeouts.
+    /// The case was not sent because the harness stopped running it: its group used up its
+    /// timeouts or crashes, or the session its time budget. A definite case left so fails the
+    /// check.
     NotRun {
         /// Why.
+        reason: String,
+    },
+    /// The case was not sent: the candidate said it does not implement the case's shape (its
+    /// hello's `shapes`, or [`Candidate::supports`](super::rust::Candidate::supports)). This
+    /// alone fails no check (unless the shape is required).
+    Unsupported {
+        /// Why, in words.
         reason: String,
     },
 }

@@ -57,6 +57,9 @@ pub(crate) enum Line {
     Parsed(ParsedLine),
     /// A line longer than [`MAX_LINE_BYTES`]: its first characters, quoted.
     Oversize(String),
+    /// What the process wrote after its last newline before its stdout ended (it died in the
+    /// middle of a line): the start of it, quoted. An [`Line::Eof`] follows.
+    Partial(String),
     /// The end of its stdout.
     Eof,
 }
@@ -222,8 +225,10 @@ fn read_lines(stdout: ChildStdout, tx: SyncSender<Line>) {
     loop {
         let (done, used) = match reader.fill_buf() {
             Ok([]) => {
+                // A line is one once its newline came: what is left was cut off by the end.
                 if !line.is_empty() {
-                    let _ = tx.send(finish(&line, oversize));
+                    let text = String::from_utf8_lossy(&line);
+                    let _ = tx.send(Line::Partial(quote_line(&text)));
                 }
                 let _ = tx.send(Line::Eof);
                 return;

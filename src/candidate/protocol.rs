@@ -224,6 +224,28 @@ impl CandidateError {
     }
 }
 
+/// `s` quoted for a report around the byte `at` (where a parser found the problem): the
+/// [`MAX_QUOTE_CHARS`] characters that end a quarter of that past it, with `...` where cut on
+/// either side, in Rust string syntax. A line short enough is quoted whole ([`quote_line`]).
+pub fn quote_around(s: &str, at: usize) -> String {
+    let chars: Vec<(usize, char)> = s.char_indices().collect();
+    if chars.len() <= MAX_QUOTE_CHARS {
+        return quote_line(s);
+    }
+    let at_char = chars.partition_point(|&(i, _)| i < at.min(s.len()));
+    let end = (at_char + MAX_QUOTE_CHARS / 4).clamp(MAX_QUOTE_CHARS, chars.len());
+    let start = end - MAX_QUOTE_CHARS;
+    let byte = |k: usize| chars.get(k).map_or(s.len(), |&(i, _)| i);
+    let mut q = format!("{:?}", &s[byte(start)..byte(end)]);
+    if start > 0 {
+        q.insert_str(0, "...");
+    }
+    if end < chars.len() {
+        q.push_str("...");
+    }
+    q
+}
+
 /// `s` quoted for a report: at most [`MAX_QUOTE_CHARS`] characters (with `...` when cut), in
 /// Rust string syntax, so control characters show as escapes.
 pub fn quote_line(s: &str) -> String {
@@ -347,6 +369,23 @@ fn malformed(id: Option<String>, problem: String, line: &str) -> ParsedLine {
     }
 }
 
+/// A malformed answer whose problem the JSON parser placed (`error`, from parsing the text
+/// that starts `offset` bytes into `line`): the quote is taken around that place, so a long line
+/// still shows what is wrong.
+fn malformed_at(
+    id: Option<String>,
+    problem: String,
+    line: &str,
+    offset: usize,
+    error: &serde_json::Error,
+) -> ParsedLine {
+    ParsedLine::Malformed {
+        id,
+        problem,
+        quoted: quote_around(line, offset + error.column()),
+    }
+}
+
 /// Parses one stdout line: an answer, a malformed answer, a hello, or junk. A line that is
 /// not an answer but contains one after some junk (a stray `print(..., end="")`) yields the
 /// answer and the junk. Every text kept from the line is capped, so what a line costs in memory
@@ -381,19 +420,35 @@ pub fn parse_line(line: &str) -> ParsedLine {
             let Some(id) = map.get("id").and_then(|v| v.as_str()).map(str::to_string) else {
                 return malformed(None, "its \"id\" is not a string".into(), trimmed);
             };
-            match serde_json::from_value::<AnswerLine>(serde_json::Value::Object(map)) {
+            // Parsed again from the text, so the error says where in the line it is.
+            match serde_json::from_str::<AnswerLine>(object) {
                 Ok(a) => answer_or_malformed(a, prefix, trimmed),
-                Err(e) => malformed(Some(id), format!("not a valid answer: {e}"), trimmed),
+                Err(e) => malformed_at(
+                    Some(id),
+                    format!("not a valid answer: {e}"),
+                    trimmed,
+                    trimmed.len() - object.len(),
+                    &e,
+                ),
             }
         }
         Ok(_) => ParsedLine::Junk(quote_line(trimmed)),
-        Err(e) => match lenient_id(object) {
-            Some(id) => malformed(Some(id), format!("not valid JSON: {e}"), trimmed),
-            None if object.starts_with("{\"id\"") => {
-                malformed(None, format!("not valid JSON: {e}"), trimmed)
+        Err(e) => {
+            let offset = trimmed.len() - object.len();
+            match lenient_id(object) {
+                Some(id) => malformed_at(
+                    Some(id),
+                    format!("not valid JSON: {e}"),
+                    trimmed,
+                    offset,
+                    &e,
+                ),
+                None if object.starts_with("{\"id\"") => {
+                    malformed_at(None, format!("not valid JSON: {e}"), trimmed, offset, &e)
+                }
+                None => ParsedLine::Junk(quote_line(trimmed)),
             }
-            None => ParsedLine::Junk(quote_line(trimmed)),
-        },
+        }
     }
 }
 
@@ -447,9 +502,80 @@ pub struct Hello {
     /// every case is then reported with this error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<CandidateError>,
+    /// The keys of the hello that the protocol does not name (a misspelt `shape` for
+    /// `shapes`), quoted; ignored, but warned about ([`Hello::warnings`]).
+    #[serde(skip)]
+    pub unknown_keys: Vec<String>,
+}
+
+/// The keys a hello answer may have.
+pub const HELLO_KEYS: [&str; 4] = ["name", "protocol", "shapes", "error"];
+
+/// The keys of `map` that are not [`HELLO_KEYS`], in order, each capped; at most 8.
+fn unknown_hello_keys(map: &serde_json::Map<String, serde_json::Value>) -> Vec<String> {
+    map.keys()
+        .filter(|k| !HELLO_KEYS.contains(&k.as_str()))
+        .take(8)
+        .map(|k| crate::escape::truncate(k, 40))
+        .collect()
+}
+
+/// The known key `key` is likely a misspelling of: one edit away, or the same but for case
+/// or a plural `s`.
+fn likely_hello_key(key: &str) -> Option<&'static str> {
+    let key = key.to_ascii_lowercase();
+    HELLO_KEYS.into_iter().find(|known| {
+        *known == key
+            || key.strip_suffix('s') == Some(known)
+            || known.strip_suffix('s') == Some(key.as_str())
+            || one_edit_apart(known, &key)
+    })
+}
+
+/// Whether `a` becomes `b` by one insertion, deletion or substitution of a character.
+fn one_edit_apart(a: &str, b: &str) -> bool {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let (short, long) = if a.len() <= b.len() {
+        (&a, &b)
+    } else {
+        (&b, &a)
+    };
+    if long.len() - short.len() > 1 || a == b {
+        return false;
+    }
+    let k = short
+        .iter()
+        .zip(long.iter())
+        .take_while(|(x, y)| x == y)
+        .count();
+    if short.len() == long.len() {
+        short[k + 1..] == long[k + 1..]
+    } else {
+        short[k..] == long[k + 1..]
+    }
 }
 
 impl Hello {
+    /// What the harness warns about in this hello: each key the protocol does not name, with
+    /// the key it is likely a misspelling of.
+    pub fn warnings(&self) -> Vec<String> {
+        self.unknown_keys
+            .iter()
+            .map(|key| {
+                let hint = match likely_hello_key(key) {
+                    Some(known) => format!(" (did you mean \"{known}\"?)"),
+                    None => String::new(),
+                };
+                format!(
+                    "its hello has the key {}, which the protocol does not name, so it was \
+                     ignored{hint}; a hello's keys are {}",
+                    quote_line(key),
+                    HELLO_KEYS.join(", ")
+                )
+            })
+            .collect()
+    }
+
     /// Parses a hello answer line; `None` when the line is not one (or not a valid one).
     pub fn parse(line: &str) -> Option<Hello> {
         match parse_line(line) {
@@ -461,8 +587,13 @@ impl Hello {
     /// A hello from a JSON object (no `id`, a `name` or a `protocol`); `Err` says what is wrong
     /// with its fields. Text fields are capped.
     fn from_value(value: serde_json::Value) -> Result<Hello, String> {
+        let unknown_keys = match &value {
+            serde_json::Value::Object(map) => unknown_hello_keys(map),
+            _ => Vec::new(),
+        };
         let mut hello: Hello =
             serde_json::from_value(value).map_err(|e| format!("its hello is malformed: {e}"))?;
+        hello.unknown_keys = unknown_keys;
         if hello.name.len() > MAX_QUOTE_CHARS {
             hello.name = crate::escape::truncate(&hello.name, MAX_QUOTE_CHARS);
         }
@@ -643,6 +774,64 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
+    }
+
+    /// The quote of a long bad answer (400 characters of an unknown field before the bad key) showed
+    /// its first 200 characters, which stopped before the problem.
+    #[test]
+    fn a_long_bad_answer_is_quoted_around_its_problem() {
+        let pad = "p".repeat(400);
+        let line = format!(
+            r#"{{"id":"v1","hit":true,"t":1.0,"pad":"{pad}","normal":[0,0,1],"front_face":"yes"}}"#
+        );
+        assert!(line.len() > 2 * MAX_QUOTE_CHARS);
+        match parse_line(&line) {
+            ParsedLine::Malformed {
+                problem, quoted, ..
+            } => {
+                assert!(problem.contains("expected a boolean"), "{problem}");
+                assert!(quoted.contains(r#"front_face\":\"yes"#), "{quoted}");
+                assert!(quoted.starts_with("...\""), "{quoted}");
+                assert!(quoted.len() <= MAX_QUOTE_CHARS + 60, "{quoted}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // Not JSON at all, far into the line: the same.
+        let line = format!(r#"{{"id":"v2","hit":true,"pad":"{pad}","t":nan}}"#);
+        match parse_line(&line) {
+            ParsedLine::Malformed { quoted, .. } => {
+                assert!(quoted.contains(r#"\"t\":nan"#), "{quoted}")
+            }
+            other => panic!("{other:?}"),
+        }
+        // A short line is quoted whole.
+        assert_eq!(quote_around("abc", 2), "\"abc\"");
+        let s = "é".repeat(500);
+        let q = quote_around(&s, 700);
+        assert!(q.starts_with("...\"") && q.ends_with("\"..."), "{q}");
+    }
+
+    /// A misspelt key (`shape` for `shapes`) was silently ignored: it is warned about, with the
+    /// key meant.
+    #[test]
+    fn unknown_hello_keys_are_warned_about() {
+        let h =
+            Hello::parse(r#"{"name":"c","protocol":1,"shape":["sphere"],"x-build":"7"}"#).unwrap();
+        assert_eq!(h.check(), Ok(()));
+        let w = h.warnings();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].contains("\"shape\"") && w[0].contains("did you mean \"shapes\"?"),
+            "{w:?}"
+        );
+        assert!(w[1].contains("\"x-build\"") && !w[1].contains("did you mean"));
+        assert!(w[1].contains("name, protocol, shapes, error"));
+        let ok = Hello::parse(r#"{"name":"c","protocol":1,"shapes":["sphere"]}"#).unwrap();
+        assert!(ok.warnings().is_empty());
+        for (typo, meant) in [("nme", "name"), ("protocl", "protocol"), ("Error", "error")] {
+            assert_eq!(likely_hello_key(typo), Some(meant), "{typo}");
+        }
+        assert_eq!(likely_hello_key("colour"), None);
     }
 
     #[test]

@@ -6,9 +6,18 @@
 //! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
 //! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
 //! `errors` counts raised errors, dead processes and protocol errors. `ambiguous` counts the
-//! `ambiguous` vectors and `any` the `any` vectors (degenerate or non-finite inputs); both are
-//! run and reported but never scored. `ambiguous_passed` counts the `ambiguous` vectors answered
-//! with the exact answer (so `ambiguous_passed <= ambiguous`).
+//! `ambiguous` vectors and `any` the `any` vectors (degenerate or non-finite inputs); their
+//! answers are never scored. `ambiguous_passed` counts the `ambiguous` vectors answered with the
+//! exact answer (so `ambiguous_passed <= ambiguous`).
+//!
+//! What fails a check besides a definite vector answered wrong: a time-out or a dead process on
+//! *any* vector, unscored ones included (`unscored_timeouts`, `unscored_crashes`: a candidate
+//! must answer every vector, whatever it answers), and a definite vector left unrun for any
+//! reason but a shape the candidate said it does not implement (`not_run - unsupported`: after
+//! a group's time-outs or crashes, past the time budget). Such unscored vectors are listed in
+//! `failures` too, with their class in `expected`. And a watertight group whose ray hit none of
+//! its shapes (`watertight_cracked`, of `watertight` groups judged; [`super::watertight`]):
+//! listed in `failures` under its first member's id.
 //!
 //! Every message, traceback, name and stderr line from the candidate was capped by the harness
 //! when it was read ([`super::protocol`], [`super::session`]).
@@ -27,6 +36,7 @@ use super::diagnose::Diagnosis;
 use super::outcome::Outcome;
 use super::protocol::{Answer, CandidateError};
 pub use super::repro::{expected_in_words, python_repro};
+use super::watertight::{GroupResult, crack_message, judge_groups};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
 use crate::sandbox::SandboxFacts;
 
@@ -53,10 +63,39 @@ pub struct Counts {
     /// accepted (not scored).
     #[serde(default)]
     pub any: usize,
+    /// Definite vectors not run because the candidate does not implement their shape (counted
+    /// in `not_run` too); the other vectors not run fail the check.
+    #[serde(default)]
+    pub unsupported: usize,
+    /// `ambiguous` and `any` vectors with no answer within the time-out: not scored, but a hang
+    /// fails the check.
+    #[serde(default)]
+    pub unscored_timeouts: usize,
+    /// `ambiguous` and `any` vectors on which the candidate's process died: not scored, but a
+    /// crash fails the check.
+    #[serde(default)]
+    pub unscored_crashes: usize,
+    /// Watertight groups of class `hit` judged ([`super::watertight`]), counted under the
+    /// shape of their first member.
+    #[serde(default)]
+    pub watertight: usize,
+    /// Of those, the groups whose ray hit none of their shapes (a crack): each fails the check.
+    #[serde(default)]
+    pub watertight_cracked: usize,
 }
 
 impl Counts {
-    fn add(&mut self, class: Class, verdict: &Verdict) {
+    fn add(&mut self, class: Class, outcome: &Outcome, verdict: &Verdict) {
+        if let Verdict::NotScored = verdict {
+            match outcome {
+                Outcome::Timeout { .. } => self.unscored_timeouts += 1,
+                Outcome::Died { .. } => self.unscored_crashes += 1,
+                _ => {}
+            }
+        }
+        if let Outcome::Unsupported { .. } = outcome {
+            self.unsupported += usize::from(class.is_definite());
+        }
         match verdict {
             Verdict::NotScored if class == Class::Any => self.any += 1,
             Verdict::NotScored => self.ambiguous += 1,
@@ -76,18 +115,30 @@ impl Counts {
         }
     }
 
-    /// Whether no definite vector failed, raised an error or timed out, and at least one
-    /// passed if there were any (vectors not run, e.g. of a shape the candidate does not
-    /// implement, do not count against it, but a candidate that runs nothing does not pass).
+    /// Whether no definite vector failed, raised an error or timed out, no vector at all hung
+    /// or killed the candidate, every definite vector ran but those of a shape the candidate
+    /// does not implement, and at least one passed if there were any (a candidate that runs
+    /// nothing does not pass).
     pub fn all_passed(&self) -> bool {
         self.failed == 0
             && self.errors == 0
             && self.timeouts == 0
+            && self.unscored_timeouts == 0
+            && self.unscored_crashes == 0
+            && self.not_run == self.unsupported
+            && self.watertight_cracked == 0
             && (self.total == 0 || self.passed > 0)
+    }
+
+    /// Definite vectors the harness stopped running (after a group's time-outs or crashes, or
+    /// past the time budget): each fails the check.
+    pub fn left_unrun(&self) -> usize {
+        self.not_run - self.unsupported
     }
 }
 
-/// One definite vector that was run and did not pass.
+/// One vector that was run and did not pass: a definite vector answered wrong (or not at all),
+/// or any vector on which the candidate hung or died.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Failure {
     /// The vector's id.
@@ -141,7 +192,8 @@ pub struct CheckReport {
     pub counts: Counts,
     /// Counts per shape group (all three groups are always present).
     pub by_shape: BTreeMap<ShapeKind, Counts>,
-    /// Every definite vector that was run and did not pass, in suite order.
+    /// Every definite vector that was run and did not pass, and every vector on which the
+    /// candidate hung or died (`ambiguous` and `any` ones included), in suite order.
     pub failures: Vec<Failure>,
     /// The definite vectors not run, per shape and reason, in the order first met.
     #[serde(default)]
@@ -167,6 +219,11 @@ pub struct CheckReport {
     /// The known mistakes that explain the failures, per shape group ([`super::diagnose`]).
     #[serde(default)]
     pub diagnosis: Vec<Diagnosis>,
+    /// What the harness noticed about the candidate's use of the protocol that is no vector's
+    /// failure: keys of its hello the protocol does not name, answers that never came after the
+    /// hello (stdout not flushed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     /// The shapes the check requires (`check --require`): one of them with a definite vector
     /// not run (a candidate without triangles, say) fails the check ([`Self::required_not_run`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -191,6 +248,53 @@ pub struct RunInfo {
     /// Whether the candidate is the course's Python API (through the bundled adapter): its
     /// failures then carry a Python reproduction.
     pub course_api: bool,
+    /// What the harness noticed about the candidate's use of the protocol
+    /// ([`Session::notes`](super::session::Session::notes)).
+    pub notes: Vec<String>,
+}
+
+/// The failure of `case`.
+fn failure(
+    case: &Case,
+    outcome: &Outcome,
+    kind: FailureKind,
+    message: String,
+    course_api: bool,
+) -> Failure {
+    let actual = match outcome {
+        Outcome::Answered { answer, .. } => Some(answer.clone()),
+        _ => None,
+    };
+    Failure {
+        id: case.id.clone(),
+        shape: case.shape.kind(),
+        tags: case.expect.tags.clone(),
+        kind,
+        expected: case.expect.clone(),
+        expected_text: expected_in_words(&case.expect),
+        actual,
+        message,
+        repro: if course_api {
+            python_repro(case)
+        } else {
+            String::new()
+        },
+        request: super::protocol::Request::for_case(case).to_line(),
+    }
+}
+
+/// What fails the check on a vector that is not scored: a time-out or a dead process, which no
+/// answer excuses.
+fn unscored_failure(outcome: &Outcome) -> Option<(FailureKind, String)> {
+    let note = "on a vector that is not scored, but a candidate must answer every vector";
+    match outcome {
+        Outcome::Timeout { .. } => Some((
+            FailureKind::Timeout,
+            format!("no answer within the timeout ({note})"),
+        )),
+        Outcome::Died { message, .. } => Some((FailureKind::Error, format!("{message} ({note})"))),
+        _ => None,
+    }
 }
 
 /// Judges every outcome and builds the report.
@@ -208,8 +312,8 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         let verdict = judge_wound(case, outcome, winding);
         let class = case.expect.class;
         let group = by_shape.get_mut(&case.shape.kind()).expect("every kind");
-        counts.add(class, &verdict);
-        group.add(class, &verdict);
+        counts.add(class, outcome, &verdict);
+        group.add(class, outcome, &verdict);
         if judge_exact_wound(case, outcome, winding) == Verdict::Pass {
             counts.ambiguous_passed += 1;
             group.ambiguous_passed += 1;
@@ -233,29 +337,33 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
                 }
             }
             Verdict::Fail { kind, message } => {
-                let actual = match outcome {
-                    Outcome::Answered { answer, .. } => Some(answer.clone()),
-                    _ => None,
-                };
-                failures.push(Failure {
-                    id: case.id.clone(),
-                    shape: case.shape.kind(),
-                    tags: case.expect.tags.clone(),
-                    kind,
-                    expected: case.expect.clone(),
-                    expected_text: expected_in_words(&case.expect),
-                    actual,
-                    message,
-                    repro: if info.course_api {
-                        python_repro(case)
-                    } else {
-                        String::new()
-                    },
-                    request: super::protocol::Request::for_case(case).to_line(),
-                });
+                failures.push(failure(case, outcome, kind, message, info.course_api));
             }
-            _ => {}
+            Verdict::NotScored => {
+                if let Some((kind, message)) = unscored_failure(outcome) {
+                    failures.push(failure(case, outcome, kind, message, info.course_api));
+                }
+            }
+            Verdict::Pass => {}
         }
+    }
+    for g in judge_groups(cases, outcomes) {
+        let first = &cases[g.members[0]];
+        let group = by_shape.get_mut(&first.shape.kind()).expect("every kind");
+        match g.result {
+            GroupResult::Unjudged => continue,
+            GroupResult::Held => {}
+            GroupResult::Cracked => {
+                counts.watertight_cracked += 1;
+                group.watertight_cracked += 1;
+                let message = crack_message(&g, cases);
+                let outcome = &outcomes[g.members[0]];
+                let kind = FailureKind::Mismatch;
+                failures.push(failure(first, outcome, kind, message, info.course_api));
+            }
+        }
+        counts.watertight += 1;
+        group.watertight += 1;
     }
     CheckReport {
         candidate: info.candidate,
@@ -271,6 +379,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         sandbox: info.sandbox,
         triangle_winding: winding,
         diagnosis: super::diagnose::diagnose(cases, outcomes, winding),
+        notes: info.notes,
         required: Vec::new(),
     }
 }
@@ -373,6 +482,72 @@ mod tests {
         let text = report.to_text(5);
         assert!(text.contains("  request: {\"id\":") && text.contains("  expected: a "));
         assert!(!text.contains("RT_object"), "{text}");
+    }
+
+    /// The reference's answers to `cases`.
+    fn right(cases: &[Case]) -> Vec<Outcome> {
+        cases
+            .iter()
+            .map(|c| Outcome::Answered {
+                answer: Answer::from_record(crate::geometry::Shape::intersect(
+                    &c.shape.object(),
+                    &c.ray.ray(),
+                    c.interval(),
+                )),
+                junk: vec![],
+            })
+            .collect()
+    }
+
+    /// A hang or a death on a vector that is not scored counted for nothing (an adapter hanging
+    /// on every degenerate quad got PASS), and so did the definite vectors left unrun after a
+    /// group's time-outs; a shape the candidate does not implement still fails nothing.
+    #[test]
+    fn hangs_and_crashes_anywhere_and_vectors_left_unrun_fail_the_check() {
+        let mut cases = crate::candidate::test_cases::basic_cases();
+        cases[0].expect.class = Class::Any;
+        cases[1].expect.class = Class::Ambiguous;
+        let mut outcomes = right(&cases);
+        assert!(build_report(&cases, &outcomes, RunInfo::default()).passed());
+        outcomes[0] = Outcome::Timeout { junk: vec![] };
+        let r = build_report(&cases, &outcomes, RunInfo::default());
+        assert!(!r.passed());
+        assert_eq!((r.counts.unscored_timeouts, r.counts.timeouts), (1, 0));
+        assert_eq!(r.by_shape[&ShapeKind::Sphere].unscored_timeouts, 1);
+        assert_eq!(r.failures.len(), 1);
+        assert_eq!(
+            (r.failures[0].id.as_str(), r.failures[0].kind),
+            ("sphere-basic-0000", FailureKind::Timeout)
+        );
+        assert!(
+            r.to_text(5)
+                .contains("hangs and crashes: 1 time-outs and 0 crashes")
+        );
+        outcomes[0] = right(&cases).remove(0);
+        outcomes[1] = Outcome::Died {
+            message:
+                "the candidate died on this case: its process was killed by signal 6 (SIGABRT)"
+                    .into(),
+            junk: vec![],
+        };
+        let r = build_report(&cases, &outcomes, RunInfo::default());
+        assert!(!r.passed());
+        assert_eq!(r.counts.unscored_crashes, 1);
+        assert!(r.failures[0].message.contains("SIGABRT"));
+        outcomes[1] = right(&cases).remove(1);
+        outcomes[3] = Outcome::NotRun {
+            reason: "not run after 3 timeouts in the quad group".into(),
+        };
+        let r = build_report(&cases, &outcomes, RunInfo::default());
+        assert!(!r.passed());
+        assert_eq!((r.counts.not_run, r.counts.left_unrun()), (1, 1));
+        assert!(r.to_text(5).contains("left unrun: 1 definite vectors"));
+        outcomes[3] = Outcome::Unsupported {
+            reason: "the candidate does not support quads".into(),
+        };
+        let r = build_report(&cases, &outcomes, RunInfo::default());
+        assert!(r.passed(), "{}", r.to_text(5));
+        assert_eq!((r.counts.not_run, r.counts.unsupported), (1, 1));
     }
 
     #[test]

@@ -8,8 +8,10 @@
 //! the terminal or fake a line of the report. When every failure is the same error (a
 //! submission that cannot be imported), the text says it once.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 
+use super::check::FailureKind;
 use super::report::{CheckReport, Counts, Failure};
 use crate::escape::{terminal_line, terminal_text};
 
@@ -45,6 +47,9 @@ impl CheckReport {
                 }
             }
         }
+        for note in &self.notes {
+            let _ = writeln!(s, "note: {}", terminal_line(note));
+        }
         if let Some(f) = &self.start_failure {
             let _ = writeln!(
                 s,
@@ -58,7 +63,7 @@ impl CheckReport {
     fn write_table(&self, s: &mut String) {
         let _ = writeln!(
             s,
-            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
+            "\n{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>11} {:>5}",
             "shape",
             "total",
             "passed",
@@ -67,12 +72,13 @@ impl CheckReport {
             "timeouts",
             "not_run",
             "ambiguous",
+            "amb_passed",
             "any"
         );
         let row = |s: &mut String, name: &str, c: &Counts| {
             let _ = writeln!(
                 s,
-                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>5}",
+                "{:<10} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>10} {:>11} {:>5}",
                 name,
                 c.total,
                 c.passed,
@@ -81,6 +87,7 @@ impl CheckReport {
                 c.timeouts,
                 c.not_run,
                 c.ambiguous,
+                c.ambiguous_passed,
                 c.any
             );
         };
@@ -105,6 +112,31 @@ impl CheckReport {
                 String::new()
             }
         );
+        let c = &self.counts;
+        if c.unscored_timeouts + c.unscored_crashes > 0 {
+            let _ = writeln!(
+                s,
+                "hangs and crashes: {} time-outs and {} crashes on vectors that are not scored \
+                 (ambiguous or any): a candidate must answer every vector, whatever it answers",
+                c.unscored_timeouts, c.unscored_crashes
+            );
+        }
+        if c.watertight > 0 {
+            let _ = writeln!(
+                s,
+                "watertight groups: {} judged, {} cracked (a ray through an edge or vertex that \
+                 shapes share hit none of them)",
+                c.watertight, c.watertight_cracked
+            );
+        }
+        if c.left_unrun() > 0 {
+            let _ = writeln!(
+                s,
+                "left unrun: {} definite vectors (why: below); only the vectors of a shape the \
+                 candidate does not implement may be left out",
+                c.left_unrun()
+            );
+        }
         for k in self.required_not_run() {
             let _ = writeln!(
                 s,
@@ -136,15 +168,13 @@ impl CheckReport {
         }
     }
 
-    /// The first `max_failures` failures, or one cause said once when all share it.
+    /// The first `max_failures` failures, or one cause said once when all share it. Failures
+    /// alike ([`alike`]) are shown once, with the ids of the others.
     fn write_failures(&self, s: &mut String, max_failures: usize) {
         let shown = &self.failures;
+        let groups = alike(shown);
         if shown.is_empty() {
-        } else if shown.len() > 1
-            && shown
-                .iter()
-                .all(|f| f.kind == shown[0].kind && f.message == shown[0].message)
-        {
+        } else if shown.len() > 1 && groups.len() == 1 {
             // One cause for all (an import error): said once, with one example.
             let f = &shown[0];
             let _ = writeln!(
@@ -159,14 +189,20 @@ impl CheckReport {
                 write_case(s, f);
             }
         } else {
+            let kinds = if groups.len() < shown.len() {
+                format!(" ({} different)", groups.len())
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 s,
-                "\nfirst {} of {} failures:",
-                shown.len().min(max_failures),
+                "\nfirst {} of {} failures{kinds}:",
+                groups.len().min(max_failures),
                 shown.len()
             );
-            for f in shown.iter().take(max_failures) {
-                write_failure(s, f);
+            for group in groups.iter().take(max_failures) {
+                write_failure(s, group[0]);
+                write_others(s, &group[1..]);
             }
         }
     }
@@ -188,6 +224,49 @@ impl CheckReport {
             }
         }
     }
+}
+
+/// The failures in groups alike: the same kind and the same message once the failure's own id
+/// is taken out of it (a protocol error quotes the line, which carries the id), in the order
+/// of their first failure.
+fn alike(failures: &[Failure]) -> Vec<Vec<&Failure>> {
+    let mut index: HashMap<(FailureKind, String), usize> = HashMap::new();
+    let mut groups: Vec<Vec<&Failure>> = Vec::new();
+    for f in failures {
+        let key = (f.kind, f.message.replace(f.id.as_str(), "\u{0}"));
+        match index.get(&key) {
+            Some(&g) => groups[g].push(f),
+            None => {
+                index.insert(key, groups.len());
+                groups.push(vec![f]);
+            }
+        }
+    }
+    groups
+}
+
+/// Most ids of failures alike named after the one shown.
+const OTHERS_NAMED: usize = 5;
+
+/// The other failures of a group: how many, and the first ids.
+fn write_others(s: &mut String, others: &[&Failure]) {
+    if others.is_empty() {
+        return;
+    }
+    let mut ids: Vec<String> = others
+        .iter()
+        .take(OTHERS_NAMED)
+        .map(|f| terminal_line(&f.id))
+        .collect();
+    if others.len() > OTHERS_NAMED {
+        ids.push("...".into());
+    }
+    let _ = writeln!(
+        s,
+        "  and {} more failing the same way: {}",
+        others.len(),
+        ids.join(", ")
+    );
 }
 
 fn write_failure(s: &mut String, f: &Failure) {
@@ -249,5 +328,42 @@ mod tests {
             "{text}"
         );
         assert!(!text.contains("\nverdict: PASS"), "{text}");
+    }
+
+    /// The same error on many vectors (a protocol error quoting each line, which differs only
+    /// by its id) filled the report with the same paragraph: it is shown once, with the ids of
+    /// the others; different failures each still show.
+    #[test]
+    fn failures_alike_are_shown_once_with_the_others_ids() {
+        let cases = crate::candidate::test_cases::basic_cases();
+        let bad = |c: &crate::oracle::vectors::Case| Outcome::Protocol {
+            message: format!(
+                "a malformed answer (not valid JSON): the line was {:?}",
+                format!("{{\"id\":\"{}\",\"hit\":nan}}", c.id)
+            ),
+            junk: vec![],
+        };
+        let mut outcomes: Vec<Outcome> = cases.iter().map(bad).collect();
+        outcomes[4] = Outcome::Timeout { junk: vec![] };
+        let text = build_report(&cases, &outcomes, RunInfo::default()).to_text(10);
+        assert!(
+            text.contains("first 2 of 5 failures (2 different):"),
+            "{text}"
+        );
+        assert_eq!(text.matches("[protocol]").count(), 1, "{text}");
+        assert!(
+            text.contains(
+                "  and 3 more failing the same way: sphere-basic-0001, quad-basic-0000, quad-basic-0001"
+            ),
+            "{text}"
+        );
+        assert!(text.contains("[timeout] triangle-basic-0000"), "{text}");
+        // Alike all: said once.
+        outcomes[4] = bad(&cases[4]);
+        let text = build_report(&cases, &outcomes, RunInfo::default()).to_text(10);
+        assert!(
+            text.contains("all 5 failures are the same: [protocol]"),
+            "{text}"
+        );
     }
 }

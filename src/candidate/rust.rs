@@ -81,7 +81,7 @@ pub fn run_candidate<C: Candidate + ?Sized>(candidate: &mut C, cases: &[Case]) -
         .iter()
         .map(|case| {
             if !candidate.supports(case.shape.kind()) {
-                return Outcome::NotRun {
+                return Outcome::Unsupported {
                     reason: format!("the candidate does not support {}s", case.shape.kind()),
                 };
             }

@@ -97,7 +97,15 @@ pub struct Session {
     detail_left: usize,
     /// What is left of [`RUN_JUNK_BYTES`].
     junk_left: usize,
+    /// What the session noticed about the candidate's use of the protocol ([`Session::notes`]).
+    notes: Vec<String>,
+    /// Stdout lines read from the running process since its hello.
+    lines_seen: usize,
 }
+
+/// The usual reason a candidate's lines never arrive.
+const FLUSH_HINT: &str = "the usual cause: stdout not flushed after each line (fflush(stdout) \
+                          in C, print(..., flush=True) in Python)";
 
 impl Session {
     /// Starts the candidate and does the hello. A hello failure is an error when
@@ -114,6 +122,7 @@ impl Session {
                 shapes: None,
                 ops: None,
                 error: None,
+                unknown_keys: Vec::new(),
             },
             stderr: Arc::new(Mutex::new(Tail::default())),
             timeouts: BTreeMap::new(),
@@ -128,9 +137,14 @@ impl Session {
             budget_used: None,
             detail_left: RUN_DETAIL_BYTES,
             junk_left: RUN_JUNK_BYTES,
+            notes: Vec::new(),
+            lines_seen: 0,
         };
         match session.launch()? {
-            Ok(hello) => session.hello = hello,
+            Ok(hello) => {
+                session.notes.extend(hello.warnings());
+                session.hello = hello;
+            }
             Err(message) => {
                 if session.command.hello_failure_is_fatal {
                     return Err(HarnessError::Hello {
@@ -147,6 +161,13 @@ impl Session {
         }
         crate::sandbox::announce(&session.sandbox_facts());
         Ok(session)
+    }
+
+    /// What the session noticed about the candidate's use of the protocol that is no case's
+    /// failure: keys of its hello the protocol does not name, answers that never came after
+    /// the hello (stdout not flushed).
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     /// The candidate's hello (its name, shapes and any import error).
@@ -274,6 +295,7 @@ impl Session {
                         });
                     }
                     self.proc = Some(proc);
+                    self.lines_seen = 0;
                     if let Some(error) = &mut hello.error {
                         self.localise(error);
                     }
@@ -290,6 +312,10 @@ impl Session {
                     push_junk(&mut junk, describe_line(other), &mut self.junk_left)
                 }
                 Ok(Line::Oversize(head)) => push_junk(&mut junk, head, &mut self.junk_left),
+                Ok(Line::Partial(head)) => {
+                    let line = format!("{head} without its newline");
+                    push_junk(&mut junk, line, &mut self.junk_left)
+                }
                 Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
                     let mut proc = proc;
                     let status = proc.exit_status();
@@ -304,8 +330,13 @@ impl Session {
                     let what = match &self.budget_used {
                         Some(reason) if by_budget => reason.clone(),
                         _ => format!(
-                            "no hello answer within {:.1} s",
-                            self.options.hello_timeout.as_secs_f64()
+                            "no hello answer within {:.1} s{}",
+                            self.options.hello_timeout.as_secs_f64(),
+                            if junk.is_empty() {
+                                format!(" ({FLUSH_HINT})")
+                            } else {
+                                String::new()
+                            }
                         ),
                     };
                     return Ok(Err(self.failure_message(what, &junk)));
@@ -346,7 +377,7 @@ impl Session {
         for (i, case) in cases.iter().enumerate() {
             let kind = case.shape.kind();
             if !self.hello.supports(kind) && self.broken.is_none() {
-                outcomes[i] = Some(Outcome::NotRun {
+                outcomes[i] = Some(Outcome::Unsupported {
                     reason: format!("the candidate does not support {kind}s"),
                 });
             }
@@ -629,6 +660,8 @@ impl Session {
     ) -> (Option<Outcome>, bool) {
         let case = &cases[i];
         let mut junk: Vec<String> = Vec::new();
+        // What the process had written of a line when it died (an Eof follows).
+        let mut partial: Option<String> = None;
         loop {
             let case_deadline = waiting.since + self.options.timeout;
             let (until, by_budget) = match self.budget_deadline() {
@@ -643,13 +676,20 @@ impl Session {
                 proc.lines.recv_timeout(left)
             };
             let parsed = match next {
-                Ok(Line::Parsed(parsed)) => parsed,
+                Ok(Line::Parsed(parsed)) => {
+                    self.lines_seen += 1;
+                    parsed
+                }
                 Ok(Line::Oversize(head)) => {
                     let message = oversize_message(&head, MAX_LINE_BYTES);
                     return (Some(Outcome::Protocol { message, junk }), true);
                 }
+                Ok(Line::Partial(head)) => {
+                    partial = Some(head);
+                    continue;
+                }
                 Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
-                    return (self.lost(case, junk), false);
+                    return (self.lost(case, junk, partial), false);
                 }
                 Err(RecvTimeoutError::Timeout) if by_budget => {
                     self.check_budget();
@@ -694,8 +734,10 @@ impl Session {
     }
 
     /// The process ended while `case` was waited for: the first time, sync mode and nothing
-    /// recorded (the case runs again); in sync mode, the case died.
-    fn lost(&mut self, case: &Case, junk: Vec<String>) -> Option<Outcome> {
+    /// recorded (the case runs again); in sync mode, the case died. `partial` is what it had
+    /// written of a line: the answer it died writing is this case's (a line is only judged once
+    /// its newline came), so the blame stays here.
+    fn lost(&mut self, case: &Case, junk: Vec<String>, partial: Option<String>) -> Option<Outcome> {
         let mut proc = self.proc.take().expect("a running candidate");
         let status = proc.exit_status();
         let _ = proc.kill();
@@ -703,8 +745,12 @@ impl Session {
             self.sync = true;
             return None;
         }
+        let during = match partial {
+            Some(head) => format!(" in the middle of a line (it had written {head})"),
+            None => String::new(),
+        };
         let message = format!(
-            "the candidate died on this case: {}",
+            "the candidate died on this case{during}: {}",
             self.describe_end(status)
         );
         self.count(CountKind::Crash, case.shape.kind());
@@ -719,6 +765,12 @@ impl Session {
         if !self.sync {
             self.sync = true;
             return None;
+        }
+        if self.lines_seen == 0 && !self.notes.iter().any(|n| n.contains(FLUSH_HINT)) {
+            self.notes.push(format!(
+                "no line came from the candidate after its hello while it was sent requests \
+                 to answer one at a time; {FLUSH_HINT}"
+            ));
         }
         self.count(CountKind::Timeout, case.shape.kind());
         Some(Outcome::Timeout { junk })

@@ -15,6 +15,7 @@ pub(crate) fn basic_cases() -> Vec<Case> {
         normal,
         front_face: t.map(|_| true),
         normal_tol: None,
+        watertight: None,
     };
     let down = RaySpec {
         origin: [0.0, 0.0, 5.0],

@@ -271,6 +271,10 @@ pub struct Args {
     /// False-alarm rate of each statistical test of the week's samplers.
     #[arg(long, value_name = "P", default_value_t = rtoracle::functions::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
     alpha: f64,
+    /// Score the ambiguous vectors too, each by its exact answer (as a grading rubric's
+    /// `score_ambiguous` does): edges, corners and tangents answered otherwise then fail.
+    #[arg(long)]
+    score_ambiguous: bool,
 }
 
 /// A shape kind named on the command line.
@@ -336,6 +340,15 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
         anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
     }
+    let (cases, judged_by) = if args.score_ambiguous {
+        let scored = rtoracle::candidate::check::score_ambiguous(cases);
+        (
+            scored,
+            format!("{judged_by}; ambiguous vectors scored by their exact answers"),
+        )
+    } else {
+        (cases, judged_by)
+    };
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
         hello_timeout: Duration::from_millis(args.hello_timeout_ms),

@@ -42,6 +42,9 @@ pub struct Args {
     /// Time allowed per case, in milliseconds.
     #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::num::millis)]
     timeout_ms: u64,
+    /// Time allowed for the candidate to start and answer the hello, in milliseconds.
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::millis)]
+    hello_timeout_ms: u64,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -65,8 +68,8 @@ fn time_limit(secs: Option<f64>) -> anyhow::Result<Option<Duration>> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    if args.timeout_ms == 0 {
-        anyhow::bail!("--timeout-ms 0: the limit must be at least 1 ms");
+    if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
+        anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
     }
     if args.cases == Some(0) {
         anyhow::bail!("--cases 0: at least one case is needed");
@@ -82,6 +85,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let options = RunOptions {
         timeout: Duration::from_millis(args.timeout_ms),
+        hello_timeout: Duration::from_millis(args.hello_timeout_ms),
         limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
@@ -126,7 +130,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         ProgressBar::hidden()
     };
-    let report = fuzz(
+    let mut report = fuzz(
         &mut |cases| {
             let outcomes = session.run(cases);
             progress.inc(cases.len() as u64);
@@ -136,6 +140,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )
     .context("fuzz")?;
     progress.finish_and_clear();
+    report.notes = session.notes().to_vec();
     if let Some(path) = &args.save {
         if report.failures.is_empty() {
             errln!(

@@ -4,7 +4,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use rtoracle::oracle::Profile;
 use rtoracle::oracle::generate::generate_with;
-use rtoracle::oracle::suite::DEFAULT_COUNT;
+use rtoracle::oracle::suite::{DEFAULT_COUNT, suite_with};
 use rtoracle::oracle::vectors::{SCHEMA_VERSION, ShapeKind};
 use rtoracle::output::OutputFile;
 
@@ -14,7 +14,7 @@ pub struct Args {
     /// Seed of the generators: the same seed gives the same bytes.
     #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
-    /// Number of vectors (the default suite has 4000).
+    /// Number of generated vectors (the default suite has 4000).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_COUNT, value_parser = super::num::count)]
     count: usize,
     /// Comma-separated shapes to generate.
@@ -22,6 +22,10 @@ pub struct Args {
     shapes: String,
     #[command(flatten)]
     judging: super::check::JudgingArgs,
+    /// Add the watertight groups of the shapes asked for after the generated vectors, as the
+    /// built-in suite of `check` has them (`--count 4000 --watertight` is that suite).
+    #[arg(long)]
+    watertight: bool,
     /// The JSON-lines file to write; `FILE.jsonl.meta.json` (the name with `.meta.json`
     /// added) is written beside it.
     #[arg(short, long, value_name = "FILE.jsonl")]
@@ -53,7 +57,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut out = OutputFile::create(&args.output, "-o")?;
     let mut meta_out = OutputFile::create(&meta_path, "-o")?;
     let judging = args.judging.judging(Profile::Course);
-    let cases = generate_with(args.seed, count, &shapes, judging);
+    let cases = if args.watertight {
+        suite_with(args.seed, count, &shapes, judging)
+    } else {
+        generate_with(args.seed, count, &shapes, judging)
+    };
     let mut text = String::with_capacity(cases.len() * 400);
     let mut classes = std::collections::BTreeMap::<String, usize>::new();
     for c in &cases {

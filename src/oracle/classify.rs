@@ -143,6 +143,7 @@ impl Analysis {
             front_face: hit.map(|h| h.front_face),
             normal_tol: (hit.is_some() && self.judging.precision != Precision::F64)
                 .then(|| self.judging.normal_tol()),
+            watertight: None,
         }
     }
 }

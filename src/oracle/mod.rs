@@ -1,6 +1,6 @@
 //! The intersection oracle: exact decisions ([`exact`]), the error bands of the course's naive
 //! formulas ([`band`]), the classification of a case ([`classify`](mod@classify)), edge-case generators
-//! ([`generate`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
+//! ([`generate`]), watertight groups ([`watertight`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
 //! transcriptions of the course's code ([`variants`]), fuzzing entry points ([`fuzzing`]), the
 //! benchmark ([`bench`](mod@bench)) and the language-agnostic vector format ([`vectors`]).
 
@@ -16,6 +16,7 @@ pub mod suite;
 pub mod tags;
 pub mod variants;
 pub mod vectors;
+pub mod watertight;
 
 pub use classify::{analyse, analyse_with, classify, classify_tagged, classify_with};
 pub use profile::{Judging, Precision, Profile};

@@ -209,6 +209,11 @@ pub struct Expect {
     /// default `1e-6` (written for `f32` judging: `1e-3`).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "opt_num")]
     pub normal_tol: Option<f64>,
+    /// The watertight group the case belongs to, and the group's rule
+    /// ([`super::watertight`]): a ray through an edge or vertex this shape shares with the
+    /// group's other shapes must hit at least one of them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub watertight: Option<super::watertight::Watertight>,
 }
 
 /// One test vector.
@@ -447,6 +452,7 @@ mod tests {
                 normal: None,
                 front_face: None,
                 normal_tol: None,
+                watertight: None,
             },
         };
         let line = case.to_json_line();

@@ -834,6 +834,12 @@ fn fuzz_finds_shrinks_and_prints_a_reproduction() {
         "{text}"
     );
     assert!(text.contains("from RT_object import Quad"), "{text}");
+    // What it judged by, and the mistake (the fuzz report named neither).
+    assert!(text.starts_with("judged by: course/f64\n"), "{text}");
+    assert!(
+        text.contains("diagnosis: ") && text.contains("taking w as the unit normal"),
+        "{text}"
+    );
     assert!(!text.contains("(sphere)"), "{text}");
 
     let honest = assemble_fixture("honest_full_quadratic").unwrap();
@@ -1071,5 +1077,122 @@ fn bench_candidate_runs_from_a_copy_of_the_binary_in_an_empty_folder() {
         std::fs::read_dir(&empty).unwrap().count(),
         0,
         "nothing left"
+    );
+}
+
+/// `examples/adapter-c/adapter.c` built with `cc` (and `extra` flags) in `dir`, or `None` after
+/// saying the test is skipped.
+fn build_c_adapter(dir: &Path, name: &str, extra: &[&str]) -> Option<PathBuf> {
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let exe = dir.join(name);
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/adapter.c");
+    let built = std::process::Command::new(&cc)
+        .args(["-O2", "-Wall", "-Werror"])
+        .args(extra)
+        .arg("-o")
+        .arg(&exe)
+        .arg(&source)
+        .arg("-lm")
+        .status();
+    if !built.map(|s| s.success()).unwrap_or(false) {
+        eprintln!("skipped: no working C compiler ({cc})");
+        return None;
+    }
+    Some(exe)
+}
+
+/// `rtoracle check --adapter ./NAME ARGS --json` in `dir`: the exit code and the report.
+fn check_c(dir: &Path, name: &str, args: &[&str]) -> (Option<i32>, serde_json::Value) {
+    let adapter = format!("./{name}");
+    let mut all = vec!["check", "--adapter", adapter.as_str(), "--json"];
+    all.extend_from_slice(args);
+    let out = run_in(dir, &all);
+    let json = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    (out.status.code(), json)
+}
+
+/// The complete C adapter that PROTOCOL.md gives (spheres, quads, triangles, RTIOW style with
+/// closed edges and the robust sphere) passes the built-in suite in both profiles, its
+/// watertight groups included. Built with `-DOPEN_EDGES` (`alpha > 0`, `disc > 0`) it passed
+/// too before the suite had watertight groups (every exact edge is ambiguous for one shape
+/// alone); now the groups' rays through shared edges and vertices crack in both profiles.
+#[test]
+fn the_c_adapter_of_the_protocol_passes_and_its_open_edge_variant_cracks_in_both_profiles() {
+    let tmp = tempfile::tempdir().unwrap();
+    if build_c_adapter(tmp.path(), "adapter", &[]).is_none() {
+        return;
+    }
+    build_c_adapter(tmp.path(), "open", &["-DOPEN_EDGES"]).unwrap();
+    let groups = rtoracle::oracle::watertight::GROUPS
+        .iter()
+        .map(|g| g.1 - rtoracle::oracle::watertight::TANGENT_GROUPS)
+        .sum::<usize>() as u64;
+    for profile in ["course", "robust"] {
+        let (code, json) = check_c(tmp.path(), "adapter", &["--profile", profile]);
+        let counts = &json["counts"];
+        assert_eq!(code, Some(0), "{profile}: {json}");
+        assert_eq!(counts["passed"], counts["total"], "{profile}");
+        assert_eq!(json["candidate"], "c-adapter");
+        assert_eq!(counts["watertight"], groups, "{profile}");
+        assert_eq!(counts["watertight_cracked"], 0, "{profile}");
+
+        let (code, json) = check_c(tmp.path(), "open", &["--profile", profile]);
+        let counts = &json["counts"];
+        assert_eq!(code, Some(1), "{profile}: {counts}");
+        // Every definite vector still passes: only the groups find the open edges.
+        assert_eq!(counts["passed"], counts["total"], "{profile}");
+        assert_eq!(counts["watertight_cracked"], groups, "{profile}");
+        let failures = json["failures"].as_array().unwrap();
+        assert!(failures.iter().all(|f| {
+            f["id"].as_str().unwrap().starts_with("watertight-")
+                && f["message"].as_str().unwrap().contains("hit none of them")
+        }));
+    }
+    // The text report says it.
+    let out = run_in(tmp.path(), &["check", "--adapter", "./open"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(&format!(
+            "watertight groups: {groups} judged, {groups} cracked"
+        )),
+        "{text}"
+    );
+    assert!(text.contains("verdict: FAIL"), "{text}");
+}
+
+/// `check --score-ambiguous` scores the ambiguous vectors by their exact answers: the open-edge
+/// adapter then fails the single edges too, and the closed one is judged on them (it passed
+/// only the definite ones before; `check` had no such option).
+#[test]
+fn check_scores_ambiguous_vectors_when_asked() {
+    let tmp = tempfile::tempdir().unwrap();
+    if build_c_adapter(tmp.path(), "open", &["-DOPEN_EDGES"]).is_none() {
+        return;
+    }
+    let (_, plain) = check_c(tmp.path(), "open", &[]);
+    let (code, scored) = check_c(tmp.path(), "open", &["--score-ambiguous"]);
+    assert_eq!(code, Some(1));
+    let (p, s) = (&plain["counts"], &scored["counts"]);
+    assert_eq!(s["ambiguous"], 0);
+    assert_eq!(
+        s["total"].as_u64().unwrap(),
+        p["total"].as_u64().unwrap() + p["ambiguous"].as_u64().unwrap()
+    );
+    // The ambiguous vectors it answered exactly now pass, the others fail.
+    assert_eq!(
+        s["passed"].as_u64().unwrap(),
+        p["passed"].as_u64().unwrap() + p["ambiguous_passed"].as_u64().unwrap()
+    );
+    let edge_failed = scored["failures"].as_array().unwrap().iter().any(|f| {
+        !f["id"].as_str().unwrap().starts_with("watertight-")
+            && f["tags"].as_array().unwrap().iter().any(|t| t == "edge")
+    });
+    assert!(edge_failed);
+    assert!(
+        scored["judged_by"]
+            .as_str()
+            .unwrap()
+            .ends_with("; ambiguous vectors scored by their exact answers")
     );
 }

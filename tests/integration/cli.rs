@@ -116,6 +116,7 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("fuzz", "--seed", true, true),
     ("fuzz", "--time", true, false),
     ("fuzz", "--timeout-ms", true, false),
+    ("fuzz", "--hello-timeout-ms", true, false),
     ("fuzz", "--save", false, false),
     ("fuzz", "--profile", false, false),
     ("fuzz", "--precision", false, false),

@@ -421,3 +421,187 @@ fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
         out.failures.iter().map(|f| &f.message).collect::<Vec<_>>()
     );
 }
+
+/// `n` vectors of class `any` (degenerate quads) from the default suite, then [`misses`].
+fn any_quads_then_misses(n: usize) -> Vec<Case> {
+    let any: Vec<Case> = rtoracle::oracle::default_suite(0)
+        .into_iter()
+        .filter(|c| c.shape.kind() == ShapeKind::Quad && c.expect.class == Class::Any)
+        .take(n)
+        .collect();
+    assert_eq!(any.len(), n);
+    any.into_iter().chain(misses()).collect()
+}
+
+/// The ids of `cases`, comma-separated (the misbehaving adapter's target list).
+fn ids(cases: &[Case]) -> String {
+    cases
+        .iter()
+        .map(|c| c.id.as_str())
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// An adapter hanging on the degenerate quads (class `any`) got PASS: its time-outs were not
+/// counted, and the definite quads left unrun after 3 of them did not fail it. Both fail now.
+#[test]
+fn a_hang_on_vectors_that_are_not_scored_fails_and_so_do_the_vectors_left_unrun() {
+    if !python_ok() {
+        return;
+    }
+    let cases = any_quads_then_misses(3);
+    let options = RunOptions {
+        timeout: Duration::from_millis(500),
+        ..options()
+    };
+    let r = check_command(
+        adapter(&format!("hang {}", ids(&cases[..3]))),
+        &cases,
+        options,
+    )
+    .unwrap();
+    let text = r.to_text(3);
+    assert!(!r.passed(), "{text}");
+    assert_eq!(
+        (r.counts.unscored_timeouts, r.counts.timeouts),
+        (3, 0),
+        "{text}"
+    );
+    let quads = &r.by_shape[&ShapeKind::Quad];
+    assert!(quads.total > 0 && quads.not_run == quads.total, "{text}");
+    assert_eq!(quads.unsupported, 0);
+    let spheres = &r.by_shape[&ShapeKind::Sphere];
+    assert_eq!(spheres.passed, spheres.total, "{text}");
+    assert!(
+        text.contains("hangs and crashes: 3 time-outs and 0 crashes"),
+        "{text}"
+    );
+    assert!(text.contains(&format!("left unrun: {} definite vectors", quads.total)));
+    assert!(text.contains("verdict: FAIL"), "{text}");
+}
+
+/// A SIGABRT on a degenerate quad gave 0 errors and PASS.
+#[test]
+fn a_crash_on_a_vector_that_is_not_scored_fails() {
+    if !python_ok() {
+        return;
+    }
+    let cases = any_quads_then_misses(1);
+    let r = check_command(
+        adapter(&format!("abort {}", cases[0].id)),
+        &cases,
+        options(),
+    )
+    .unwrap();
+    let text = r.to_text(3);
+    assert!(!r.passed(), "{text}");
+    assert_eq!(r.counts.unscored_crashes, 1, "{text}");
+    assert_eq!(r.counts.passed, r.counts.total, "{text}");
+    assert_eq!(r.failures.len(), 1);
+    assert_eq!(r.failures[0].id, cases[0].id);
+    assert!(r.failures[0].message.contains("SIGABRT"), "{text}");
+}
+
+/// An adapter that dies having flushed half of its answer: the case it was answering is the one
+/// that died (the blame went to the next case, which answers right alone, and the half line
+/// was a protocol error of its own case).
+#[test]
+fn an_adapter_killed_mid_line_is_blamed_on_the_case_it_was_answering() {
+    if !python_ok() {
+        return;
+    }
+    let cases = misses();
+    let r = check_command(
+        adapter(&format!("die-mid-line {}", cases[20].id)),
+        &cases,
+        options(),
+    )
+    .unwrap();
+    let text = r.to_text(3);
+    let failed: Vec<(&str, FailureKind)> =
+        r.failures.iter().map(|f| (f.id.as_str(), f.kind)).collect();
+    assert_eq!(
+        failed,
+        [(cases[20].id.as_str(), FailureKind::Error)],
+        "{text}"
+    );
+    let m = &r.failures[0].message;
+    assert!(
+        m.starts_with(
+            "the candidate died on this case in the middle of a line (it had written \"{"
+        ),
+        "{m}"
+    );
+    assert!(m.contains("SIGKILL"), "{m}");
+    assert_eq!(r.counts.passed, cases.len() - 1, "{text}");
+}
+
+/// The common C mistake of flushing the hello's answer only: every answer stays in the
+/// adapter's buffer. The check fails, and the report says the usual cause.
+#[test]
+fn an_adapter_that_flushes_only_its_hello_fails_and_is_told_why() {
+    if !python_ok() {
+        return;
+    }
+    let cases = misses();
+    let options = RunOptions {
+        timeout: Duration::from_millis(500),
+        ..options()
+    };
+    let r = check_command(adapter("no-flush none"), &cases, options).unwrap();
+    let text = r.to_text(3);
+    assert!(!r.passed(), "{text}");
+    assert!(r.counts.timeouts > 0, "{text}");
+    assert!(
+        text.contains(
+            "note: no line came from the candidate after its hello while it was sent requests to \
+             answer one at a time; the usual cause: stdout not flushed after each line"
+        ),
+        "{text}"
+    );
+}
+
+/// A hello that never arrives (not flushed) is refused with the usual cause, by `check` and by
+/// `fuzz` (which has `--hello-timeout-ms` too).
+#[test]
+fn a_hello_that_never_arrives_says_the_usual_cause() {
+    if !python_ok() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    for sub in ["check", "fuzz"] {
+        let out = run_in(
+            tmp.path(),
+            &[
+                sub,
+                "--adapter",
+                &adapter_line("no-flush-hello"),
+                "--hello-timeout-ms",
+                "1500",
+            ],
+        );
+        assert_bad_input(
+            &out,
+            "no hello answer within 1.5 s (the usual cause: stdout not flushed after each line",
+        );
+    }
+}
+
+/// A misspelt hello key (`shape` for `shapes`) was ignored in silence: the report warns.
+#[test]
+fn an_unknown_hello_key_is_warned_about() {
+    if !python_ok() {
+        return;
+    }
+    let cases = misses();
+    let r = check_command(adapter("hello-shape"), &cases, options()).unwrap();
+    let text = r.to_text(3);
+    assert!(r.passed(), "{text}");
+    assert!(
+        text.contains("note: its hello has the key \"shape\", which the protocol does not name")
+            && text.contains("(did you mean \"shapes\"?)"),
+        "{text}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+    assert!(json["notes"][0].as_str().unwrap().contains("\"shape\""));
+}
