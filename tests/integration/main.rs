@@ -5,6 +5,7 @@ mod check;
 mod cli;
 mod common;
 mod compare;
+mod compare_report;
 mod course_weeks;
 mod golden;
 mod grade;
