@@ -3,9 +3,10 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use rtoracle::render::{RenderOptions, render};
-use rtoracle::scene::SceneDescription;
+use rtoracle::scene::{Profile, SceneDescription, TextureSource};
 
-/// `rtoracle render (NAME | FILE.toml) [-o OUT.png | OUT.exr] [--spp N] [--seed S] [--width W] [--threads T]`
+/// `rtoracle render (NAME | FILE.toml) [-o OUT.png | OUT.exr] [--spp N] [--seed S] [--width W]
+/// [--threads T] [--profile P] [--textures DIR]`
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// A built-in scene name (see `rtoracle scenes`) or a TOML scene file.
@@ -26,16 +27,40 @@ pub struct Args {
     /// Worker threads (default: all cores). The image is the same for any count.
     #[arg(long, value_name = "T", value_parser = super::num::threads)]
     threads: Option<usize>,
+    /// Render by these rules instead of the scene's own: `course` (what the course's code of
+    /// the scene's week computes) or `physical` (as Ray Tracing in One Weekend computes it).
+    #[arg(long, value_name = "P", value_parser = parse_profile)]
+    profile: Option<Profile>,
+    /// A built-in scene's image textures from the course's files in DIR (earthmap.png,
+    /// pepsi.jpg, ...) instead of the pictures rtoracle generates.
+    #[arg(long, value_name = "DIR")]
+    textures: Option<PathBuf>,
+}
+
+/// `--profile`'s value.
+pub fn parse_profile(text: &str) -> Result<Profile, String> {
+    Profile::from_name(text)
+        .ok_or_else(|| format!("'{text}' is not a profile: the profiles are course and physical"))
 }
 
 /// The largest image `render` makes: 100 million pixels (2.4 GB of film).
 const MAX_PIXELS: usize = 100_000_000;
 
 /// Loads a built-in scene by name, or a scene file when the argument ends in `.toml` or names an
-/// existing file.
-pub fn load_scene(name: &str) -> anyhow::Result<(String, SceneDescription)> {
+/// existing file; a built-in scene's image textures come from the course's files in `textures`
+/// (refused for a scene file, whose textures are its own).
+pub fn load_scene_with(
+    name: &str,
+    textures: Option<&std::path::Path>,
+) -> anyhow::Result<(String, SceneDescription)> {
     let path = std::path::Path::new(name);
     if name.ends_with(".toml") || path.is_file() {
+        if textures.is_some() {
+            anyhow::bail!(
+                "--textures: {name} is a scene file, which names its own texture files \
+                 (--textures is for the built-in scenes)"
+            );
+        }
         let stem = path
             .file_stem()
             .and_then(|s| s.to_str())
@@ -43,12 +68,41 @@ pub fn load_scene(name: &str) -> anyhow::Result<(String, SceneDescription)> {
             .to_string();
         Ok((stem, SceneDescription::from_file(path)?))
     } else {
-        Ok((name.to_string(), rtoracle::scene::builtin(name)?))
+        let source = match textures {
+            Some(dir) if !dir.is_dir() => {
+                anyhow::bail!("--textures {}: no such folder", dir.display())
+            }
+            Some(dir) => TextureSource::Folder(dir.to_path_buf()),
+            None => TextureSource::Generated,
+        };
+        Ok((
+            name.to_string(),
+            rtoracle::scene::builtin_with_textures(name, &source)?,
+        ))
     }
 }
 
+/// `description` under `profile` (its own when `None`), checked again for that profile.
+pub fn with_profile(
+    name: &str,
+    mut description: SceneDescription,
+    profile: Option<Profile>,
+) -> anyhow::Result<SceneDescription> {
+    if let Some(profile) = profile {
+        if profile != description.profile {
+            description.profile = profile;
+            description
+                .validate(name)
+                .with_context(|| format!("--profile {profile}"))?;
+        }
+    }
+    Ok(description)
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let (name, description) = load_scene(&args.scene)?;
+    let (name, description) = load_scene_with(&args.scene, args.textures.as_deref())?;
+    let description = with_profile(&args.scene, description, args.profile)?;
+    let profile = description.profile;
     let spp = args.spp.unwrap_or(description.image.samples_per_pixel);
     let width = args.width;
     let option = if args.output.is_some() {
@@ -92,20 +146,32 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             &rtoracle::image_io::Rgb8Image {
                 width: film.width,
                 height: film.height,
-                data: film.to_course_rgb8(),
+                data: film.to_rgb8(profile),
             },
         )?,
         OutputFormat::Exr => {
             let attributes = vec![
                 ("rtoracle.scene".to_string(), name.clone()),
-                ("rtoracle.spp".to_string(), spp.to_string()),
+                (
+                    "rtoracle.spp".to_string(),
+                    film.samples_per_pixel.to_string(),
+                ),
+                ("rtoracle.profile".to_string(), profile.name().to_string()),
                 ("rtoracle.seed".to_string(), args.seed.to_string()),
             ];
             rtoracle::image_io::write_exr(&output, &film, &attributes)?
         }
     }
+    let samples = if film.samples_per_pixel == spp {
+        format!("{spp} spp")
+    } else {
+        format!(
+            "{spp} spp: {} jittered samples a pixel",
+            film.samples_per_pixel
+        )
+    };
     errln!(
-        "rendered {name} ({}x{}, {spp} spp, seed {}) to {}",
+        "rendered {name} ({}x{}, {samples}, seed {}, profile {profile}) to {}",
         film.width,
         film.height,
         args.seed,

@@ -1,26 +1,72 @@
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use rtoracle::scene::{BUILTIN_SCENES, builtin};
+use rtoracle::scene::{BUILTIN_SCENES, TextureSource};
 
-/// `rtoracle scenes [--dump NAME]`
+/// `rtoracle scenes [--dump NAME [--textures DIR] [--profile P]]`
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Print the built-in scene NAME as a TOML scene file instead of listing the scenes.
     #[arg(long, value_name = "NAME")]
     dump: Option<String>,
+    /// With --dump: the scene's image textures from the course's files in DIR (written as
+    /// absolute paths) instead of the pictures rtoracle generates.
+    #[arg(long, value_name = "DIR", requires = "dump")]
+    textures: Option<PathBuf>,
+    /// With --dump: the scene under this profile (course or physical) instead of its own.
+    #[arg(long, value_name = "P", requires = "dump", value_parser = super::render::parse_profile)]
+    profile: Option<rtoracle::scene::Profile>,
+}
+
+/// Where a built-in scene comes from, as `scenes` lists it.
+fn origin(scene: &rtoracle::scene::BuiltinScene) -> String {
+    match scene.week {
+        Some(week) => format!("week {week}"),
+        None if scene.name.starts_with("rtiow") => "book 1".to_string(),
+        None => "rtoracle".to_string(),
+    }
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.dump {
-        Some(name) => out!("{}", builtin(&name)?.to_toml())?,
+        Some(name) => {
+            let source = match &args.textures {
+                Some(dir) if !dir.is_dir() => {
+                    anyhow::bail!("--textures {}: no such folder", dir.display())
+                }
+                Some(dir) => TextureSource::Folder(dir.clone()),
+                None => TextureSource::Generated,
+            };
+            let description = rtoracle::scene::builtin_with_textures(&name, &source)?;
+            let description = super::render::with_profile(&name, description, args.profile)?;
+            out!("{}", description.to_toml())?
+        }
         None => {
             let width = BUILTIN_SCENES
                 .iter()
                 .map(|s| s.name.len())
                 .max()
                 .unwrap_or(0);
+            let profiles = |s: &rtoracle::scene::BuiltinScene| {
+                s.profiles
+                    .iter()
+                    .map(|p| p.name())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            };
+            let profile_width = BUILTIN_SCENES
+                .iter()
+                .map(|s| profiles(s).len())
+                .max()
+                .unwrap_or(0);
             for s in BUILTIN_SCENES {
-                outln!("{:width$}  {}", s.name, s.summary)?;
+                outln!(
+                    "{:width$}  {:8}  {:profile_width$}  {}",
+                    s.name,
+                    origin(s),
+                    profiles(s),
+                    s.summary
+                )?;
             }
         }
     }

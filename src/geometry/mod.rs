@@ -1,4 +1,5 @@
-//! Rays, intervals, hit records and the three primitives, in `f64`.
+//! Rays, intervals, hit records and the primitives (spheres, moving spheres, quads, triangles),
+//! in `f64`.
 //!
 //! Everything here follows the course's semantics (see `docs/oracle.md`, "The course's semantics"):
 //! spheres take the near root when the interval *surrounds* it (open), quads and triangles take
@@ -16,7 +17,7 @@ pub use hit::HitRecord;
 pub use interval::Interval;
 pub use quad::{PARALLEL_EPSILON, Quad};
 pub use ray::Ray;
-pub use sphere::Sphere;
+pub use sphere::{MovingSphere, Sphere};
 pub(crate) use sphere::{pick_root, roots_of};
 pub use triangle::Triangle;
 

@@ -153,6 +153,44 @@ pub(crate) fn pick_root((near, far): (f64, f64), interval: Interval) -> Option<f
     }
 }
 
+/// A sphere whose centre moves in a straight line with time (the course's week-10
+/// `add_moving`): at time `t` it is `sphere` moved to `center + (end - center) t` (the course's
+/// `move_sphere`, in that order of operations), with the same radius. Its normal and surface
+/// coordinates are those of the moved sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MovingSphere {
+    /// The sphere at time 0.
+    pub sphere: Sphere,
+    /// Its centre at time 1.
+    pub end: DVec3,
+}
+
+impl MovingSphere {
+    /// The sphere `sphere` moving to `end` at time 1.
+    pub const fn new(sphere: Sphere, end: DVec3) -> Self {
+        Self { sphere, end }
+    }
+
+    /// Where the sphere is at `time`: centre `center + (end - center) * time`.
+    #[inline]
+    pub fn at(&self, time: f64) -> Sphere {
+        let c = self.sphere.center;
+        Sphere::new(c + (self.end - c) * time, self.sphere.radius)
+    }
+}
+
+impl Shape for MovingSphere {
+    #[inline]
+    fn intersect(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
+        self.at(ray.time).intersect(ray, interval)
+    }
+
+    #[inline]
+    fn hit_t(&self, ray: &Ray, interval: Interval) -> Option<f64> {
+        self.at(ray.time).hit_t(ray, interval)
+    }
+}
+
 impl Shape for Sphere {
     fn intersect(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         let t = self.pick_root(ray, interval)?;

@@ -33,18 +33,26 @@ pub fn scene_sha256(description: &SceneDescription) -> String {
     sha256_hex(description.to_toml().as_bytes())
 }
 
-/// The files `description` reads besides itself (image textures), as it names them: relative
-/// to the scene file's folder unless absolute. The scene descriptions of this version name none,
-/// so this is empty; a field that names a file must be listed here, so that its content enters
-/// every golden's key ([`GoldenScene::inputs`]).
+/// The files `description` reads besides itself (its image textures' files), as it names them:
+/// relative to the scene file's folder unless absolute, in the order of its `[[textures]]`. A
+/// field that names a file must be listed here, so that its content enters every golden's key
+/// ([`GoldenScene::inputs`]); the destructuring below fails to compile when a field is added.
 pub fn files_read(description: &SceneDescription) -> Vec<PathBuf> {
     let SceneDescription {
+        profile: _,
         image: _,
         camera: _,
+        render: _,
+        textures,
         materials: _,
         objects: _,
+        base_dir: _,
     } = description;
-    Vec::new()
+    textures
+        .iter()
+        .filter_map(|t| t.file.as_deref())
+        .map(PathBuf::from)
+        .collect()
 }
 
 /// One file a scene reads, by content.
@@ -102,9 +110,9 @@ impl GoldenScene {
     ) -> Result<Self, GoldenError> {
         let mut scene = GoldenScene {
             name: name.to_string(),
+            profile: description.profile.name().to_string(),
             description,
             builtin: false,
-            profile: DEFAULT_PROFILE.to_string(),
             inputs: Vec::new(),
         };
         for file in files_read(&scene.description) {
@@ -121,9 +129,13 @@ impl GoldenScene {
         Ok(scene)
     }
 
-    /// The same scene rendered in `profile`.
+    /// The same scene rendered in `profile` (the scene's own profile too, when `profile` names
+    /// one the renderer knows).
     pub fn with_profile(mut self, profile: &str) -> Self {
         self.profile = profile.to_string();
+        if let Some(known) = crate::scene::Profile::from_name(profile) {
+            self.description.profile = known;
+        }
         self
     }
 
@@ -200,6 +212,13 @@ impl GoldenScene {
             ));
         }
         let record = GoldenRecord::of(image);
+        // The profile is part of the scene's text too: say it first, as the more telling reason.
+        if record.profile != self.profile {
+            return Err(format!(
+                "was rendered in the {} profile ({ATTR_PROFILE}), not {}",
+                record.profile, self.profile
+            ));
+        }
         let want = self.scene_sha256();
         match &record.scene_sha256 {
             Some(h) if *h == want => {}
@@ -216,12 +235,6 @@ impl GoldenScene {
                     "holds a scene ({ATTR_SCENE_TOML}) whose hash is not its {ATTR_SCENE_SHA256}"
                 ));
             }
-        }
-        if record.profile != self.profile {
-            return Err(format!(
-                "was rendered in the {} profile ({ATTR_PROFILE}), not {}",
-                record.profile, self.profile
-            ));
         }
         if record.inputs != self.inputs_text() {
             return Err(format!(
@@ -291,7 +304,12 @@ mod tests {
         let physical = quad.clone().with_profile("physical");
         assert_eq!(
             physical.content_key(),
-            format!("{}-physical", quad.scene_sha256())
+            format!("{}-physical", physical.scene_sha256())
+        );
+        assert_ne!(
+            physical.content_key(),
+            key,
+            "another profile is another golden"
         );
         let textured = quad.clone().with_input("textures/earth.png", b"one");
         let retextured = quad.clone().with_input("textures/earth.png", b"two");

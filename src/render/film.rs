@@ -1,5 +1,7 @@
 use glam::DVec3;
 
+use crate::scene::Profile;
+
 /// A rendered image: the per-pixel mean of the samples and, when asked for, the per-sample
 /// (unbiased) variance of each channel. Row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,6 +35,30 @@ impl Film {
     }
 }
 
+impl Film {
+    /// The image as 8-bit RGB under `profile`'s encoding: the course's
+    /// ([`encode_course_png`]) or the book's ([`encode_book_png`]).
+    pub fn to_rgb8(&self, profile: Profile) -> Vec<u8> {
+        let encode = match profile {
+            Profile::Course => encode_course_png,
+            Profile::Physical => encode_book_png,
+        };
+        self.mean
+            .iter()
+            .flat_map(|c| c.to_array().map(encode))
+            .collect()
+    }
+}
+
+/// The book's encoding of one linear value (`write_color`): `linear_to_gamma` (`sqrt`, 0 for
+/// values that are not positive), clamped to `[0, 0.999]`, times 256, truncated. So 255 is the
+/// largest code, reached from `(255/256)^2` up.
+#[inline]
+pub fn encode_book_png(linear: f64) -> u8 {
+    let gamma = if linear > 0.0 { linear.sqrt() } else { 0.0 };
+    (256.0 * gamma.clamp(0.0, 0.999)) as u8
+}
+
 /// The course's encoding of one linear value: `sqrt` (gamma 2, 0 for negative values), clamped to
 /// `[0, 0.999]`, times 255, truncated. So 254 is the largest code.
 #[inline]
@@ -54,5 +80,17 @@ mod tests {
         // sqrt(0.25) = 0.5, 127.5 truncates to 127.
         assert_eq!(encode_course_png(0.25), 127);
         assert_eq!(encode_course_png(f64::NAN), 0);
+    }
+
+    #[test]
+    fn book_encoding_matches_its_formula() {
+        assert_eq!(encode_book_png(0.0), 0);
+        assert_eq!(encode_book_png(-1.0), 0);
+        assert_eq!(encode_book_png(1.0), 255);
+        // sqrt(0.25) = 0.5, 128 exactly.
+        assert_eq!(encode_book_png(0.25), 128);
+        // 0.999 * 256 = 255.744.
+        assert_eq!(encode_book_png(0.998), 255);
+        assert_eq!(encode_book_png(f64::NAN), 0);
     }
 }

@@ -12,8 +12,8 @@ use glam::DVec3;
 
 use super::PixelSampler;
 use super::fixed_origin::{ALL_CANDIDATES, Candidates, Cone, FixedOrigin};
+use super::job::{Job, Moments, Trace};
 use super::packet::{Directions, NO_HIT, WIDTH};
-use super::renderer::{Job, Moments, Trace};
 use crate::geometry::Interval;
 use crate::scene::{Camera, Scene};
 
@@ -338,8 +338,8 @@ mod tests {
     use super::*;
     use crate::geometry::{Quad, Sphere, Triangle};
     use crate::render::PixelJitter;
-    use crate::render::renderer::film_bits;
-    use crate::scene::{CameraSettings, Material, Object, SceneObject};
+    use crate::render::job::film_bits;
+    use crate::scene::{CameraSettings, Material, Object, SceneObject, World};
 
     /// A random scene made to test the footprints: spheres and triangles of every size from a
     /// fraction of a pixel to wider than the image, many with an edge or a silhouette through
@@ -447,7 +447,8 @@ mod tests {
                 PixelJitter::Centre,
             ][scene_number % 3];
             let spp = [1, 2, 3, 5, 8, 13][scene_number % 6];
-            let general = Job::new(&scene, &camera, spp, scene_number as u64, jitter);
+            let world = World::from(scene.clone());
+            let general = Job::new(&world, &camera, spp, scene_number as u64, jitter);
             let fast = Job::new(&pinhole, &camera, spp, scene_number as u64, jitter);
             assert_eq!(
                 film_bits(&fast),
@@ -529,7 +530,10 @@ mod tests {
     /// Whether the pinhole path renders the general path's film, bit for bit.
     fn same_film(scene: &Scene, camera: &Camera, spp: u32, seed: u64, jitter: PixelJitter) -> bool {
         let pinhole = Pinhole::new(scene, camera.center);
-        let general = Job::new(scene, camera, spp, seed, jitter);
+        // A world of more than 16 objects intersects through its hierarchy: the fast path must
+        // agree with that too.
+        let world = World::from(scene.clone());
+        let general = Job::new(&world, camera, spp, seed, jitter);
         let fast = Job::new(&pinhole, camera, spp, seed, jitter);
         film_bits(&fast) == film_bits(&general)
     }

@@ -1,6 +1,9 @@
-//! The TOML scene format.
+//! The TOML scene format: reading a scene file, writing a scene's canonical form, and turning a
+//! description into the [`World`] a render reads.
 //!
 //! ```toml
+//! profile = "course"       # optional: "course" (the default) or "physical"
+//!
 //! [image]
 //! width = 400
 //! aspect_ratio = 1.7777777777777777   # height = int(width / aspect_ratio)
@@ -14,214 +17,96 @@
 //! focus_distance = 10.0    # optional, 10 by default (the book's focus_dist)
 //! defocus_angle = 0.0      # degrees; optional, 0 is a pinhole
 //!
+//! [render]                 # optional: without it, week 4 (albedo of the closest hit, sky)
+//! integrator = "direct"    # "albedo" (week 4), "direct" (weeks 5-7), "brdf" (weeks 8-10)
+//! direct_term = "clamped"  # weeks 5-7: "clamped" (E min(1, 1/d)) or "unclamped" (E / d)
+//! direct_light = true      # weeks 8-10: add the point lights' direct term
+//! max_depth = 5            # at least 1; 50 by default
+//! background = "flat"      # "sky" (the default) or "flat"
+//! background_color = [0.01, 0.01, 0.01]
+//! diffuse_sampling = "unit-sphere"   # or "cosine" (weeks 9-10)
+//! sampling = "uniform"     # or "course-jittered" (weeks 9-10), with jitter_step
+//!
+//! [[textures]]
+//! name = "ground"
+//! type = "checker"         # "solid" (color), "checker" (scale, even, odd),
+//! scale = 0.32             # "image" (file = "earthmap.png" relative to this file,
+//! even = [0.2, 0.2, 0.2]   #   or generated = "earth")
+//! odd = [0.9, 0.9, 0.9]
+//!
 //! [[materials]]
 //! name = "ground"
-//! type = "lambertian"
-//! albedo = [0.0, 0.0, 0.8]
+//! type = "textured"        # lambertian, textured (texture), diffuse_light, mirror,
+//! texture = "ground"       # dielectric (ior), metal (roughness), phong and blinn
+//!                          # (kd, ks, alpha), cook_torrance (kd, ks, alpha, ior)
+//! albedo = [1.0, 1.0, 1.0] # the colour (a light's emission, a texture's tint)
 //!
 //! [[objects]]
 //! type = "sphere"          # or "quad" (q, u, v) or "triangle" (a, b, c)
 //! center = [0.0, -100.5, -1.0]
 //! radius = 100.0           # negative flips the normal
 //! material = "ground"
+//! # moving_center = [0.0, -100.0, -1.0]   # where the centre is at time 1
 //! ```
 //!
-//! Every table rejects unknown fields. Every number must be finite.
+//! Every table rejects unknown keys, and a key that does not apply to its kind. Every number must
+//! be finite.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use serde::{Deserialize, Serialize};
 
-use super::{Camera, CameraSettings, Material, Object, Scene, SceneObject};
-use crate::geometry::{Quad, Sphere, Triangle};
-
-/// What can be wrong with a scene (one line each, naming the scene and the problem).
-#[derive(Debug, thiserror::Error)]
-pub enum SceneError {
-    /// The scene file could not be read.
-    // The reason is in the message, not a `#[source]`, so a report of the whole chain (anyhow's
-    // `{:#}`) does not say it twice.
-    #[error("{path}: cannot read the scene file: {}", read_reason(.error))]
-    Read {
-        /// The file.
-        path: String,
-        /// Why.
-        error: std::io::Error,
-    },
-    /// The file is not valid TOML or does not follow the schema.
-    #[error("{path}: malformed scene file: {message}")]
-    Parse {
-        /// The file.
-        path: String,
-        /// The parser's complaint, with line and column.
-        message: String,
-    },
-    /// The scene parses but a value is unusable.
-    #[error("{path}: {message}")]
-    Invalid {
-        /// The file or built-in scene name.
-        path: String,
-        /// What is wrong, naming the field.
-        message: String,
-    },
-    /// No built-in scene has that name.
-    #[error(
-        "unknown scene '{name}' (not a built-in scene and not a .toml file; `rtoracle scenes` lists the built-ins)"
-    )]
-    Unknown {
-        /// The name asked for.
-        name: String,
-    },
-}
-
-/// Image size and default sampling.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ImageSettings {
-    /// Width in pixels.
-    pub width: usize,
-    /// Width over height; the height is `int(width / aspect_ratio)`, as the course computes it.
-    pub aspect_ratio: f64,
-    /// Samples per pixel when the command line does not say.
-    pub samples_per_pixel: u32,
-}
-
-/// A named material.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialEntry {
-    /// The name objects refer to it by.
-    pub name: String,
-    /// The kind (only `"lambertian"` in week 4).
-    #[serde(rename = "type")]
-    pub kind: MaterialKind,
-    /// Linear RGB albedo.
-    pub albedo: [f64; 3],
-}
-
-/// The kinds of material a scene file may name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MaterialKind {
-    /// [`Material::Lambertian`].
-    Lambertian,
-}
-
-/// One object of a scene file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-pub enum ObjectEntry {
-    /// A sphere.
-    Sphere {
-        /// Centre.
-        center: [f64; 3],
-        /// Radius (negative flips the normal; zero is rejected).
-        radius: f64,
-        /// Material name.
-        material: String,
-    },
-    /// A parallelogram `q + alpha u + beta v`.
-    Quad {
-        /// Corner.
-        q: [f64; 3],
-        /// First edge.
-        u: [f64; 3],
-        /// Second edge.
-        v: [f64; 3],
-        /// Material name.
-        material: String,
-    },
-    /// A triangle.
-    Triangle {
-        /// First vertex.
-        a: [f64; 3],
-        /// Second vertex.
-        b: [f64; 3],
-        /// Third vertex.
-        c: [f64; 3],
-        /// Material name.
-        material: String,
-    },
-}
-
-impl ObjectEntry {
-    fn material(&self) -> &str {
-        match self {
-            ObjectEntry::Sphere { material, .. }
-            | ObjectEntry::Quad { material, .. }
-            | ObjectEntry::Triangle { material, .. } => material,
-        }
-    }
-}
-
-/// A whole scene as a file states it: what `scenes --dump` prints and `render FILE` reads.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SceneDescription {
-    /// Image size and sampling.
-    pub image: ImageSettings,
-    /// The camera.
-    pub camera: CameraSettings,
-    /// The materials, referred to by name.
-    pub materials: Vec<MaterialEntry>,
-    /// The objects, in order (the order decides ties).
-    pub objects: Vec<ObjectEntry>,
-}
-
-/// Why a scene file could not be read, in a few words ("no such file" rather than "No such file
-/// or directory (os error 2)").
-fn read_reason(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".to_string(),
-        std::io::ErrorKind::IsADirectory => "it is a folder".to_string(),
-        std::io::ErrorKind::InvalidData => "it is not UTF-8 text".to_string(),
-        _ => e.to_string(),
-    }
-}
-
-fn check_vec(path: &str, field: &str, v: [f64; 3]) -> Result<(), SceneError> {
-    for (axis, x) in ["x", "y", "z"].iter().zip(v) {
-        check_num(path, &format!("{field}.{axis}"), x)?;
-    }
-    Ok(())
-}
-
-/// The largest width or height a scene may have, in pixels.
-pub const MAX_SIDE: usize = 100_000;
-
-fn check_num(path: &str, field: &str, x: f64) -> Result<(), SceneError> {
-    if x.is_finite() {
-        Ok(())
-    } else {
-        Err(invalid(
-            path,
-            format!("{field} is {x}, but every number in a scene must be finite"),
-        ))
-    }
-}
-
-fn invalid(path: &str, message: String) -> SceneError {
-    SceneError::Invalid {
-        path: path.to_string(),
-        message,
-    }
-}
+use super::error::SceneError;
+use super::texture::{RgbPicture, generated_picture, read_picture};
+use super::{
+    Camera, CameraSettings, ImageSettings, Material, MaterialEntry, MaterialKind, Object,
+    ObjectEntry, Profile, RenderSettings, Scene, SceneDescription, SceneObject, Texture,
+    TextureEntry, TextureImage, TextureKind, World,
+};
+use crate::geometry::{MovingSphere, Quad, Sphere, Triangle};
 
 impl SceneDescription {
-    /// Reads and validates a TOML scene file.
+    /// A course-profile, week-4 scene (no `[render]` table, no textures) of these parts.
+    pub fn new(
+        image: ImageSettings,
+        camera: CameraSettings,
+        materials: Vec<MaterialEntry>,
+        objects: Vec<ObjectEntry>,
+    ) -> Self {
+        Self {
+            profile: Profile::Course,
+            image,
+            camera,
+            render: RenderSettings::default(),
+            textures: Vec::new(),
+            materials,
+            objects,
+            base_dir: None,
+        }
+    }
+
+    /// Reads and validates a TOML scene file; its texture files are named relative to its
+    /// folder.
     pub fn from_file(path: &Path) -> Result<Self, SceneError> {
         let name = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|error| SceneError::Read {
             path: name.clone(),
             error,
         })?;
-        Self::from_toml(&text, &name)
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_toml_in(&text, &name, &base)
     }
 
-    /// Parses and validates TOML text; `name` labels errors.
+    /// Parses and validates TOML text; `name` labels errors, and texture files are named
+    /// relative to the working folder.
     pub fn from_toml(text: &str, name: &str) -> Result<Self, SceneError> {
-        let description: SceneDescription = toml::from_str(text).map_err(|e| {
+        Self::from_toml_in(text, name, Path::new(""))
+    }
+
+    /// Parses and validates TOML text whose texture files are named relative to `base`; `name`
+    /// labels errors.
+    pub fn from_toml_in(text: &str, name: &str, base: &Path) -> Result<Self, SceneError> {
+        let mut description: SceneDescription = toml::from_str(text).map_err(|e| {
             let location = e
                 .span()
                 .map(|span| {
@@ -235,171 +120,95 @@ impl SceneDescription {
                 message: format!("{location}{message}"),
             }
         })?;
+        description.base_dir = (!base.as_os_str().is_empty()).then(|| base.to_path_buf());
         description.validate(name)?;
         Ok(description)
     }
 
-    /// The scene as TOML, which [`SceneDescription::from_toml`] reads back to an equal value
-    /// (numbers are written as shortest round-trip decimals).
+    /// The scene's canonical form: TOML that [`SceneDescription::from_toml`] reads back to an
+    /// equal value (numbers as shortest round-trip decimals). Everything that decides the
+    /// image is in it except the content of the files [`SceneDescription::external_files`]
+    /// names; a table or key at its default is left out, so a week-4 scene's form is what it
+    /// always was.
     pub fn to_toml(&self) -> String {
         toml::to_string(self).expect("a scene description always serialises")
     }
 
-    /// Checks every number is finite and every value usable; `name` labels errors.
-    pub fn validate(&self, name: &str) -> Result<(), SceneError> {
-        let image = &self.image;
-        if image.width == 0 {
-            return Err(invalid(name, "image.width must be at least 1".into()));
+    /// `file` as the scene reads it: relative to [`SceneDescription::base_dir`] unless absolute.
+    pub fn resolve(&self, file: &str) -> PathBuf {
+        match &self.base_dir {
+            Some(base) if Path::new(file).is_relative() => base.join(file),
+            _ => PathBuf::from(file),
         }
-        check_num(name, "image.aspect_ratio", image.aspect_ratio)?;
-        if image.aspect_ratio <= 0.0 {
-            return Err(invalid(
-                name,
-                format!(
-                    "image.aspect_ratio is {:?}, it must be positive",
-                    image.aspect_ratio
-                ),
-            ));
-        }
-        if image.width > MAX_SIDE {
-            return Err(invalid(
-                name,
-                format!("image.width is {}, at most {MAX_SIDE} pixels", image.width),
-            ));
-        }
-        if image.width as f64 / image.aspect_ratio >= (MAX_SIDE + 1) as f64 {
-            return Err(invalid(
-                name,
-                format!(
-                    "image.aspect_ratio is {:?}: a {}-pixel-wide image would be more than \
-                     {MAX_SIDE} pixels high",
-                    image.aspect_ratio, image.width
-                ),
-            ));
-        }
-        if image.samples_per_pixel == 0 {
-            return Err(invalid(
-                name,
-                "image.samples_per_pixel must be at least 1".into(),
-            ));
-        }
-        let cam = &self.camera;
-        check_vec(name, "camera.look_from", cam.look_from)?;
-        check_vec(name, "camera.look_at", cam.look_at)?;
-        check_vec(name, "camera.up", cam.up)?;
-        check_num(name, "camera.vfov", cam.vfov)?;
-        check_num(name, "camera.focus_distance", cam.focus_distance)?;
-        check_num(name, "camera.defocus_angle", cam.defocus_angle)?;
-        if !(cam.vfov > 0.0 && cam.vfov < 180.0) {
-            return Err(invalid(
-                name,
-                format!(
-                    "camera.vfov is {:?}, it must lie strictly between 0 and 180 degrees",
-                    cam.vfov
-                ),
-            ));
-        }
-        if cam.focus_distance <= 0.0 {
-            return Err(invalid(
-                name,
-                format!(
-                    "camera.focus_distance is {:?}, it must be positive",
-                    cam.focus_distance
-                ),
-            ));
-        }
-        if !(0.0..180.0).contains(&cam.defocus_angle) {
-            return Err(invalid(
-                name,
-                format!(
-                    "camera.defocus_angle is {:?}, it must lie in [0, 180)",
-                    cam.defocus_angle
-                ),
-            ));
-        }
-        let view = DVec3::from(cam.look_from) - DVec3::from(cam.look_at);
-        if view == DVec3::ZERO {
-            return Err(invalid(
-                name,
-                "camera.look_from equals camera.look_at".into(),
-            ));
-        }
-        if DVec3::from(cam.up).cross(view) == DVec3::ZERO {
-            return Err(invalid(
-                name,
-                "camera.up is zero or parallel to the viewing direction".into(),
-            ));
-        }
-        for (i, m) in self.materials.iter().enumerate() {
-            check_vec(name, &format!("materials[{i}].albedo"), m.albedo)?;
-            if self.materials[..i].iter().any(|other| other.name == m.name) {
-                return Err(invalid(
-                    name,
-                    format!("materials[{i}]: the name '{}' is used twice", m.name),
-                ));
-            }
-        }
-        for (i, o) in self.objects.iter().enumerate() {
-            let field = |f: &str| format!("objects[{i}].{f}");
-            match o {
-                ObjectEntry::Sphere { center, radius, .. } => {
-                    check_vec(name, &field("center"), *center)?;
-                    check_num(name, &field("radius"), *radius)?;
-                    if *radius == 0.0 {
-                        return Err(invalid(
-                            name,
-                            format!("{} is 0: a sphere needs a non-zero radius", field("radius")),
-                        ));
-                    }
-                }
-                ObjectEntry::Quad { q, u, v, .. } => {
-                    check_vec(name, &field("q"), *q)?;
-                    check_vec(name, &field("u"), *u)?;
-                    check_vec(name, &field("v"), *v)?;
-                    if DVec3::from(*u).cross(DVec3::from(*v)) == DVec3::ZERO {
-                        return Err(invalid(
-                            name,
-                            format!("objects[{i}]: u and v are parallel, the quad is degenerate"),
-                        ));
-                    }
-                }
-                ObjectEntry::Triangle { a, b, c, .. } => {
-                    check_vec(name, &field("a"), *a)?;
-                    check_vec(name, &field("b"), *b)?;
-                    check_vec(name, &field("c"), *c)?;
-                    let (a, b, c) = (DVec3::from(*a), DVec3::from(*b), DVec3::from(*c));
-                    if (b - a).cross(c - a) == DVec3::ZERO {
-                        return Err(invalid(
-                            name,
-                            format!(
-                                "objects[{i}]: the vertices are collinear, the triangle is degenerate"
-                            ),
-                        ));
-                    }
-                }
-            }
-            if !self.materials.iter().any(|m| m.name == o.material()) {
-                return Err(invalid(
-                    name,
-                    format!(
-                        "{} names the material '{}', which is not defined",
-                        field("material"),
-                        o.material()
-                    ),
-                ));
-            }
-        }
-        Ok(())
     }
 
-    /// The scene's objects and materials, ready to intersect.
-    pub fn scene(&self) -> Scene {
+    /// The files the image depends on besides the scene itself (its image textures), resolved,
+    /// in the order of the `[[textures]]` table: a cache of its renders must be keyed by their
+    /// content too.
+    pub fn external_files(&self) -> Vec<PathBuf> {
+        self.textures
+            .iter()
+            .filter_map(|t| t.file.as_deref())
+            .map(|f| self.resolve(f))
+            .collect()
+    }
+
+    /// The picture of image texture `t`, read from its file or generated.
+    fn picture(&self, t: &TextureEntry) -> Result<RgbPicture, String> {
+        match (&t.file, &t.generated) {
+            (Some(file), _) => read_picture(&self.resolve(file)),
+            (None, Some(name)) => {
+                generated_picture(name).ok_or_else(|| format!("no generated picture '{name}'"))
+            }
+            (None, None) => Err("no file".into()),
+        }
+    }
+
+    /// The scene ready to render: objects, materials, the textures' images prepared for the
+    /// profile, the point lights and settings.
+    ///
+    /// The texture files are read again here (validation read them once, before any work);
+    /// one that has become unreadable since gives the course's colour for an unusable file,
+    /// `(0, 1, 1)`, everywhere.
+    pub fn scene(&self) -> World {
+        let profile = self.profile;
+        let mut images = Vec::new();
+        let textures: Vec<(String, Texture)> = self
+            .textures
+            .iter()
+            .map(|t| {
+                let v = |c: Option<[f64; 3]>| DVec3::from(c.unwrap_or([0.0; 3]));
+                let texture = match t.kind {
+                    TextureKind::Solid => Texture::Solid(v(t.color)),
+                    TextureKind::Checker => Texture::Checker {
+                        scale: t.scale.unwrap_or(1.0),
+                        even: v(t.even),
+                        odd: v(t.odd),
+                    },
+                    TextureKind::Image => {
+                        let image = match self.picture(t) {
+                            Ok(p) => TextureImage::new(p.width, p.height, &p.data, profile),
+                            Err(_) => TextureImage::new(0, 0, &[], profile),
+                        };
+                        images.push(image);
+                        Texture::Image {
+                            image: images.len() - 1,
+                            tint: DVec3::ONE,
+                        }
+                    }
+                };
+                (t.name.clone(), texture)
+            })
+            .collect();
+        let texture_of = |name: &Option<String>| {
+            name.as_ref()
+                .and_then(|n| textures.iter().find(|(t, _)| t == n))
+                .map_or(Texture::Solid(DVec3::ONE), |(_, t)| *t)
+        };
         let materials = self
             .materials
             .iter()
-            .map(|m| Material::Lambertian {
-                albedo: DVec3::from(m.albedo),
-            })
+            .map(|m| material_of(m, texture_of(&m.texture)))
             .collect();
         let index = |name: &str| {
             self.materials
@@ -410,27 +219,23 @@ impl SceneDescription {
         let objects = self
             .objects
             .iter()
-            .map(|o| {
-                let shape = match o {
-                    ObjectEntry::Sphere { center, radius, .. } => {
-                        Object::Sphere(Sphere::new(DVec3::from(*center), *radius))
-                    }
-                    ObjectEntry::Quad { q, u, v, .. } => {
-                        Object::Quad(Quad::new(DVec3::from(*q), DVec3::from(*u), DVec3::from(*v)))
-                    }
-                    ObjectEntry::Triangle { a, b, c, .. } => Object::Triangle(Triangle::new(
-                        DVec3::from(*a),
-                        DVec3::from(*b),
-                        DVec3::from(*c),
-                    )),
-                };
-                SceneObject {
-                    shape,
-                    material: index(o.material()),
-                }
+            .map(|o| SceneObject {
+                shape: shape_of(o),
+                material: index(o.material()),
             })
             .collect();
-        Scene { objects, materials }
+        let cam = &self.camera;
+        let lens = cam.focus_distance * libm::tan(cam.defocus_angle.to_radians() / 2.0);
+        let reach = DVec3::from(cam.look_from).abs().max_element() + lens.abs();
+        let mut world = World::new(
+            Scene { objects, materials },
+            profile,
+            self.render,
+            images,
+            reach,
+        );
+        world.samples_per_pixel = self.image.samples_per_pixel;
+        world
     }
 
     /// The camera for an image `width` pixels wide (the file's width when `None`).
@@ -440,5 +245,91 @@ impl SceneDescription {
             width.unwrap_or(self.image.width),
             self.image.aspect_ratio,
         )
+    }
+}
+
+/// The material of entry `m`, whose texture (for a textured one) is `texture`.
+fn material_of(m: &MaterialEntry, texture: Texture) -> Material {
+    let albedo = DVec3::from(m.albedo);
+    let (kd, ks, alpha) = (
+        m.kd.unwrap_or(0.0),
+        m.ks.unwrap_or(0.0),
+        m.alpha.unwrap_or(0.0),
+    );
+    let ior = m.ior.unwrap_or(1.0);
+    match m.kind {
+        MaterialKind::Lambertian => Material::Lambertian { albedo },
+        MaterialKind::Textured => Material::Textured {
+            texture: tinted(texture, albedo),
+        },
+        MaterialKind::DiffuseLight => Material::DiffuseLight { emit: albedo },
+        MaterialKind::Mirror => Material::Mirror { albedo },
+        MaterialKind::Dielectric => Material::Dielectric { albedo, ior },
+        MaterialKind::Metal => Material::Metal {
+            albedo,
+            // Both the course and the book clamp the roughness (fuzz) to at most 1.
+            roughness: m.roughness.unwrap_or(0.0).min(1.0),
+        },
+        MaterialKind::Phong => Material::Phong {
+            albedo,
+            kd,
+            ks,
+            alpha,
+        },
+        MaterialKind::Blinn => Material::Blinn {
+            albedo,
+            kd,
+            ks,
+            alpha,
+        },
+        MaterialKind::CookTorrance => Material::CookTorrance {
+            albedo,
+            kd,
+            ks,
+            alpha,
+            ior,
+        },
+    }
+}
+
+/// `texture` with every colour multiplied by `tint` (white changes nothing, bit for bit).
+fn tinted(texture: Texture, tint: DVec3) -> Texture {
+    match texture {
+        Texture::Solid(c) => Texture::Solid(tint * c),
+        Texture::Checker { scale, even, odd } => Texture::Checker {
+            scale,
+            even: tint * even,
+            odd: tint * odd,
+        },
+        Texture::Image { image, tint: t } => Texture::Image {
+            image,
+            tint: tint * t,
+        },
+    }
+}
+
+/// The shape of object entry `o`.
+fn shape_of(o: &ObjectEntry) -> Object {
+    match o {
+        ObjectEntry::Sphere {
+            center,
+            radius,
+            moving_center,
+            ..
+        } => {
+            let sphere = Sphere::new(DVec3::from(*center), *radius);
+            match moving_center {
+                Some(end) => Object::MovingSphere(MovingSphere::new(sphere, DVec3::from(*end))),
+                None => Object::Sphere(sphere),
+            }
+        }
+        ObjectEntry::Quad { q, u, v, .. } => {
+            Object::Quad(Quad::new(DVec3::from(*q), DVec3::from(*u), DVec3::from(*v)))
+        }
+        ObjectEntry::Triangle { a, b, c, .. } => Object::Triangle(Triangle::new(
+            DVec3::from(*a),
+            DVec3::from(*b),
+            DVec3::from(*c),
+        )),
     }
 }

@@ -1,15 +1,44 @@
-//! Scenes: materials, objects, the course's camera, TOML scene files and the built-in scenes.
+//! Scenes: materials, textures, objects, the course's camera, TOML scene files, the built-in
+//! scenes, and the [`World`] a render reads.
+//!
+//! A scene file ([`SceneDescription`]) states a profile (how it is rendered: as the course or as
+//! *Ray Tracing in One Weekend*), the image, the camera, the integrator's settings, textures,
+//! materials and objects; [`SceneDescription::scene`] turns it into a [`World`].
 
 mod builtin;
+mod bvh;
 mod camera;
+mod description;
+mod error;
 mod file;
 mod material;
 mod object;
+mod profile;
+mod settings;
+mod texture;
+mod validate;
+mod world;
 
-pub use builtin::{BUILTIN_SCENES, BuiltinScene, builtin, builtin_names};
-pub use camera::{Camera, CameraSettings};
-pub use file::{
-    ImageSettings, MaterialEntry, MaterialKind, ObjectEntry, SceneDescription, SceneError,
+pub use builtin::{
+    BUILTIN_SCENES, BuiltinScene, TextureSource, builtin, builtin_names, builtin_with_textures,
+    rtiow_final_scene,
 };
+pub use bvh::BVH_MIN_OBJECTS;
+pub use camera::{Camera, CameraSettings};
+pub use description::{
+    ImageSettings, MaterialEntry, MaterialKind, ObjectEntry, SceneDescription, TextureEntry,
+    TextureKind,
+};
+pub use error::SceneError;
 pub use material::Material;
 pub use object::{Object, Scene, SceneObject};
+pub use profile::Profile;
+pub use settings::{
+    Background, COURSE_BACKGROUND, DEFAULT_MAX_DEPTH, DiffuseSampling, DirectTerm, Integrator,
+    PixelSampling, RenderSettings,
+};
+pub use texture::{
+    GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,
+};
+pub use validate::{MAX_DEPTH_LIMIT, MAX_SIDE};
+pub use world::{PointLight, World};

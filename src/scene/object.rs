@@ -1,4 +1,4 @@
-use crate::geometry::{HitRecord, Interval, Quad, Ray, Shape, Sphere, Triangle};
+use crate::geometry::{HitRecord, Interval, MovingSphere, Quad, Ray, Shape, Sphere, Triangle};
 
 use super::Material;
 
@@ -7,10 +7,22 @@ use super::Material;
 pub enum Object {
     /// A sphere.
     Sphere(Sphere),
+    /// A sphere that moves with the ray's time.
+    MovingSphere(MovingSphere),
     /// A parallelogram.
     Quad(Quad),
     /// A triangle.
     Triangle(Triangle),
+}
+
+impl Object {
+    /// Whether the test is closed at the interval's ends (quads and triangles, the course's
+    /// `contains`) rather than open (spheres, `surrounds`): at exactly the same `t` as an
+    /// earlier object, a closed one replaces it in [`Scene::closest`] and an open one does not.
+    #[inline]
+    pub fn is_closed(&self) -> bool {
+        matches!(self, Object::Quad(_) | Object::Triangle(_))
+    }
 }
 
 impl Shape for Object {
@@ -18,6 +30,7 @@ impl Shape for Object {
     fn intersect(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         match self {
             Object::Sphere(s) => s.intersect(ray, interval),
+            Object::MovingSphere(s) => s.intersect(ray, interval),
             Object::Quad(q) => q.intersect(ray, interval),
             Object::Triangle(t) => t.intersect(ray, interval),
         }
@@ -27,6 +40,7 @@ impl Shape for Object {
     fn hit_t(&self, ray: &Ray, interval: Interval) -> Option<f64> {
         match self {
             Object::Sphere(s) => s.hit_t(ray, interval),
+            Object::MovingSphere(s) => s.hit_t(ray, interval),
             Object::Quad(q) => q.hit_t(ray, interval),
             Object::Triangle(t) => t.hit_t(ray, interval),
         }

@@ -25,23 +25,19 @@ fn options(spp: u32, jitter: PixelJitter) -> RenderOptions {
 }
 
 fn material(name: &str, albedo: [f64; 3]) -> MaterialEntry {
-    MaterialEntry {
-        name: name.to_string(),
-        kind: MaterialKind::Lambertian,
-        albedo,
-    }
+    MaterialEntry::new(name, MaterialKind::Lambertian, albedo)
 }
 
 /// A square image `width` wide seen by the course's camera (vfov 90, focus distance 10) from
 /// `look_from` towards `look_at`.
 fn square_view(width: usize, look_from: [f64; 3], look_at: [f64; 3]) -> SceneDescription {
-    SceneDescription {
-        image: ImageSettings {
+    SceneDescription::new(
+        ImageSettings {
             width,
             aspect_ratio: 1.0,
             samples_per_pixel: 1,
         },
-        camera: CameraSettings {
+        CameraSettings {
             look_from,
             look_at,
             up: [0.0, 1.0, 0.0],
@@ -49,9 +45,9 @@ fn square_view(width: usize, look_from: [f64; 3], look_at: [f64; 3]) -> SceneDes
             focus_distance: 10.0,
             defocus_angle: 0.0,
         },
-        materials: vec![],
-        objects: vec![],
-    }
+        vec![],
+        vec![],
+    )
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -235,6 +231,7 @@ fn a_sphere_seen_head_on_covers_the_predicted_pixel_centres() {
         center: [0.0, 0.0, -5.0],
         radius: 3.0,
         material: "m".into(),
+        moving_center: None,
     }];
     let film = film_of(&description, &options(1, PixelJitter::Centre));
     let covered = film
@@ -650,4 +647,319 @@ fn bad_input_is_one_line_and_exit_2() {
     let out = run_in(dir.path(), &["scenes", "--dump", "nope"]);
     assert_bad_input(&out, "unknown scene 'nope'");
     assert!(out.stdout.is_empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Weeks 5 to 10 and the two profiles.
+
+/// Every built-in scene, in each profile it is meant for, renders the same film (variance
+/// included) on 1, 2 and 3 threads: small images at a few samples, so all twenty scenes in two
+/// profiles stay within a few seconds.
+#[test]
+fn every_builtin_renders_the_same_on_1_2_and_3_threads_in_its_profiles() {
+    for scene in BUILTIN_SCENES {
+        for &profile in scene.profiles {
+            let mut description = scene.description();
+            description.profile = profile;
+            let options = RenderOptions {
+                samples_per_pixel: 3,
+                seed: 11,
+                variance: true,
+                jitter: PixelJitter::Uniform,
+                progress: false,
+            };
+            let world = description.scene();
+            let camera = description.camera(Some(24));
+            let films: Vec<Film> = [1, 2, 3]
+                .iter()
+                .map(|&threads| {
+                    rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .unwrap()
+                        .install(|| render(&world, &camera, &options).unwrap())
+                })
+                .collect();
+            let what = format!("{} ({profile})", scene.name);
+            assert!(
+                films[0].mean.iter().all(|c| c.is_finite()),
+                "{what}: not finite"
+            );
+            assert!(
+                same_bits(&films[0], &films[1]),
+                "{what}: 1 and 2 threads differ"
+            );
+            assert!(
+                same_bits(&films[0], &films[2]),
+                "{what}: 1 and 3 threads differ"
+            );
+        }
+    }
+}
+
+/// `render` names the profile on its line and in the EXR, renders a course scene by the
+/// book's rules with `--profile physical` (the book's encoding: a white sky pixel is 255, the
+/// course's 254), and says how many samples the course's jitter took.
+#[test]
+fn render_names_the_profile_and_the_samples_taken() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        dir.path(),
+        &["render", "week06-mirrors", "--spp", "1", "--width", "40"],
+    );
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(stderr.contains("profile course"), "{stderr}");
+    let out = run_in(
+        dir.path(),
+        &[
+            "render",
+            "week06-mirrors",
+            "--spp",
+            "1",
+            "--width",
+            "40",
+            "--profile",
+            "physical",
+            "-o",
+            "p.exr",
+        ],
+    );
+    assert!(out.status.success());
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(stderr.contains("profile physical"), "{stderr}");
+    let exr = std::fs::read(dir.path().join("p.exr")).unwrap();
+    let at = exr
+        .windows(16)
+        .position(|w| w == b"rtoracle.profile")
+        .unwrap();
+    assert!(exr[at..at + 60].windows(8).any(|w| w == b"physical"));
+    let out = run_in(
+        dir.path(),
+        &["render", "week09-blinn", "--spp", "30", "--width", "16"],
+    );
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("30 spp, seed")
+    );
+    let out = run_in(
+        dir.path(),
+        &["render", "week10-moving", "--spp", "200", "--width", "16"],
+    );
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("200 spp: 196 jittered samples a pixel"),
+        "{stderr}"
+    );
+    // The book's encoding reaches 255 where the course's stops at 254: a ray straight up.
+    let mut sky = builtin("rtiow-materials").unwrap();
+    sky.camera.look_at = [0.0, 1.0, 0.0];
+    sky.camera.up = [0.0, 0.0, 1.0];
+    sky.objects.clear();
+    std::fs::write(dir.path().join("sky.toml"), sky.to_toml()).unwrap();
+    let out = run_in(
+        dir.path(),
+        &[
+            "render", "sky.toml", "--spp", "1", "--width", "8", "-o", "sky.png",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = rtoracle::image_io::read_png(&dir.path().join("sky.png")).unwrap();
+    assert!(png.data.contains(&255), "the book's encoding");
+}
+
+/// The scene file's new keys are refused when they are wrong, with one line naming the file
+/// and the key, and exit 2: an unknown key in `[render]`, a key of another kind of material,
+/// a missing or unreadable texture file, negative roughness and IOR, a depth of 0, the
+/// course's jitter without its step, a BRDF material in the physical profile, an unknown
+/// texture name; and `--profile`, `--textures` used wrongly.
+#[test]
+fn bad_new_keys_are_one_line_and_exit_2() {
+    let good = builtin("week07-procedural-texture").unwrap().to_toml();
+    let command = ["render", "scene.toml"];
+    let refused = |text: &str, needle: &str| {
+        assert_render_refused(&[("scene.toml", text)], &command, needle);
+    };
+    refused(
+        &with_line(&good, "max_depth = 5", "max_depht = 5"),
+        "unknown field `max_depht`",
+    );
+    refused(
+        &with_line(&good, "max_depth = 5", "max_depth = 0"),
+        "scene.toml: render.max_depth is 0",
+    );
+    refused(
+        &with_line(
+            &good,
+            "generated = \"earth\"",
+            "file = \"textures/earthmap.png\"",
+        ),
+        "textures[3].file = '",
+    );
+    refused(
+        &with_line(
+            &good,
+            "generated = \"earth\"",
+            "file = \"textures/earthmap.png\"",
+        ),
+        "earthmap.png': no such file",
+    );
+    refused(
+        &with_line(&good, "generated = \"earth\"", "generated = \"mars\""),
+        "textures[3].generated is 'mars'",
+    );
+    refused(
+        &with_line(&good, "texture = \"checker\"", "texture = \"chequer\""),
+        "materials[1].texture names the texture 'chequer', which is not defined",
+    );
+    refused(
+        &with_line(
+            &good,
+            "sampling = \"uniform\"",
+            "sampling = \"course-jittered\"",
+        ),
+        "render.sampling is \"course-jittered\", which needs render.jitter_step",
+    );
+    refused(
+        &with_line(
+            &good,
+            "texture = \"ground\"",
+            "texture = \"ground\"\nior = 1.5",
+        ),
+        "materials[0].ior does not apply to a textured material",
+    );
+    let glass = builtin("week06-dielectric").unwrap().to_toml();
+    refused(
+        &with_line(&glass, "ior = 1.5", "ior = -1.5"),
+        "materials[3].ior is -1.5, it must be positive",
+    );
+    refused(
+        &with_line(&glass, "ior = 1.5", "ior = 0.0"),
+        "materials[3].ior is 0.0, it must be positive",
+    );
+    refused(
+        &with_line(&glass, "ior = 1.5\n", ""),
+        "materials[3].ior is missing",
+    );
+    let metal = builtin("rtiow-materials").unwrap().to_toml();
+    refused(
+        &with_line(&metal, "roughness = 1.0", "roughness = -0.2"),
+        "materials[4].roughness is -0.2, it must be at least 0",
+    );
+    let phong = builtin("week08-phong").unwrap().to_toml();
+    refused(
+        &format!("profile = \"physical\"\n{phong}"),
+        "materials[1].type is phong, one of the course's BRDF models",
+    );
+    refused(
+        &format!("profile = \"bookish\"\n{phong}"),
+        "unknown variant `bookish`",
+    );
+    // A texture file that is not an image, relative to the scene file's folder.
+    assert_render_refused(
+        &[
+            (
+                "scene.toml",
+                &with_line(&good, "generated = \"earth\"", "file = \"earth.png\""),
+            ),
+            ("earth.png", "not a picture"),
+        ],
+        &command,
+        "earth.png': not a PNG or JPEG image",
+    );
+    // The command line.
+    assert_render_refused(
+        &[],
+        &["render", "week08-phong", "--profile", "physical"],
+        "--profile physical",
+    );
+    assert_render_refused(
+        &[],
+        &["render", "week08-phong", "--profile", "book"],
+        "'book' is not a profile",
+    );
+    assert_render_refused(
+        &[],
+        &["render", "week07-earth", "--textures", "nowhere"],
+        "--textures nowhere: no such folder",
+    );
+    assert_render_refused(
+        &[],
+        &["render", "week07-earth", "--textures", "."],
+        "no basketball.png or basketball.jpg",
+    );
+    assert_render_refused(
+        &[("scene.toml", &good)],
+        &["render", "scene.toml", "--textures", "."],
+        "--textures: scene.toml is a scene file",
+    );
+}
+
+/// A texture file is named relative to the scene file's folder, wherever `render` runs, and
+/// it is what the image shows: a scene file naming a copy of a generated picture renders the
+/// same bytes as the built-in with the generated picture.
+#[test]
+fn a_texture_file_is_read_relative_to_the_scene_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("scenes")).unwrap();
+    let picture = rtoracle::scene::generated_picture("earth").unwrap();
+    rtoracle::image_io::write_png(
+        &dir.path().join("scenes/earthmap.png"),
+        &rtoracle::image_io::Rgb8Image {
+            width: picture.width,
+            height: picture.height,
+            data: picture.data,
+        },
+    )
+    .unwrap();
+    let text = builtin("week07-procedural-texture")
+        .unwrap()
+        .to_toml()
+        .replace("generated = \"earth\"", "file = \"earthmap.png\"");
+    std::fs::write(dir.path().join("scenes/earth.toml"), text).unwrap();
+    let args = ["--spp", "2", "--width", "60", "-o"];
+    let from_file = run_in(
+        dir.path(),
+        &[&["render", "scenes/earth.toml"][..], &args, &["a.png"]].concat(),
+    );
+    assert!(
+        from_file.status.success(),
+        "{}",
+        String::from_utf8_lossy(&from_file.stderr)
+    );
+    let builtin = run_in(
+        dir.path(),
+        &[
+            &["render", "week07-procedural-texture"][..],
+            &args,
+            &["b.png"],
+        ]
+        .concat(),
+    );
+    assert!(builtin.status.success());
+    assert_eq!(
+        std::fs::read(dir.path().join("a.png")).unwrap(),
+        std::fs::read(dir.path().join("b.png")).unwrap()
+    );
+    // --textures DIR with the course's name gives the same scene, with the file's absolute path.
+    let dumped = run_in(
+        dir.path(),
+        &[
+            "scenes",
+            "--dump",
+            "week07-procedural-texture",
+            "--textures",
+            "scenes",
+        ],
+    );
+    let text = String::from_utf8(dumped.stdout).unwrap();
+    let path = dir.path().join("scenes/earthmap.png");
+    assert!(
+        text.contains(&format!("file = \"{}\"", path.display())),
+        "{text}"
+    );
 }
