@@ -89,15 +89,8 @@ fn summary(c: &Comparison, candidate: &Path, pictures: bool, spp_note: Option<&s
     if total > 5 {
         s.push_str(&format!("  ... and {} more regions\n", total - 5));
     }
-    if let Some(n) = c.noise.as_ref().filter(|n| !n.passed) {
-        s.push_str(&format!(
-            "  noise: the pixels differ from the golden as much as a render of about {} spp would, not {} spp (p {:.2e} < {:.0e})\n",
-            n.effective_spp
-                .map_or_else(|| "fewer".to_string(), |e| format!("{e:.1}")),
-            n.claimed_spp,
-            n.p,
-            n.threshold
-        ));
+    if c.noise.as_ref().is_some_and(|n| !n.passed) {
+        s.push_str(&format!("  {}\n", c.noise_sentence()));
     }
     if let Some(d) = &c.diagnosis {
         s.push_str(&format!("  diagnosis: {}\n", d.summary));
@@ -113,7 +106,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .encoding
         .parse()
         .map_err(|e: String| anyhow::anyhow!(e))?;
-    if let Some(h) = &args.heatmap {
+    let heatmap_in_report = heatmap_in_report(&args)?;
+    if let (Some(h), None) = (&args.heatmap, &heatmap_in_report) {
         rtoracle::output::check_output_file(h, "--heatmap")?;
         let png = h.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if !png {
@@ -141,10 +135,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         encoding,
         ..Default::default()
     };
-    let comparison = compare_image(&candidate, &golden, &options)
+    let mut comparison = compare_image(&candidate, &golden, &options)
         .with_context(|| args.candidate.display().to_string())?;
-    if let Some(h) = &args.heatmap {
-        write_heatmap(h, &comparison)?;
+    comparison.candidate = Some(args.candidate.display().to_string());
+    match (&args.heatmap, &heatmap_in_report) {
+        (Some(h), None) => write_heatmap(h, &comparison)?,
+        (_, Some(name)) if name != "heatmap.png" => {
+            if let Some(out) = &report_out {
+                out.write(name, &rtoracle::compare::heatmap::heatmap_png(&comparison)?)?;
+            }
+        }
+        _ => {}
     }
     if let Some(out) = report_out {
         write_report_to(out, &comparison, &candidate, &golden, encoding)?;
@@ -159,6 +160,36 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
     Ok(ExitCode::from(if comparison.passed() { 0 } else { 1 }))
+}
+
+/// The name `--heatmap` gives inside the `--report` folder, when it names a file there (written
+/// into the report, which the folder does not hold yet): `heat*.png`, or bad input.
+fn heatmap_in_report(args: &Args) -> anyhow::Result<Option<String>> {
+    let (Some(h), Some(dir)) = (&args.heatmap, &args.report) else {
+        return Ok(None);
+    };
+    let parent = h
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let same = match (std::path::absolute(parent), std::path::absolute(dir)) {
+        (Ok(a), Ok(b)) => a.components().eq(b.components()),
+        _ => false,
+    };
+    if !same {
+        return Ok(None);
+    }
+    let name = h
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    if !report::is_heatmap_name(&name) {
+        anyhow::bail!(
+            "--heatmap {}: inside the --report folder the heatmap must be named heat*.png (the report holds heatmap.png already)",
+            h.display()
+        );
+    }
+    Ok(Some(name))
 }
 
 /// The golden, made once the candidate's samples per pixel are known.

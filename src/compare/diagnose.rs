@@ -3,6 +3,7 @@
 
 use rayon::prelude::*;
 
+use super::hypotheses;
 use super::{
     CandidateImage, CompareOptions, Diagnosis, ENCODINGS, Encoding, Evaluation, Golden,
     HypothesisScore, evaluate,
@@ -17,6 +18,7 @@ fn encoding_mistake(e: Encoding, asked: Encoding) -> String {
         Encoding::Gamma22 => format!("fits the golden encoded with gamma 2.2, where the {asked} encoding is asked for"),
         Encoding::Srgb => format!("fits the golden encoded with the sRGB curve, where the {asked} encoding is asked for"),
         Encoding::Rtiow => "fits the golden encoded as the book does (256 * clamp(sqrt(x), 0, 0.999)), not as the course does (255 * ...)".into(),
+        Encoding::GammaTwice => "fits the golden with the gamma applied twice (sqrt of sqrt: a value already gamma-encoded encoded again)".into(),
         Encoding::Course => "fits the golden encoded as the course does (255 * clamp(sqrt(x), 0, 0.999), truncated)".into(),
     }
 }
@@ -91,6 +93,117 @@ enum Try {
     FlipX,
     Bgr,
     Shift(i32),
+    /// Every linear value times `k` (per channel).
+    Scale([f64; 3]),
+    /// The image zoomed by `s` about its centre.
+    Zoom(f64),
+}
+
+/// Scales within this of each other are "the same in every channel".
+const SAME_SCALE: f64 = 0.02;
+
+/// The name and words of a uniform scale `k`.
+fn scale_mistake(k: [f64; 3]) -> (String, String) {
+    let (lo, hi) = (
+        k.iter().copied().fold(f64::INFINITY, f64::min),
+        k.iter().copied().fold(0.0, f64::max),
+    );
+    if hi - lo <= SAME_SCALE * hi {
+        let m = (k[0] + k[1] + k[2]) / 3.0;
+        let way = if m < 1.0 { "darker" } else { "brighter" };
+        (
+            format!("scale:{m:.2}"),
+            format!(
+                "fits the golden with every value times {m:.2} (the same in red, green and blue: {:.0}% {way}): an exposure or brightness change, a light's strength, or every albedo scaled",
+                100.0 * (m - 1.0).abs()
+            ),
+        )
+    } else {
+        (
+            format!("scale:{:.2},{:.2},{:.2}", k[0], k[1], k[2]),
+            format!(
+                "fits the golden with red times {:.2}, green times {:.2} and blue times {:.2}: a colour cast (a light's or the albedos' colour scaled per channel)",
+                k[0], k[1], k[2]
+            ),
+        )
+    }
+}
+
+/// The name and words of a zoom by `s` about the centre, naming the field of view when the
+/// golden's is known.
+fn zoom_mistake(s: f64, vfov: Option<f64>) -> (String, String) {
+    let how = if s > 1.0 {
+        format!("magnified {s:.3} times")
+    } else {
+        format!("shrunk to {s:.3} of its size")
+    };
+    let why = match vfov {
+        Some(v) => format!(
+            "a vertical field of view of about {:.1} degrees where the scene's is {v}, or the camera {} the scene",
+            hypotheses::zoomed_vfov(v, s),
+            if s > 1.0 { "closer to" } else { "farther from" }
+        ),
+        None => "a field of view or a camera distance that differs from the scene's".to_string(),
+    };
+    (
+        format!("zoom:{s:.3}"),
+        format!("fits the golden {how} about the centre: {why}"),
+    )
+}
+
+/// Evaluates the candidate under one hypothesis: its name, the mistake in words, the result.
+fn attempt(
+    t: &Try,
+    candidate: &CandidateImage,
+    golden: &Golden,
+    options: &CompareOptions,
+) -> (String, String, Evaluation) {
+    let asked = options.encoding;
+    match *t {
+        Try::Encoding(e) => (
+            format!("encoding:{e}"),
+            encoding_mistake(e, asked),
+            evaluate(candidate, golden, e, options),
+        ),
+        Try::FlipY => (
+            "flip-y".to_string(),
+            "fits the golden upside down: rows written bottom to top (y flipped)"
+                .to_string(),
+            evaluate(&flip_y(candidate), golden, asked, options),
+        ),
+        Try::FlipX => (
+            "flip-x".to_string(),
+            "fits the golden mirrored left to right: columns written right to left, or the camera's horizontal axis reversed (x flipped)"
+                .to_string(),
+            evaluate(&flip_x(candidate), golden, asked, options),
+        ),
+        Try::Bgr => (
+            "bgr".to_string(),
+            "fits the golden with red and blue swapped: channels written in BGR order"
+                .to_string(),
+            evaluate(&bgr(candidate), golden, asked, options),
+        ),
+        Try::Shift(s) if s > 0 => (
+            "shift:+0.5".to_string(),
+            "fits the golden shifted half a pixel right and down: samples jittered in [0, 1) instead of [-0.5, 0.5)".to_string(),
+            evaluate(candidate, &golden.half_pixel_shifted(1), asked, options),
+        ),
+        Try::Shift(_) => (
+            "shift:-0.5".to_string(),
+            "fits the golden shifted half a pixel left and up: a half-pixel camera shift (pixel00 without its half-pixel offset?)".to_string(),
+            evaluate(candidate, &golden.half_pixel_shifted(-1), asked, options),
+        ),
+        Try::Scale(k) => {
+            let (name, mistake) = scale_mistake(k);
+            let e = evaluate(candidate, &hypotheses::scaled(golden, k), asked, options);
+            (name, mistake, e)
+        }
+        Try::Zoom(s) => {
+            let (name, mistake) = zoom_mistake(s, golden.vfov);
+            let e = evaluate(candidate, &hypotheses::zoomed(golden, s), asked, options);
+            (name, mistake, e)
+        }
+    }
 }
 
 /// Tries every hypothesis on a failed image and names the best one that explains at least half
@@ -115,45 +228,19 @@ pub fn diagnose(
         Try::Shift(1),
         Try::Shift(-1),
     ]);
+    if let Some(k) = hypotheses::channel_scales(candidate, golden, asked)
+        .filter(|k| k.iter().any(|x| (x - 1.0).abs() > 0.005))
+    {
+        tries.push(Try::Scale(k));
+    }
+    if let Some(s) = hypotheses::best_zoom(candidate, golden, asked) {
+        tries.push(Try::Zoom(s));
+    }
     // The hypotheses are independent: evaluate them in parallel (each is deterministic).
     let mut scores: Vec<HypothesisScore> = tries
         .par_iter()
         .map(|t| {
-            let (name, mistake, e) = match *t {
-                Try::Encoding(e) => (
-                    format!("encoding:{e}"),
-                    encoding_mistake(e, asked),
-                    evaluate(candidate, golden, e, options),
-                ),
-                Try::FlipY => (
-                    "flip-y".to_string(),
-                    "fits the golden upside down: rows written bottom to top (y flipped)"
-                        .to_string(),
-                    evaluate(&flip_y(candidate), golden, asked, options),
-                ),
-                Try::FlipX => (
-                    "flip-x".to_string(),
-                    "fits the golden mirrored left to right: columns written right to left, or the camera's horizontal axis reversed (x flipped)"
-                        .to_string(),
-                    evaluate(&flip_x(candidate), golden, asked, options),
-                ),
-                Try::Bgr => (
-                    "bgr".to_string(),
-                    "fits the golden with red and blue swapped: channels written in BGR order"
-                        .to_string(),
-                    evaluate(&bgr(candidate), golden, asked, options),
-                ),
-                Try::Shift(s) if s > 0 => (
-                    "shift:+0.5".to_string(),
-                    "fits the golden shifted half a pixel right and down: samples jittered in [0, 1) instead of [-0.5, 0.5)".to_string(),
-                    evaluate(candidate, &golden.half_pixel_shifted(1), asked, options),
-                ),
-                Try::Shift(_) => (
-                    "shift:-0.5".to_string(),
-                    "fits the golden shifted half a pixel left and up: a half-pixel camera shift (pixel00 without its half-pixel offset?)".to_string(),
-                    evaluate(candidate, &golden.half_pixel_shifted(-1), asked, options),
-                ),
-            };
+            let (name, mistake, e) = attempt(t, candidate, golden, options);
             HypothesisScore {
                 name,
                 mistake,
@@ -182,7 +269,7 @@ pub fn diagnose(
             s.mistake,
             100.0 * (1.0 - s.misfit_ratio)
         ),
-        None => "no common mistake explains the image (tried other encodings, y flipped, x flipped, BGR, half-pixel shifts): look at the failing regions".into(),
+        None => "no common mistake explains the image (tried other encodings, y flipped, x flipped, BGR, half-pixel shifts, a uniform scale, a zoom): look at the failing regions".into(),
     };
     Diagnosis {
         summary,

@@ -22,15 +22,19 @@ pub enum Encoding {
     Gamma22,
     /// No transfer curve: `255 x`, rounded or truncated.
     Linear,
+    /// The course's gamma applied twice: `floor(255 * clamp(sqrt(sqrt(x)), 0, 0.999))` (a
+    /// mistake the diagnosis tests, not an encoding an assignment asks for).
+    GammaTwice,
 }
 
 /// Every encoding, in the order the diagnosis tries them.
-pub const ENCODINGS: [Encoding; 5] = [
+pub const ENCODINGS: [Encoding; 6] = [
     Encoding::Course,
     Encoding::Rtiow,
     Encoding::Srgb,
     Encoding::Gamma22,
     Encoding::Linear,
+    Encoding::GammaTwice,
 ];
 
 /// Marks a code the encoding can never produce: its "interval" lies far outside `[0, 1]`.
@@ -61,6 +65,7 @@ impl Encoding {
             Encoding::Srgb => "srgb",
             Encoding::Gamma22 => "gamma22",
             Encoding::Linear => "linear",
+            Encoding::GammaTwice => "gamma-twice",
         }
     }
 
@@ -72,6 +77,7 @@ impl Encoding {
             Encoding::Srgb => linear_to_srgb(x.min(1.0)),
             Encoding::Gamma22 => x.min(1.0).powf(1.0 / 2.2),
             Encoding::Linear => x,
+            Encoding::GammaTwice => x.sqrt().sqrt(),
         }
     }
 
@@ -83,6 +89,7 @@ impl Encoding {
             Encoding::Srgb => srgb_to_linear(g),
             Encoding::Gamma22 => g.powf(2.2),
             Encoding::Linear => g,
+            Encoding::GammaTwice => (g * g) * (g * g),
         }
     }
 
@@ -91,7 +98,7 @@ impl Encoding {
     pub fn encode(self, x: f64) -> u8 {
         let g = self.curve(x);
         match self {
-            Encoding::Course => (255.0 * g.clamp(0.0, 0.999)) as u8,
+            Encoding::Course | Encoding::GammaTwice => (255.0 * g.clamp(0.0, 0.999)) as u8,
             Encoding::Rtiow => (256.0 * g.clamp(0.0, 0.999)) as u8,
             _ => (255.0 * g.clamp(0.0, 1.0)).round() as u8,
         }
@@ -112,7 +119,7 @@ impl Encoding {
     fn decode_exact(self, code: u8) -> (f64, f64) {
         let q = code as f64;
         match self {
-            Encoding::Course => match code {
+            Encoding::Course | Encoding::GammaTwice => match code {
                 255 => IMPOSSIBLE,
                 254 => (self.inverse(254.0 / 255.0), 1.0),
                 _ => (self.inverse(q / 255.0), self.inverse((q + 1.0) / 255.0)),
@@ -149,7 +156,7 @@ impl FromStr for Encoding {
             .into_iter()
             .find(|e| e.name() == s)
             .ok_or_else(|| {
-                format!("unknown encoding '{s}' (expected course, rtiow, srgb, gamma22 or linear)")
+                format!("unknown encoding '{s}' (expected course, rtiow, srgb, gamma22, linear or gamma-twice)")
             })
     }
 }

@@ -1,31 +1,50 @@
-//! The signed z-map: red where the candidate is brighter than the golden, blue where darker,
-//! white where it agrees, failing regions outlined in green.
+//! The signed z maps: one per channel (red, green, blue, side by side, [`GAP`] pixels apart),
+//! orange where the candidate is higher than the golden, purple where it is lower, white where
+//! it agrees, the colour full from `|z| =` [`SATURATE`] on; every failing region outlined in
+//! green in each map. Three maps, not one, so that a colour change (red up, blue down) does not
+//! read as a brighter image.
 
 use std::path::Path;
 
 use super::{CompareError, Comparison};
 use crate::image_io::{Rgb8Image, write_png};
 
-/// |z| at which the colour saturates.
-const SATURATE: f32 = 8.0;
-const OUTLINE: [u8; 3] = [0, 170, 0];
+/// `|z|` from which the colour is full.
+pub const SATURATE: f32 = 8.0;
+/// The colour of a channel higher than the golden's (`z >= SATURATE`).
+pub const HIGHER: [u8; 3] = [230, 97, 1];
+/// The colour of a channel lower than the golden's (`z <= -SATURATE`).
+pub const LOWER: [u8; 3] = [94, 60, 153];
+/// The outline of failing regions.
+pub const OUTLINE: [u8; 3] = [0, 170, 0];
+/// White columns between the three maps.
+pub const GAP: usize = 4;
 
-/// The heatmap as an image.
+/// The colour of a signed `z`: white at 0, blended linearly towards [`HIGHER`] or [`LOWER`].
+pub fn colour(z: f32) -> [u8; 3] {
+    let t = (z.abs() / SATURATE).min(1.0);
+    let end = if z > 0.0 { HIGHER } else { LOWER };
+    end.map(|e| (255.0 + t * (f32::from(e) - 255.0)).round() as u8)
+}
+
+/// The three maps as one image, `3 w + 2 GAP` wide.
 pub fn heatmap_image(comparison: &Comparison) -> Rgb8Image {
     let (w, h) = (comparison.width, comparison.height);
-    let mut data = Vec::with_capacity(w * h * 3);
-    for &z in &comparison.z_map {
-        let t = (z.abs() / SATURATE).min(1.0);
-        let fade = (255.0 * (1.0 - t)).round() as u8;
-        data.extend_from_slice(&if z > 0.0 {
-            [255, fade, fade]
-        } else {
-            [fade, fade, 255]
-        });
+    let out_w = 3 * w + 2 * GAP;
+    let mut data = vec![255u8; 3 * out_w * h];
+    for (i, z) in comparison.z_map.iter().enumerate() {
+        let (x, y) = (i % w, i / w);
+        for (c, &zc) in z.iter().enumerate() {
+            let at = 3 * (y * out_w + c * (w + GAP) + x);
+            data[at..at + 3].copy_from_slice(&colour(zc));
+        }
     }
     let mut put = |x: usize, y: usize| {
         if x < w && y < h {
-            data[3 * (y * w + x)..3 * (y * w + x) + 3].copy_from_slice(&OUTLINE);
+            for c in 0..3 {
+                let at = 3 * (y * out_w + c * (w + GAP) + x);
+                data[at..at + 3].copy_from_slice(&OUTLINE);
+            }
         }
     };
     // Every failing region, not only the ones the report lists.
@@ -46,13 +65,34 @@ pub fn heatmap_image(comparison: &Comparison) -> Rgb8Image {
         }
     }
     Rgb8Image {
-        width: w,
+        width: out_w,
         height: h,
         data,
     }
 }
 
+/// The heatmap as PNG bytes.
+pub fn heatmap_png(comparison: &Comparison) -> Result<Vec<u8>, CompareError> {
+    crate::image_io::encode_png(&heatmap_image(comparison))
+        .map_err(|message| CompareError::Golden(format!("cannot encode the heatmap: {message}")))
+}
+
 /// Writes the heatmap PNG atomically.
 pub fn write_heatmap(path: &Path, comparison: &Comparison) -> Result<(), CompareError> {
     Ok(write_png(path, &heatmap_image(comparison))?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colours_run_from_purple_through_white_to_orange() {
+        assert_eq!(colour(0.0), [255; 3]);
+        assert_eq!(colour(SATURATE), HIGHER);
+        assert_eq!(colour(1000.0), HIGHER);
+        assert_eq!(colour(-SATURATE), LOWER);
+        // Half way: half way between white and the end, per channel.
+        assert_eq!(colour(-SATURATE / 2.0), [175, 158, 204]);
+    }
 }

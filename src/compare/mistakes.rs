@@ -18,6 +18,8 @@ pub enum Mistake {
     NoGamma,
     /// Gamma 2.2 where the course asks for 2: `floor(255 * clamp(x^(1/2.2), 0, 0.999))`.
     Gamma22,
+    /// The course's gamma applied twice: `floor(255 * clamp(sqrt(sqrt(x)), 0, 0.999))`.
+    GammaTwice,
     /// Every albedo times 0.97.
     AlbedoScaled,
     /// The camera's `pixel00` without its half-pixel offset: every sample half a pixel left and up.
@@ -43,9 +45,10 @@ pub enum Mistake {
 
 /// Every mistake the comparison must reject (`docs/comparing-images.md`, "Measured false alarms
 /// and power").
-pub const MUST_FAIL: [Mistake; 10] = [
+pub const MUST_FAIL: [Mistake; 11] = [
     Mistake::NoGamma,
     Mistake::Gamma22,
+    Mistake::GammaTwice,
     Mistake::AlbedoScaled,
     Mistake::HalfPixelShift,
     Mistake::JitterZeroOne,
@@ -58,10 +61,11 @@ pub const MUST_FAIL: [Mistake; 10] = [
 
 /// Every mistake of the catalogue with the name `examples/mistake.rs` (and the README test's
 /// `mistake:` fixture) calls it by.
-pub const BY_ARGUMENT: [(&str, Mistake); 12] = [
+pub const BY_ARGUMENT: [(&str, Mistake); 13] = [
     ("honest", Mistake::Honest),
     ("no-gamma", Mistake::NoGamma),
     ("gamma22", Mistake::Gamma22),
+    ("gamma-twice", Mistake::GammaTwice),
     ("albedo", Mistake::AlbedoScaled),
     ("half-pixel", Mistake::HalfPixelShift),
     ("jitter01", Mistake::JitterZeroOne),
@@ -88,6 +92,7 @@ impl Mistake {
             Mistake::Honest => "honest",
             Mistake::NoGamma => "no gamma",
             Mistake::Gamma22 => "gamma 2.2",
+            Mistake::GammaTwice => "gamma applied twice",
             Mistake::AlbedoScaled => "albedo x 0.97",
             Mistake::HalfPixelShift => "half-pixel camera shift",
             Mistake::JitterZeroOne => "jitter in [0, 1)",
@@ -171,6 +176,9 @@ pub fn render_with_mistake(
                 for x in mean.to_array() {
                     row.push(match mistake {
                         Mistake::NoGamma => (255.0 * x.clamp(0.0, 0.999)) as u8,
+                        Mistake::GammaTwice => {
+                            (255.0 * x.max(0.0).sqrt().sqrt().clamp(0.0, 0.999)) as u8
+                        }
                         Mistake::Gamma22 => {
                             (255.0 * x.max(0.0).powf(1.0 / 2.2).clamp(0.0, 0.999)) as u8
                         }

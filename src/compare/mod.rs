@@ -9,11 +9,14 @@
 //! common mistakes as alternative hypotheses. See `docs/comparing-images.md`.
 
 pub mod bench;
+pub mod candidate;
 pub mod diagnose;
 pub mod encoding;
 pub mod heatmap;
+mod hypotheses;
 pub mod mistakes;
 pub mod noise_model;
+pub mod regions;
 pub mod report;
 pub mod stats;
 pub mod verdict;
@@ -22,6 +25,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+pub use candidate::CandidateImage;
 pub use encoding::{ENCODINGS, Encoding};
 pub use heatmap::write_heatmap;
 pub use noise_model::Golden;
@@ -50,106 +54,6 @@ pub enum CompareError {
     /// The report folder cannot be written (or may not be replaced).
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
-}
-
-/// A candidate image: 8-bit codes (from a PNG) or linear values (from an EXR).
-#[derive(Clone, Debug, PartialEq)]
-pub enum CandidateImage {
-    /// 8-bit RGB, row-major, top row first.
-    Rgb8 {
-        /// Width in pixels.
-        width: usize,
-        /// Height in pixels.
-        height: usize,
-        /// `3 * width * height` codes.
-        data: Vec<u8>,
-    },
-    /// Linear RGB (an EXR, read as `f32`), row-major, top row first.
-    Linear {
-        /// Width in pixels.
-        width: usize,
-        /// Height in pixels.
-        height: usize,
-        /// One linear RGB triple per pixel.
-        data: Vec<[f32; 3]>,
-    },
-}
-
-impl CandidateImage {
-    /// Reads a PNG (8-bit RGB or RGBA) or an EXR, telling them apart by their first bytes.
-    pub fn load(path: &Path) -> Result<Self, CompareError> {
-        let bad = |message: String| CompareError::Input {
-            path: path.to_path_buf(),
-            message,
-        };
-        let mut head = [0u8; 8];
-        let n = {
-            use std::io::Read;
-            let mut f = std::fs::File::open(path).map_err(|e| {
-                bad(if e.kind() == std::io::ErrorKind::NotFound {
-                    "no such file".to_string()
-                } else {
-                    format!("cannot open: {e}")
-                })
-            })?;
-            if f.metadata().map(|m| m.is_dir()).unwrap_or(false) {
-                return Err(bad("is a folder, not an image".into()));
-            }
-            f.read(&mut head)
-                .map_err(|e| bad(format!("cannot read: {e}")))?
-        };
-        if n >= 8 && head == *b"\x89PNG\r\n\x1a\n" {
-            let img = crate::image_io::read_png(path)?;
-            Ok(CandidateImage::Rgb8 {
-                width: img.width,
-                height: img.height,
-                data: img.data,
-            })
-        } else if n >= 4 && head[..4] == [0x76, 0x2f, 0x31, 0x01] {
-            let img = crate::image_io::read_exr(path)?;
-            if img.data_is_bad() {
-                return Err(bad("has a NaN or infinite pixel value".into()));
-            }
-            Ok(CandidateImage::Linear {
-                width: img.width,
-                height: img.height,
-                data: img.mean,
-            })
-        } else if n == 0 {
-            Err(bad("is empty, not an image".into()))
-        } else {
-            Err(bad("is not a PNG or EXR image".into()))
-        }
-    }
-
-    /// `(width, height)`.
-    pub fn size(&self) -> (usize, usize) {
-        match self {
-            CandidateImage::Rgb8 { width, height, .. }
-            | CandidateImage::Linear { width, height, .. } => (*width, *height),
-        }
-    }
-
-    /// The image as 8-bit RGB for pictures (linear images are encoded with `encoding`).
-    pub fn to_rgb8(&self, encoding: Encoding) -> Vec<u8> {
-        match self {
-            CandidateImage::Rgb8 { data, .. } => data.clone(),
-            CandidateImage::Linear { data, .. } => data
-                .iter()
-                .flat_map(|p| p.map(|x| encoding.encode(x as f64)))
-                .collect(),
-        }
-    }
-}
-
-trait ExrCheck {
-    fn data_is_bad(&self) -> bool;
-}
-
-impl ExrCheck for crate::image_io::ExrImage {
-    fn data_is_bad(&self) -> bool {
-        self.mean.iter().any(|p| p.iter().any(|x| !x.is_finite()))
-    }
 }
 
 /// How to compare.
@@ -225,6 +129,10 @@ pub struct Region {
     pub adjusted_p: f64,
     /// Its signed z: positive when the candidate is brighter than the golden.
     pub z: f64,
+    /// What each channel does inside, in words ("red up, blue down: a different colour, not a
+    /// brighter one"; see [`regions::channel_change`]).
+    #[serde(default)]
+    pub change: Option<String>,
 }
 
 /// The noise check: is the candidate no noisier than `N` samples per pixel allow? The squared
@@ -276,6 +184,9 @@ pub struct Diagnosis {
 pub struct Comparison {
     /// Pass or fail.
     pub verdict: Verdict,
+    /// The candidate's file, as given, when it came from one.
+    #[serde(default)]
+    pub candidate: Option<String>,
     /// Image width.
     pub width: usize,
     /// Image height.
@@ -311,15 +222,48 @@ pub struct Comparison {
     pub effective_spp: Option<f64>,
     /// The diagnosis, when the image fails and diagnosis was asked for.
     pub diagnosis: Option<Diagnosis>,
-    /// Signed z per pixel (the channel with the largest |z|), clamped to +-1000; for pictures.
+    /// Signed z per pixel and channel, clamped to +-1000; for pictures.
     #[serde(skip)]
-    pub z_map: Vec<f32>,
+    pub z_map: Vec<[f32; 3]>,
 }
 
 impl Comparison {
     /// Whether the candidate passed.
     pub fn passed(&self) -> bool {
         self.verdict == Verdict::Pass
+    }
+
+    /// The noise check in plain words: "the pixels differ from the golden as much as a render of
+    /// about 2.4 spp would, not 20 spp (p 1.2e-30 < 1e-6)", or that they are within the noise of
+    /// the claim, or that too few pixels show their noise to tell.
+    pub fn noise_sentence(&self) -> String {
+        let Some(n) = &self.noise else {
+            return format!(
+                "noise: too few pixels show their noise through the codes to tell the candidate's samples per pixel (judged as {} spp)",
+                self.candidate_spp
+            );
+        };
+        let about = |fewer: &str| {
+            n.effective_spp
+                .map_or_else(|| fewer.to_string(), |e| format!("about {e:.1}"))
+        };
+        if n.passed {
+            format!(
+                "noise: the pixels differ from the golden as much as a render of {} spp would, within the noise of {} spp (p {:.2e} >= {:.0e})",
+                about("at least"),
+                n.claimed_spp,
+                n.p,
+                n.threshold
+            )
+        } else {
+            format!(
+                "noise: the pixels differ from the golden as much as a render of {} spp would, not {} spp (p {:.2e} < {:.0e})",
+                about("fewer"),
+                n.claimed_spp,
+                n.p,
+                n.threshold
+            )
+        }
     }
 }
 
@@ -358,7 +302,9 @@ pub fn compare_file(
 ) -> Result<Comparison, CompareError> {
     let candidate = CandidateImage::load(path)?;
     check_size(path, &candidate, golden.width, golden.height)?;
-    compare_image(&candidate, golden, options)
+    let mut comparison = compare_image(&candidate, golden, options)?;
+    comparison.candidate = Some(path.display().to_string());
+    Ok(comparison)
 }
 
 /// Checks the candidate has the golden's size, with an error naming the file.

@@ -1,5 +1,8 @@
-//! The report folder: `report.json`, `heatmap.png`, side-by-side crops of the worst regions
-//! (candidate, golden, difference) and an `index.html` that shows them. It is an
+//! The report folder: `report.json`; `candidate.png`, `golden.png` and `difference.png` (the
+//! whole images, shown at the same scale, the worst regions boxed on the candidate);
+//! `heatmap.png` (each channel's signed z); side-by-side crops of the worst regions (candidate,
+//! golden, difference); and an `index.html` that shows them with their legends, the candidate's
+//! name, the diagnosis and the noise check in words. It is an
 //! [`OutputDir`]: checked before any work (an existing folder must hold only a compare report's
 //! files, [`REPORT_FOLDER`]), built beside its place and swapped in whole (see
 //! [`crate::output`]).
@@ -60,11 +63,7 @@ fn side_by_side(
                 0 => [cand[src], cand[src + 1], cand[src + 2]],
                 1 => [gold[src], gold[src + 1], gold[src + 2]],
                 _ => {
-                    let d = (0..3)
-                        .map(|c| (cand[src + c] as i32 - gold[src + c] as i32).abs())
-                        .max()
-                        .unwrap_or(0);
-                    let v = 255 - (4 * d).min(255) as u8;
+                    let v = difference_shade(&cand[src..src + 3], &gold[src..src + 3]);
                     [v, v, v]
                 }
             };
@@ -78,15 +77,110 @@ fn side_by_side(
     }
 }
 
+/// Pixels a thumbnail is shown wide: the image's width up to 320, small images enlarged by a
+/// whole factor to at least 160.
+fn thumb_width(w: usize) -> usize {
+    if w >= 160 {
+        w.min(320)
+    } else {
+        w * 160usize.div_ceil(w)
+    }
+}
+
+/// Scales an image coordinate to the thumbnail's, in CSS pixels.
+fn scaled(v: usize, w: usize) -> String {
+    format!("{:.1}", v as f64 * thumb_width(w) as f64 / w as f64)
+}
+
+const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;max-width:1150px}\
+td,th{padding:2px 10px;text-align:right}\
+img{image-rendering:pixelated;border:1px solid #ccc}\
+.row{display:flex;gap:12px;flex-wrap:wrap;align-items:flex-start}\
+figure{margin:0}figcaption{font-size:90%;text-align:center}\
+.thumb{position:relative}.thumb img{display:block}\
+.box{position:absolute;border:2px solid #0a0;box-sizing:border-box}\
+.box span{position:absolute;top:-1.3em;left:0;color:#0a0;font-weight:bold;font-size:80%}\
+.legend{display:flex;align-items:center;gap:8px;font-size:90%;margin:6px 0}\
+.bar{display:inline-block;width:220px;height:14px;border:1px solid #999}";
+
+/// The three thumbnails (candidate with the listed regions boxed, golden, |difference|) at the
+/// same scale, and the difference's legend.
+fn thumbnails(h: &mut String, c: &Comparison, boxed: &[(String, super::Region)]) {
+    let (w, tw) = (c.width, thumb_width(c.width));
+    let th = scaled(c.height, w);
+    let _ = write!(
+        h,
+        "<h2>The images</h2>\n<div class=\"row\">\n<figure><div class=\"thumb\" style=\"width:{tw}px;height:{th}px\">\
+         <img src=\"candidate.png\" alt=\"the candidate\" width=\"{tw}\">"
+    );
+    for (k, (_, r)) in boxed.iter().enumerate() {
+        let _ = write!(
+            h,
+            "<div class=\"box\" data-region=\"{},{},{},{}\" style=\"left:{}px;top:{}px;width:{}px;height:{}px\"><span>{}</span></div>",
+            r.x,
+            r.y,
+            r.width,
+            r.height,
+            scaled(r.x, w),
+            scaled(r.y, w),
+            scaled(r.width, w),
+            scaled(r.height, w),
+            k + 1
+        );
+    }
+    let _ = write!(
+        h,
+        "</div><figcaption>candidate{}</figcaption></figure>\n\
+         <figure><img src=\"golden.png\" alt=\"the golden\" width=\"{tw}\"><figcaption>golden ({} spp)</figcaption></figure>\n\
+         <figure><img src=\"difference.png\" alt=\"the difference\" width=\"{tw}\"><figcaption>|difference| x4</figcaption></figure>\n</div>\n",
+        if boxed.is_empty() {
+            String::new()
+        } else {
+            " (the worst regions boxed, numbered as below)".to_string()
+        },
+        c.golden_spp
+    );
+    h.push_str(DIFFERENCE_LEGEND);
+}
+
+/// The legend of every |difference| picture.
+const DIFFERENCE_LEGEND: &str = "<div class=\"legend\" id=\"difference-legend\">|difference| x4: the largest of the three channels' differences in 8-bit codes, times 4. \
+<span>white: equal</span><span class=\"bar\" style=\"background:linear-gradient(to right,#fff,#000)\"></span><span>black: 64 codes or more apart (of 255)</span></div>\n";
+
+/// The heatmap and its legend.
+fn heatmap_section(h: &mut String, c: &Comparison) {
+    use super::heatmap::{HIGHER, LOWER, SATURATE};
+    let rgb = |c: [u8; 3]| format!("rgb({},{},{})", c[0], c[1], c[2]);
+    let tw = 3 * thumb_width(c.width);
+    let _ = write!(
+        h,
+        "<h2>Where and how each channel differs</h2>\n<p>Each map is one channel's signed z: the candidate minus the golden, over the noise that \
+         {n} samples and the golden's allow. White is within noise; failing regions are outlined in green.</p>\n\
+         <figure><img src=\"heatmap.png\" alt=\"the signed z of the red, green and blue channels\" width=\"{tw}\">\
+         <figcaption style=\"display:flex;justify-content:space-around\"><span>red channel</span><span>green channel</span><span>blue channel</span></figcaption></figure>\n\
+         <div class=\"legend\" id=\"z-legend\"><span>z &le; -{s}: the candidate lower</span>\
+         <span class=\"bar\" style=\"background:linear-gradient(to right,{lo},#fff,{hi})\"></span>\
+         <span>z &ge; +{s}: the candidate higher</span></div>\n",
+        n = c.candidate_spp,
+        s = SATURATE,
+        lo = rgb(LOWER),
+        hi = rgb(HIGHER),
+    );
+}
+
 fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
     let mut h = String::new();
     let verdict = if c.passed() { "PASS" } else { "FAIL" };
+    let name = c
+        .candidate
+        .as_deref()
+        .map(|n| format!(": {}", html(n)))
+        .unwrap_or_default();
     let _ = write!(
         h,
-        "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>rtoracle compare: {verdict}</title>\
-         <style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 10px;text-align:right}}\
-         img{{image-rendering:pixelated;border:1px solid #ccc}}</style></head><body>\n\
-         <h1>{verdict}</h1>\n<p>{w}x{hh}, candidate {n} spp against a golden of {m} spp{scene}, \
+        "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>rtoracle compare: {verdict}{name}</title>\
+         <style>{STYLE}</style></head><body>\n\
+         <h1>{verdict}{name}</h1>\n<p>{w}x{hh}, candidate {n} spp against a golden of {m} spp{scene}, \
          encoding {enc}, false-failure rate {alpha}.</p>\n",
         w = c.width,
         hh = c.height,
@@ -101,7 +195,39 @@ fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
         alpha = c.alpha
     );
     if let Some(d) = &c.diagnosis {
-        let _ = writeln!(h, "<h2>Diagnosis</h2><p><b>{}</b></p>", html(&d.summary));
+        let _ = writeln!(
+            h,
+            "<p id=\"diagnosis\">Diagnosis: <b>{}</b></p>",
+            html(&d.summary)
+        );
+    }
+    let _ = writeln!(h, "<p id=\"noise\">{}</p>", html(&c.noise_sentence()));
+    thumbnails(&mut h, c, crops);
+    heatmap_section(&mut h, c);
+    if !crops.is_empty() {
+        let _ = writeln!(
+            h,
+            "<h2>The worst regions: candidate, golden, |difference| x4</h2>\n<p>{} failing regions in all, ranked by how much they show (evidence over their area, distinct places first).</p>",
+            c.regions_total.max(c.regions.len())
+        );
+        for (k, (file, r)) in crops.iter().enumerate() {
+            let _ = writeln!(
+                h,
+                "<p>{}. x {} y {} ({}x{}): <b>{}</b>; {} scale, channel {}, adjusted p {:.2e}, z {:+.1}<br><img src=\"{file}\" alt=\"region {}\"></p>",
+                k + 1,
+                r.x,
+                r.y,
+                r.width,
+                r.height,
+                html(r.change.as_deref().unwrap_or("")),
+                r.scale,
+                r.channel,
+                r.adjusted_p,
+                r.z,
+                k + 1
+            );
+        }
+        h.push_str(DIFFERENCE_LEGEND);
     }
     h.push_str("<h2>Scales</h2><table><tr><th>scale</th><th>tests</th><th>smallest adjusted p</th><th>threshold</th><th>largest |z|</th><th>failing</th></tr>\n");
     for s in &c.scales {
@@ -120,24 +246,59 @@ fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
         c.effective_spp
             .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}"))
     );
-    h.push_str("<h2>Signed z (red: brighter than the golden, blue: darker; failing regions in green)</h2>\n<img src=\"heatmap.png\" alt=\"heatmap\">\n");
-    if !crops.is_empty() {
-        h.push_str("<h2>Worst regions: candidate, golden, |difference| x4</h2>\n");
-        for (file, r) in crops {
-            let _ = writeln!(
-                h,
-                "<p>x {} y {} ({}x{}), {} scale, channel {}, adjusted p {:.2e}, z {:+.1}<br><img src=\"{file}\" alt=\"{file}\"></p>",
-                r.x, r.y, r.width, r.height, r.scale, r.channel, r.adjusted_p, r.z
-            );
-        }
-    }
     h.push_str("<p>Report: <a href=\"report.json\">report.json</a></p></body></html>\n");
     h
 }
 
+/// The |difference| x4 image of two images' codes: per pixel the largest channel's difference
+/// times 4, white where they are equal.
+fn difference_image(cand: &[u8], gold: &[u8], width: usize, height: usize) -> Rgb8Image {
+    let data = cand
+        .chunks_exact(3)
+        .zip(gold.chunks_exact(3))
+        .flat_map(|(a, b)| {
+            let v = difference_shade(a, b);
+            [v, v, v]
+        })
+        .collect();
+    Rgb8Image {
+        width,
+        height,
+        data,
+    }
+}
+
+/// The grey of one pixel of a |difference| x4 picture.
+fn difference_shade(a: &[u8], b: &[u8]) -> u8 {
+    let d = (0..3)
+        .map(|c| (i32::from(a[c]) - i32::from(b[c])).abs())
+        .max()
+        .unwrap_or(0);
+    255 - (4 * d).min(255) as u8
+}
+
+/// Whether `name` may be given to `--heatmap` inside the `--report` folder: `heat*.png` (letters,
+/// digits, `-`, `_` and `.`), so that a report folder holding it can be replaced again.
+pub fn is_heatmap_name(name: &str) -> bool {
+    name.strip_prefix("heat")
+        .and_then(|n| n.strip_suffix(".png"))
+        .is_some()
+        && name
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || matches!(b, b'-' | b'_' | b'.'))
+}
+
 /// Whether `name` is a file of a compare report folder.
 fn is_report_file(name: &str) -> bool {
-    matches!(name, "report.json" | "heatmap.png" | "index.html")
+    matches!(
+        name,
+        "report.json"
+            | "heatmap.png"
+            | "index.html"
+            | "candidate.png"
+            | "golden.png"
+            | "difference.png"
+    ) || is_heatmap_name(name)
         || name
             .strip_prefix("region-")
             .and_then(|n| n.strip_suffix(".png"))
@@ -195,6 +356,26 @@ pub fn write_report_to(
         .iter()
         .flat_map(|p| p.map(|x| encoding.encode(x)))
         .collect();
+    png(
+        "candidate.png",
+        &Rgb8Image {
+            width: comparison.width,
+            height: comparison.height,
+            data: cand.clone(),
+        },
+    )?;
+    png(
+        "golden.png",
+        &Rgb8Image {
+            width: comparison.width,
+            height: comparison.height,
+            data: gold.clone(),
+        },
+    )?;
+    png(
+        "difference.png",
+        &difference_image(&cand, &gold, comparison.width, comparison.height),
+    )?;
     let mut crops = Vec::new();
     for (k, r) in comparison.regions.iter().take(CROPS).enumerate() {
         let name = format!("region-{}.png", k + 1);

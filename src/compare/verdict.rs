@@ -24,6 +24,8 @@ const CELL: usize = 8;
 /// Regions never cross a block of this many cells a side (32 pixels), so a failing outline of
 /// an object gives boxes along it rather than one box around the whole object.
 const BLOCK: usize = 4;
+/// A cell of a failing 32x32 tile is boxed when its own sum leans the tile's way by this `z`.
+const CELL_Z: f64 = 2.0;
 
 /// The intervals of linear values a candidate's pixels stand for, and the width of a code at a
 /// given linear value (to tell pixels whose noise shows through the quantisation).
@@ -107,6 +109,19 @@ impl Sums {
         self.count += 1;
     }
 
+    /// The `z` of these sums in the direction of `sign`'s (the candidate brighter when
+    /// positive); negative when they lean the other way.
+    fn leaning(&self, sign: f64) -> f64 {
+        let t = if sign >= 0.0 { self.above } else { self.below };
+        if t > 0.0 {
+            z_of(t, self.variance)
+        } else if self.variance > 0.0 {
+            t / self.variance.sqrt()
+        } else {
+            t
+        }
+    }
+
     /// `(p, signed z)`.
     fn test(&self) -> (f64, f64) {
         if self.count == 0 {
@@ -159,8 +174,8 @@ pub struct Evaluation {
     pub regions: Vec<Region>,
     /// Whether the candidate is as noisy as `N` samples allow.
     pub noise: Option<NoiseCheck>,
-    /// Signed z per pixel.
-    pub z_map: Vec<f32>,
+    /// Signed z per pixel and channel.
+    pub z_map: Vec<[f32; 3]>,
     /// Mean (candidate mid-point - golden) per channel.
     pub bias: [f64; 3],
     /// Estimated samples per pixel.
@@ -315,7 +330,7 @@ struct PixelPass {
     pixel_min_p: f64,
     pixel_max_z: f64,
     pixel_failing: usize,
-    z_map: Vec<f32>,
+    z_map: Vec<[f32; 3]>,
     /// Sum of (candidate mid-point - golden) per channel.
     bias: [f64; 3],
     noise: NoiseSums,
@@ -333,7 +348,7 @@ impl PixelPass {
             pixel_min_p: 1.0,
             pixel_max_z: 0.0,
             pixel_failing: 0,
-            z_map: vec![0.0f32; g.width * g.height],
+            z_map: vec![[0.0f32; 3]; g.width * g.height],
             bias: [0.0; 3],
             noise: NoiseSums::default(),
             misfit: 0.0,
@@ -356,7 +371,6 @@ impl PixelPass {
         g: &Grids,
     ) {
         let i = y * g.width + x;
-        let mut best_z = 0.0f64;
         // A pixel's channels come from the same samples: its terms are summed first, and
         // the pixels (independent) enter the bound as one term each.
         let (mut px_sq, mut px_bound, mut px_cap) = (0.0f64, 0.0f64, 0.0f64);
@@ -368,9 +382,7 @@ impl PixelPass {
             let t = Term::of(lo, hi, mu, s2, b, claim);
             let z = t.z;
             self.misfit += (z * z).min(100.0);
-            if z.abs() > best_z.abs() {
-                best_z = z;
-            }
+            self.z_map[i][c] = z as f32;
             self.pixel_max_z = self.pixel_max_z.max(z.abs());
             if t.p < 1.0 {
                 let adjusted = sidak(t.p, claim.pixel_tests);
@@ -404,7 +416,6 @@ impl PixelPass {
                 }
             }
         }
-        self.z_map[i] = best_z as f32;
         if px_cap > 0.0 {
             let n = &mut self.noise;
             n.sq_sum += px_sq;
@@ -463,25 +474,39 @@ impl PixelPass {
         }
     }
 
-    /// Marks the cells of the failing tile `k / 3` (channel `k % 3`) of the tile scale `scale`:
-    /// only those whose pixels entered the sum (cells are 8x8 tiles).
+    /// Marks the cells of the failing tile `k / 3` (channel `k % 3`) of the tile scale `scale`
+    /// (cells are 8x8 tiles). A failing 32x32 tile marks only the cells that carry its evidence:
+    /// those whose own sum leans its way by at least [`CELL_Z`] (or, when none does, the one
+    /// that leans most), so a box never covers a corner of the tile where nothing changed.
     fn mark_tile(&mut self, k: usize, scale: usize, g: &Grids, adjusted: f64, z: f64) {
         let (size, tx) = if scale == 1 { (8, g.t8x) } else { (32, g.t32x) };
-        let tile = k / 3;
+        let (tile, c) = (k / 3, k % 3);
         let (x0, y0) = ((tile % tx) * size, (tile / tx) * size);
+        let mut leaning = Vec::new();
         for yy in (y0..(y0 + size).min(g.height)).step_by(CELL) {
             for xx in (x0..(x0 + size).min(g.width)).step_by(CELL) {
-                if self.tiles8[g.tile(8, xx, yy, k % 3)].count == 0 {
-                    continue;
+                let cell = &self.tiles8[g.tile(8, xx, yy, c)];
+                if cell.count > 0 {
+                    leaning.push((g.cell(xx, yy), cell.leaning(z)));
                 }
-                let w = Worst {
-                    p: adjusted,
-                    scale,
-                    channel: k % 3,
-                    z,
-                };
-                mark(&mut self.cells[g.cell(xx, yy)], w);
             }
+        }
+        if scale == 2 {
+            let most = leaning
+                .iter()
+                .map(|l| l.1)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let least = most.min(CELL_Z);
+            leaning.retain(|l| l.1 >= least);
+        }
+        let w = Worst {
+            p: adjusted,
+            scale,
+            channel: c,
+            z,
+        };
+        for (cell, _) in leaning {
+            mark(&mut self.cells[cell], w);
         }
     }
 
@@ -626,6 +651,7 @@ fn region(x: usize, y: usize, width: usize, height: usize, w: Worst) -> Region {
         channel: CHANNELS[w.channel].into(),
         adjusted_p: w.p,
         z: w.z,
+        change: None,
     }
 }
 
@@ -700,13 +726,15 @@ impl Evaluation {
     ) -> Comparison {
         let (width, height) = candidate.size();
         let regions_total = self.regions.len();
-        let listed = self.regions.iter().take(REGIONS_LISTED).cloned().collect();
+        let ranked = super::regions::rank(self.regions, &self.z_map, width, height);
+        let listed = ranked.iter().take(REGIONS_LISTED).cloned().collect();
         Comparison {
             verdict: if self.passed {
                 Verdict::Pass
             } else {
                 Verdict::Fail
             },
+            candidate: None,
             width,
             height,
             candidate_spp: options.samples_per_pixel,
@@ -719,7 +747,7 @@ impl Evaluation {
             scales: self.scales,
             regions: listed,
             regions_total,
-            outline: self.regions,
+            outline: ranked,
             noise: self.noise,
             bias: self.bias,
             effective_spp: self.effective_spp,

@@ -130,6 +130,7 @@ fn every_must_fail_mistake_fails_and_is_diagnosed() {
     let expected = |m: Mistake| match m {
         Mistake::NoGamma => Some("encoding:linear"),
         Mistake::Gamma22 => Some("encoding:gamma22"),
+        Mistake::GammaTwice => Some("encoding:gamma-twice"),
         Mistake::YFlipped => Some("flip-y"),
         Mistake::Bgr => Some("bgr"),
         Mistake::HalfPixelShift => Some("shift:-0.5"),
@@ -161,6 +162,14 @@ fn every_must_fail_mistake_fails_and_is_diagnosed() {
                 );
                 // The named hypothesis makes the image pass outright.
                 assert!(diagnosis.hypotheses[0].passes, "{scene}: {}", m.name());
+            } else if m == Mistake::WiderFov {
+                // A wider field of view is a zoom (fitted: named, passing or not).
+                let best = diagnosis.best.as_deref().unwrap_or_default();
+                assert!(best.starts_with("zoom:"), "{scene}: {}", diagnosis.summary);
+            } else if m == Mistake::AlbedoScaled {
+                // Albedos scaled but not the sky: a uniform scale at best, never another mistake.
+                let best = diagnosis.best.as_deref().unwrap_or("scale:");
+                assert!(best.starts_with("scale:"), "{scene}: {}", diagnosis.summary);
             } else {
                 // Mistakes outside the catalogue of hypotheses are not explained away.
                 assert!(
@@ -236,7 +245,7 @@ fn a_half_pixel_shift_is_located_on_the_edges() {
     // The back quad spans x, y in [-2, 2] at z = 0, 10 units from the eye with a 20-unit
     // viewport: pixels 160..240. Its centre is flat, right, and in no failing region.
     let centre = 200 * c.width + 200;
-    assert_eq!(c.z_map[centre], 0.0);
+    assert_eq!(c.z_map[centre], [0.0; 3]);
     assert!(
         c.regions
             .iter()

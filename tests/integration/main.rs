@@ -6,6 +6,7 @@ mod check;
 mod cli;
 mod common;
 mod compare;
+mod compare_report;
 mod course_weeks;
 mod functions;
 mod golden;
