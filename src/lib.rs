@@ -33,6 +33,7 @@ pub mod arithmetic;
 pub mod candidate;
 pub mod compare;
 pub mod escape;
+pub mod functions;
 pub mod geometry;
 pub mod golden;
 pub mod grade;

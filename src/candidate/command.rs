@@ -37,6 +37,13 @@ pub const MAX_SKIPPED_NAMED: usize = 20;
 /// The embedded adapter for the course's Python API.
 pub const PYTHON_COURSE_ADAPTER: &str = include_str!("python_course.py");
 
+/// The adapter's driver of the course's functions of weeks 5 to 10 (function requests,
+/// `docs/PROTOCOL.md`), written beside the adapter, which loads it from its own folder.
+pub const COURSE_FUNCTIONS_DRIVER: &str = include_str!("../functions/course_functions.py");
+
+/// The driver's name in the sandbox folder (the adapter's `FUNCTIONS_FILE`).
+const FUNCTIONS_NAME: &str = "rtoracle_course_functions.py";
+
 /// The program a candidate runs, and how its failures are treated.
 #[derive(Clone, Debug)]
 pub struct CandidateCommand {
@@ -179,7 +186,7 @@ impl CandidateCommand {
         for entry in entries.flatten() {
             let raw = entry.file_name();
             let name = raw.to_string_lossy().to_string();
-            if !name.ends_with(".py") || name == ADAPTER_NAME {
+            if !name.ends_with(".py") || name == ADAPTER_NAME || name == FUNCTIONS_NAME {
                 continue;
             }
             candidates.push((name, entry));
@@ -245,6 +252,9 @@ impl CandidateCommand {
         if self.course_adapter {
             sandbox
                 .add_file(ADAPTER_NAME, PYTHON_COURSE_ADAPTER.as_bytes())
+                .map_err(io)?;
+            sandbox
+                .add_file(FUNCTIONS_NAME, COURSE_FUNCTIONS_DRIVER.as_bytes())
                 .map_err(io)?;
         } else {
             let found = if self.program.components().count() > 1 {

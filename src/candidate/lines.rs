@@ -41,6 +41,7 @@ pub(crate) fn describe_line(line: ParsedLine) -> String {
         ParsedLine::BadHello(problem) => format!("a line like a hello ({problem})"),
         ParsedLine::Answer { id, .. } => format!("an answer for {}", quote_line(&id)),
         ParsedLine::Malformed { quoted, .. } => quoted,
+        ParsedLine::Result { id, .. } => format!("a function's answer for {}", quote_line(&id)),
     }
 }
 
@@ -89,6 +90,9 @@ pub(crate) fn meaning(
             answer,
             prefix: junk,
         },
+        ParsedLine::Result { id, .. } if id == case.id => {
+            Meaning::Protocol("a function's answer (\"result\") to an intersection request".into())
+        }
         ParsedLine::Malformed {
             id,
             problem,

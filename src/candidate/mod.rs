@@ -53,26 +53,28 @@ pub use outcome::Outcome;
 pub use protocol::{Answer, CandidateError, Hello};
 pub use report::{CheckReport, Counts, Failure, RunInfo, build_report};
 pub use rust::{Candidate, Reference, check_candidate};
-pub use session::Session;
+pub use session::{CallOutcome, Session};
 
 use crate::oracle::vectors::Case;
 
 /// Runs `cases` through a started session and builds the report.
 pub fn check_session(session: &mut Session, cases: &[Case]) -> Result<CheckReport, HarnessError> {
     let outcomes = session.run(cases)?;
-    Ok(build_report(
-        cases,
-        &outcomes,
-        RunInfo {
-            candidate: session.hello().name.clone(),
-            import_error: session.hello().error.clone(),
-            start_failure: session.start_failure().map(str::to_string),
-            stderr_tail: session.stderr_tail(),
-            restarts: session.restarts(),
-            sandbox: Some(session.sandbox_facts()),
-            course_api: session.command().is_course_adapter(),
-        },
-    ))
+    Ok(build_report(cases, &outcomes, run_info(session)))
+}
+
+/// What a report says of the session that ran it (its candidate, import error, restarts,
+/// stderr, sandbox).
+pub fn run_info(session: &Session) -> RunInfo {
+    RunInfo {
+        candidate: session.hello().name.clone(),
+        import_error: session.hello().error.clone(),
+        start_failure: session.start_failure().map(str::to_string),
+        stderr_tail: session.stderr_tail(),
+        restarts: session.restarts(),
+        sandbox: Some(session.sandbox_facts()),
+        course_api: session.command().is_course_adapter(),
+    }
 }
 
 /// Starts `command`, checks it against `cases` and returns the report (the process group is

@@ -252,6 +252,9 @@ struct AnswerLine {
     front_face: Option<bool>,
     #[serde(default)]
     error: Option<CandidateError>,
+    /// Present in a function request's answer (its content is read from the line's text).
+    #[serde(default)]
+    result: Option<serde::de::IgnoredAny>,
 }
 
 impl AnswerLine {
@@ -300,10 +303,32 @@ pub enum ParsedLine {
     BadHello(String),
     /// Not an answer: stray output, quoted and capped ([`quote_line`]).
     Junk(String),
+    /// A valid answer to a function request (`docs/PROTOCOL.md`, "Function requests"): the id
+    /// and the answer object's text (at most [`MAX_RESULT_BYTES`]), whose `result` the session
+    /// reads when it is wanted.
+    Result {
+        /// The id the answer carries.
+        id: String,
+        /// The answer object, as the candidate wrote it.
+        text: String,
+    },
 }
 
+/// Longest answer to a function request kept (its text): larger ones are malformed. Requests
+/// for samples ask for few enough that their answers fit.
+pub const MAX_RESULT_BYTES: usize = 128 * 1024;
+
 /// Keys of an answer object.
-const ANSWER_KEYS: [&str; 7] = ["id", "hit", "t", "point", "normal", "front_face", "error"];
+const ANSWER_KEYS: [&str; 8] = [
+    "id",
+    "hit",
+    "t",
+    "point",
+    "normal",
+    "front_face",
+    "error",
+    "result",
+];
 
 /// Reads `"id":"..."` out of text that is not valid JSON (a bare `nan` further on).
 fn lenient_id(text: &str) -> Option<String> {
@@ -373,6 +398,20 @@ pub fn parse_line(line: &str) -> ParsedLine {
 }
 
 fn answer_or_malformed(a: AnswerLine, junk: &str, line: &str) -> ParsedLine {
+    if a.result.is_some() && a.error.is_none() && a.hit.is_none() {
+        let text = line[junk.len()..].trim_start();
+        if text.len() > MAX_RESULT_BYTES {
+            return malformed(
+                Some(a.id),
+                format!("a function's answer over {MAX_RESULT_BYTES} bytes"),
+                line,
+            );
+        }
+        return ParsedLine::Result {
+            id: a.id,
+            text: text.to_string(),
+        };
+    }
     let (id, answer) = a.split();
     match answer.validate() {
         Ok(()) => ParsedLine::Answer {
@@ -400,6 +439,10 @@ pub struct Hello {
     /// The shapes it supports (all three when absent).
     #[serde(default)]
     pub shapes: Option<Vec<String>>,
+    /// The requests it answers besides `intersect` (`["intersect", "reflect", ...]`); only
+    /// `intersect` when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ops: Option<Vec<String>>,
     /// Set when the candidate cannot answer any case, e.g. a submission that cannot be imported:
     /// every case is then reported with this error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -424,6 +467,14 @@ impl Hello {
             hello.name = crate::escape::truncate(&hello.name, MAX_QUOTE_CHARS);
         }
         hello.error = hello.error.map(CandidateError::capped);
+        if let Some(ops) = &mut hello.ops {
+            ops.truncate(64);
+            for s in ops.iter_mut() {
+                if s.len() > 40 {
+                    *s = crate::escape::truncate(s, 40);
+                }
+            }
+        }
         if let Some(shapes) = &mut hello.shapes {
             shapes.truncate(16);
             for s in shapes.iter_mut() {
@@ -461,6 +512,16 @@ impl Hello {
             }
         }
         Ok(())
+    }
+
+    /// Whether the candidate answers requests of kind `op`; every candidate answers
+    /// `"intersect"`.
+    pub fn answers(&self, op: &str) -> bool {
+        op == "intersect"
+            || self
+                .ops
+                .as_ref()
+                .is_some_and(|ops| ops.iter().any(|o| o == op))
     }
 
     /// Whether the candidate supports `kind`.

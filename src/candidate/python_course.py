@@ -15,8 +15,13 @@ none, answers holding numpy floats or arrays (read with float() and bool()). A m
 submission imports that is neither its own nor in `--requires` (default numpy and PIL) is
 reported as the student's ("your code imports scipy, which the grader does not provide"); a
 missing required module is said to be the grader's.
+
+The requests for the course's functions of weeks 5 to 10 (reflect, refract, the samplers, ...;
+docs/PROTOCOL.md, "Function requests") are answered by rtoracle's driver, a second file written
+beside this one (FUNCTIONS_FILE); the hello lists them in "ops" when it is there.
 """
 
+import importlib.util
 import inspect
 import json
 import os
@@ -56,6 +61,20 @@ def truth(x):
 
 REQUIRES = ["numpy", "PIL"]
 SUBMISSION = "."
+# rtoracle's driver of the course's functions, written beside this file.
+FUNCTIONS_FILE = "rtoracle_course_functions.py"
+
+
+def load_functions():
+    """The functions driver (a module with OPS and answer(request)), or None without it."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), FUNCTIONS_FILE)
+    if not os.path.isfile(path):
+        return None
+    spec = importlib.util.spec_from_file_location("rtoracle_course_functions", path)
+    driver = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(driver)
+    driver.set_submission(SUBMISSION)
+    return driver
 
 
 def missing_module_message(exc):
@@ -248,6 +267,9 @@ def main():
     if next(requests, None) is None:
         return
     hello = {"name": name, "protocol": 1, "shapes": ["sphere", "quad"]}
+    functions = load_functions()
+    if functions is not None:
+        hello["ops"] = ["intersect"] + list(functions.OPS)
     try:
         import RT_utility
         import RT_ray
@@ -298,6 +320,17 @@ def main():
                 rid = '"' + rid + '"'
             else:
                 rid = dumps(rid)
+            op = req.get("op", "intersect")
+            if op != "intersect":
+                chan.busy_since = monotonic()
+                if functions is None or op not in functions.OPS:
+                    raise ValueError("unknown request op %r" % (op,))
+                ans = '{"id":' + rid + ',"result":' + dumps(functions.answer(req), separators=(",", ":")) + "}\n"
+                chan.busy_since = 0.0
+                out.write(ans)
+                if len(pending) > 256 or b'"sync":true' in line[:16]:
+                    chan.send()
+                continue
             s = req["shape"]
             kind = s["type"]
             r = req["ray"]

@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitStatus;
 use std::sync::mpsc::RecvTimeoutError;
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use super::command::CandidateCommand;
 use super::error::HarnessError;
@@ -112,6 +112,7 @@ impl Session {
                 name: String::new(),
                 protocol: None,
                 shapes: None,
+                ops: None,
                 error: None,
             },
             stderr: Arc::new(Mutex::new(Tail::default())),
@@ -446,6 +447,115 @@ impl Session {
         self.budget_used.as_deref()
     }
 
+    /// Sends one request (a JSON object with its `op`; `id` is set here, and `"sync": true`
+    /// so a batching candidate answers at once) and waits up to `timeout` for the answer with
+    /// that id. Other lines meanwhile are stray output and ignored. A candidate that does not
+    /// answer in time, or dies, is killed, and the next call starts it again (a restart); once
+    /// the time budget is used up every call fails with its reason.
+    pub fn call(
+        &mut self,
+        id: &str,
+        request: &serde_json::Value,
+        timeout: Duration,
+    ) -> CallOutcome {
+        self.check_budget();
+        if let Some(reason) = &self.budget_used {
+            return CallOutcome::Failed(reason.clone());
+        }
+        if let Some(message) = &self.broken {
+            return CallOutcome::Failed(message.clone());
+        }
+        if self.proc.is_none() {
+            self.restarts += 1;
+            match self.launch() {
+                Ok(Ok(_)) => {}
+                Ok(Err(message)) => {
+                    let message = format!("could not restart the candidate: {message}");
+                    self.broken = Some(message.clone());
+                    return CallOutcome::Failed(message);
+                }
+                Err(e) => return CallOutcome::Failed(e.to_string()),
+            }
+        }
+        let mut object = match request {
+            serde_json::Value::Object(map) => map.clone(),
+            _ => serde_json::Map::new(),
+        };
+        object.insert("id".into(), serde_json::Value::String(id.to_string()));
+        object.remove("sync");
+        let body = serde_json::Value::Object(object).to_string();
+        let line = format!("{{\"sync\":true,{}\n", &body[1..]);
+        let by_call = Instant::now() + timeout;
+        let (deadline, by_budget) = match self.budget_deadline() {
+            Some(b) if b < by_call => (b, true),
+            _ => (by_call, false),
+        };
+        let proc = self.proc.as_ref().expect("a running candidate");
+        proc.send(line.into_bytes());
+        loop {
+            let proc = self.proc.as_mut().expect("a running candidate");
+            let left = deadline.saturating_duration_since(Instant::now());
+            let next = if left.is_zero() {
+                Err(RecvTimeoutError::Timeout)
+            } else {
+                proc.lines.recv_timeout(left)
+            };
+            match next {
+                Ok(Line::Parsed(ParsedLine::Result { id: got, text })) if got == id => {
+                    return match serde_json::from_str::<serde_json::Value>(&text) {
+                        Ok(mut v) => CallOutcome::Result(v["result"].take()),
+                        Err(e) => CallOutcome::Failed(format!("a malformed answer: {e}")),
+                    };
+                }
+                Ok(Line::Parsed(ParsedLine::Answer {
+                    id: got, answer, ..
+                })) if got == id => {
+                    let answer = self.keep(answer);
+                    return match answer.error {
+                        Some(error) => CallOutcome::Error(error),
+                        None => CallOutcome::Failed(
+                            "it answered with an intersection's answer, not a \"result\"".into(),
+                        ),
+                    };
+                }
+                Ok(Line::Parsed(ParsedLine::Malformed {
+                    id: got,
+                    problem,
+                    quoted,
+                })) if got.as_deref().is_none_or(|g| g == id) => {
+                    return CallOutcome::Failed(format!(
+                        "a malformed answer ({problem}): the line was {quoted}"
+                    ));
+                }
+                Ok(Line::Oversize(head)) => {
+                    return CallOutcome::Failed(oversize_message(&head, MAX_LINE_BYTES));
+                }
+                Ok(Line::Parsed(_)) => {}
+                Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
+                    let mut proc = self.proc.take().expect("a running candidate");
+                    let status = proc.exit_status();
+                    let _ = proc.kill();
+                    return CallOutcome::Failed(format!(
+                        "the candidate died on this request: {}",
+                        self.describe_end(status)
+                    ));
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    if let Some(proc) = self.proc.take() {
+                        let _ = proc.kill();
+                    }
+                    if by_budget {
+                        self.check_budget();
+                        if let Some(reason) = &self.budget_used {
+                            return CallOutcome::Failed(reason.clone());
+                        }
+                    }
+                    return CallOutcome::TimedOut;
+                }
+            }
+        }
+    }
+
     /// An answer as the session keeps it: the error's tracebacks renamed to the submission's
     /// files, its fields capped further once the session's [`RUN_DETAIL_BYTES`] are used up.
     fn keep(&mut self, mut answer: Answer) -> Answer {
@@ -627,6 +737,20 @@ impl Session {
                 .or_insert_with(|| format!("not run after {max} {noun} in the {kind} group"));
         }
     }
+}
+
+/// What one request sent with [`Session::call`] got.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CallOutcome {
+    /// The answer's `result` object.
+    Result(serde_json::Value),
+    /// The candidate raised an error instead (file names are the submission's).
+    Error(CandidateError),
+    /// No answer within the time given: the candidate was killed (the next call restarts it).
+    TimedOut,
+    /// No answer: the candidate died, could not start, broke the protocol, or the session's
+    /// time budget is used up; why.
+    Failed(String),
 }
 
 enum CountKind {

@@ -1,4 +1,6 @@
-//! `rtoracle check`: runs a candidate against the intersection vectors.
+//! `rtoracle check`: runs a candidate against the intersection vectors, and from week 5 on
+//! against the week's function checks (`--week N`, or the week found from a course folder's
+//! files).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -6,6 +8,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::candidate::{CandidateCommand, RunOptions, SandboxPolicy, check_command, python};
+use rtoracle::functions::{FunctionOptions, Week, check_week, detect};
 use rtoracle::oracle::vectors::{Case, read_vectors};
 use rtoracle::oracle::{
     Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
@@ -233,6 +236,14 @@ pub struct Args {
     /// can still pass (the course's week 4 has no triangles).
     #[arg(long, value_name = "SHAPE", value_delimiter = ',', value_parser = shape_kind)]
     require: Vec<rtoracle::oracle::vectors::ShapeKind>,
+    /// The course week to check (4 to 10): from week 5 on, the week's functions (and the
+    /// earlier weeks') are checked too. Without it, a course folder's week is found from the
+    /// functions and classes its files define; an adapter is checked as week 4.
+    #[arg(long, value_name = "N", value_parser = super::num::week)]
+    week: Option<u8>,
+    /// False-alarm rate of each statistical test of the week's samplers.
+    #[arg(long, value_name = "P", default_value_t = rtoracle::functions::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
+    alpha: f64,
 }
 
 /// A shape kind named on the command line.
@@ -305,15 +316,41 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         ..RunOptions::default()
     };
     rtoracle::sandbox::announce_on_stderr();
-    let command = if args.target.python_course.is_none() && args.target.adapter.is_none() {
+    let (command, folder) = if args.target.python_course.is_none() && args.target.adapter.is_none()
+    {
         let here = Target {
             python_course: Some(current_submission()?),
             adapter: None,
         };
-        here.command(&args.sandbox)?
+        (here.command(&args.sandbox)?, here.python_course)
     } else {
-        args.target.command(&args.sandbox)?
+        (
+            args.target.command(&args.sandbox)?,
+            args.target.python_course.clone(),
+        )
     };
+    if let Some((week, week_from)) = week_of(args.week, folder.as_deref()) {
+        errln!("checking as {week} ({week_from})");
+        let functions = FunctionOptions {
+            seed: args.seed,
+            alpha: args.alpha,
+        };
+        let mut report =
+            check_week(command, &cases, options, week, week_from, functions).context("check")?;
+        report.intersections.judged_by = Some(judged_by);
+        report.intersections.required = args.require.clone();
+        let text = if args.json {
+            report.to_json()
+        } else {
+            report.to_text(args.show)
+        };
+        outln!("{}", text.trim_end())?;
+        return Ok(ExitCode::from(if report.passed() {
+            0
+        } else {
+            super::FAILED
+        }));
+    }
     let mut report = check_command(command, &cases, options).context("check")?;
     report.judged_by = Some(judged_by);
     report.required = args.require.clone();
@@ -328,4 +365,23 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     } else {
         super::FAILED
     }))
+}
+
+/// The week to check as, and how it was found: `--week N` (4 is intersections only), else the
+/// week a course folder's files show (`None`: week 4).
+fn week_of(given: Option<u8>, folder: Option<&std::path::Path>) -> Option<(Week, String)> {
+    match given {
+        Some(n) => Week::new(n).map(|w| (w, format!("--week {n}"))),
+        None => {
+            let found = detect(folder?);
+            let week = found.week?;
+            let shown: Vec<String> = found
+                .because
+                .iter()
+                .take(3)
+                .map(|b| rtoracle::escape::terminal_line(b))
+                .collect();
+            Some((week, format!("found from the files: {}", shown.join(", "))))
+        }
+    }
 }

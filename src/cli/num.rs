@@ -77,6 +77,19 @@ pub fn millis(s: &str) -> Result<u64, String> {
     int_in::<1, 3_600_000>(s)
 }
 
+/// A course week: 4 (intersections only) to 10.
+pub fn week(s: &str) -> Result<u8, String> {
+    int_in::<4, 10>(s).map(|n| n as u8)
+}
+
+/// A false-alarm rate: a probability from 1e-12 to 0.5.
+pub fn alpha(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && (1e-12..=0.5).contains(&x) => Ok(x),
+        _ => Err("must be a probability from 1e-12 to 0.5".to_string()),
+    }
+}
+
 /// A number of seconds: finite, from 0.001 to one week.
 pub fn seconds(s: &str) -> Result<f64, String> {
     const WEEK: f64 = 7.0 * 24.0 * 3600.0;

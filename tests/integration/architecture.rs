@@ -42,6 +42,8 @@ const FLOORS: &[&[&str]] = &[
     &["render", "oracle", "sandbox"],
     &["image_io"],
     &["candidate"],
+    // The function checks of the course's weeks 5 to 10 (run through a candidate's session).
+    &["functions"],
     &["golden"],
     &["compare"],
     &["grade"],

@@ -8,6 +8,7 @@ mod common;
 mod compare;
 mod course_weeks;
 mod feedback;
+mod functions;
 mod golden;
 mod grade;
 mod oracle;

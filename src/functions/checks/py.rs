@@ -1,0 +1,76 @@
+//! Python reproductions of the requests, written with the course's modules and short names, so
+//! a student can paste one into a Python started in the submission folder.
+
+use glam::DVec3;
+
+/// The import lines every reproduction starts with.
+pub(crate) const IMPORTS: &str =
+    "import math\nimport RT_utility as rtu, RT_ray as rtr, RT_object as rto, RT_material as rtm";
+
+/// A number as Python reads it (shortest round trip; `math.inf`, `math.nan`).
+pub(crate) fn f(x: f64) -> String {
+    if x.is_nan() {
+        "math.nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "math.inf" } else { "-math.inf" }.into()
+    } else {
+        format!("{x:?}")
+    }
+}
+
+/// `rtu.Vec3(x, y, z)`.
+pub(crate) fn vec(v: DVec3) -> String {
+    format!("rtu.Vec3({}, {}, {})", f(v.x), f(v.y), f(v.z))
+}
+
+/// `rtu.Color(r, g, b)`.
+pub(crate) fn color(v: DVec3) -> String {
+    format!("rtu.Color({}, {}, {})", f(v.x), f(v.y), f(v.z))
+}
+
+/// `rtr.Ray(origin, direction)` (with the time when it is not 0).
+pub(crate) fn ray(origin: DVec3, direction: DVec3, time: f64) -> String {
+    if time == 0.0 {
+        format!("rtr.Ray({}, {})", vec(origin), vec(direction))
+    } else {
+        format!("rtr.Ray({}, {}, {})", vec(origin), vec(direction), f(time))
+    }
+}
+
+/// The lines that make `rtu.random_double` return `values` in turn (scaled to its range).
+pub(crate) fn random_doubles(values: &[f64]) -> String {
+    let list: Vec<String> = values.iter().map(|&u| f(u)).collect();
+    format!(
+        "_u = iter([{}])\nrtu.random_double = lambda min=0.0, max=1.0: min + next(_u) * (max - min)",
+        list.join(", ")
+    )
+}
+
+/// The lines that make `rtu.NAME()` return the vectors `values` in turn.
+pub(crate) fn random_vectors(name: &str, values: &[DVec3]) -> String {
+    let list: Vec<String> = values.iter().map(|&v| vec(v)).collect();
+    format!(
+        "_v = iter([{}])\nrtu.{name} = lambda: next(_v)",
+        list.join(", ")
+    )
+}
+
+/// A hit record as the course's intersect makes one, in a variable `hit`.
+pub(crate) fn hit(point: DVec3, outward: DVec3, ray_var: &str, material: &str) -> String {
+    format!(
+        "hit = rtu.Hitinfo({}, {}, 1.0, {material})\nhit.set_face_normal({ray_var}, {})",
+        vec(point),
+        vec(outward),
+        vec(outward)
+    )
+}
+
+/// A whole reproduction: the imports, `body`, and what the course's code answers.
+pub(crate) fn script(body: &str, course_answer: &str) -> String {
+    format!("{IMPORTS}\n{body}\n# the course's code gives {course_answer}")
+}
+
+/// `[x, y, z]` as the course's answer is shown.
+pub(crate) fn list(v: DVec3) -> String {
+    format!("[{}, {}, {}]", f(v.x), f(v.y), f(v.z))
+}

@@ -1,0 +1,732 @@
+"""rtoracle's driver of the course's functions of weeks 5 to 10 (stdlib only; the submission's
+own modules bring numpy and Pillow).
+
+The course adapter (course_adapter.py) loads this file from its own folder and hands it every
+request whose "op" is one of OPS (docs/PROTOCOL.md, "Function requests"). `answer(request)`
+calls the submission's own function, unmodified, and returns the answer's "result" object; an
+exception (the submission's, or NotFound / BadReturn / RandomExhausted raised here) becomes the
+answer's "error".
+
+Finding functions. The course puts reflect, refract, schlick, halfvector, the samplers and ONB
+in RT_utility, the materials in RT_material, the textures in RT_texture, Scene in RT_scene,
+Integrator in RT_integrator, Camera in RT_camera; a student may put them elsewhere. Each is
+looked for in every RT_*.py module of the submission (RT_utility first; RT_renderer and RT_pbar
+are never imported: they need progressbar2), and a function also as a static method of Vec3.
+What cannot be found is an error of type NotFound that names where it looked.
+
+Random numbers. A request's "replace" object gives the values that the course's random
+functions return for the call: "random_double" (numbers u in [0, 1]; a call
+random_double(lo, hi) returns lo + u (hi - lo)), "random_vec3_unit",
+"random_cosine_hemisphere_on_z", "random_in_unit_disk" (vectors), "rng" (numbers the camera's
+own generator returns from .random()). Each is replaced, for the call, in every module that
+holds it (`rtu.random_double` and a `from RT_utility import random_double` alike); a call past
+the values given raises RandomExhausted, and the answer says how many of each were drawn
+("draws"). Sampling requests ("n", "seed") seed numpy's global generator, Python's random and
+every np.random.default_rng() made during the call with the seed instead.
+"""
+
+import glob
+import inspect
+import math
+import os
+import sys
+
+# Modules that are never imported: the renderer needs progressbar2, main.py renders.
+SKIPPED = ("RT_renderer", "RT_pbar")
+# The course's own placement of things, searched first, in this order.
+PREFERRED = ("RT_utility", "RT_material", "RT_texture", "RT_object", "RT_scene",
+             "RT_integrator", "RT_camera", "RT_ray")
+
+OPS = ("reflect", "refract", "schlick", "halfvector", "sphere_uv", "quad_uv", "texture",
+       "brdf", "scatter", "onb", "move_sphere", "intersect_at_time", "camera", "occlusion",
+       "shade", "sample_unit_vector", "sample_cosine_hemisphere", "sample_unit_disk",
+       "sample_scatter", "sample_camera_ray")
+
+# Most samples one request may ask for (an answer line stays under 1 MiB).
+MAX_SAMPLES = 2000
+
+
+class NotFound(Exception):
+    """What the request needs is not in the submission."""
+
+
+class BadReturn(Exception):
+    """A function returned something the course's never returns (None from a stub, say)."""
+
+
+class RandomExhausted(Exception):
+    """The code drew more random numbers than the request gave."""
+
+
+_state = {"dir": ".", "modules": None}
+
+
+def set_submission(folder):
+    _state["dir"] = folder
+    _state["modules"] = None
+
+
+def modules():
+    """The submission's RT_*.py modules, imported: the course's order first, then the others."""
+    if _state["modules"] is None:
+        names = sorted(
+            os.path.basename(p)[:-3]
+            for p in glob.glob(os.path.join(_state["dir"], "RT_*.py"))
+        )
+        names = [n for n in names if n.isidentifier() and n not in SKIPPED]
+        ordered = [n for n in PREFERRED if n in names] + [n for n in names if n not in PREFERRED]
+        found = []
+        for name in ordered:
+            found.append((name, __import__(name)))
+        _state["modules"] = found
+    return _state["modules"]
+
+
+def module(name):
+    for n, m in modules():
+        if n == name:
+            return m
+    return None
+
+
+def where_looked():
+    return ", ".join(n + ".py" for n, _ in modules()) or "no RT_*.py module"
+
+
+def find_function(name, aliases=(), course_home="RT_utility"):
+    """A module-level function of the submission (or a static method of Vec3)."""
+    names = (name,) + tuple(aliases)
+    for _, m in modules():
+        for n in names:
+            f = getattr(m, n, None)
+            if callable(f) and not inspect.isclass(f):
+                return f
+    vec3 = getattr(module("RT_utility"), "Vec3", None)
+    for n in names:
+        f = getattr(vec3, n, None) if vec3 is not None else None
+        if callable(f):
+            return f
+    raise NotFound(
+        "no function %s in the submission (looked in %s, and for Vec3.%s); the course defines "
+        "it in %s.py" % (name, where_looked(), name, course_home)
+    )
+
+
+def find_class(names, course_home):
+    if isinstance(names, str):
+        names = (names,)
+    for _, m in modules():
+        for n in names:
+            c = getattr(m, n, None)
+            if inspect.isclass(c):
+                return c
+    raise NotFound(
+        "no class %s in the submission (looked in %s); the course defines it in %s.py"
+        % (names[0], where_looked(), course_home)
+    )
+
+
+def method(obj, name, cls_name):
+    f = getattr(obj, name, None)
+    if not callable(f):
+        raise NotFound("%s has no method %s" % (cls_name, name))
+    return f
+
+
+def positional_count(f):
+    """How many positional parameters f takes (self excluded), or None when it cannot be read."""
+    try:
+        params = list(inspect.signature(f).parameters.values())
+    except (TypeError, ValueError):
+        return None
+    if any(p.kind == p.VAR_POSITIONAL for p in params):
+        return None
+    return len([p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)])
+
+
+# ---------------------------------------------------------------------------------------------
+# Values in and out.
+
+def vec3(a):
+    Vec3 = find_class("Vec3", "RT_utility")
+    return Vec3(float(a[0]), float(a[1]), float(a[2]))
+
+
+def color(a):
+    Color = find_class("Color", "RT_utility")
+    return Color(float(a[0]), float(a[1]), float(a[2]))
+
+
+def number(x):
+    """A float for JSON: non-finite numbers as the protocol's strings."""
+    x = float(x)
+    if x != x:
+        return "nan"
+    if x == math.inf:
+        return "inf"
+    if x == -math.inf:
+        return "-inf"
+    return x
+
+
+def num_in(x):
+    if isinstance(x, str):
+        return float(x)
+    return float(x)
+
+
+def out_vec(v, what):
+    """A Vec3 or Color (components in .e), a sequence or a numpy array, as three numbers."""
+    if v is None:
+        raise BadReturn("%s returned None" % what)
+    e = getattr(v, "e", v)
+    try:
+        if len(e) != 3:
+            raise BadReturn("%s returned %d components, not 3" % (what, len(e)))
+        return [number(e[0]), number(e[1]), number(e[2])]
+    except (TypeError, ValueError):
+        raise BadReturn("%s returned %s, not a vector" % (what, type(v).__name__))
+
+
+def out_num(x, what):
+    if x is None:
+        raise BadReturn("%s returned None" % what)
+    try:
+        return number(x)
+    except (TypeError, ValueError):
+        raise BadReturn("%s returned %s, not a number" % (what, type(x).__name__))
+
+
+def out_bool(x, what):
+    if x is None:
+        raise BadReturn("%s returned None" % what)
+    return bool(x)
+
+
+def make_ray(spec):
+    Ray = find_class("Ray", "RT_ray")
+    o, d = vec3(spec["origin"]), vec3(spec["direction"])
+    time = spec.get("time")
+    if time is None:
+        return Ray(o, d)
+    count = positional_count(Ray.__init__)
+    if count is not None and count < 4:
+        if float(time) == 0.0:
+            return Ray(o, d)
+        raise NotFound("Ray takes no time (the course adds Ray(vOrigin, vDir, fTime) in week 10)")
+    return Ray(o, d, float(time))
+
+
+def make_interval(a):
+    Interval = find_class("Interval", "RT_utility")
+    return Interval(num_in(a[0]), num_in(a[1]))
+
+
+def make_hit(spec, ray, material):
+    """A hit record as the course's intersect makes one: Hitinfo(P, outward normal, t, material),
+    then set_face_normal(ray, outward) and set_uv(u, v)."""
+    Hitinfo = find_class(("Hitinfo", "HitInfo", "HitRecord"), "RT_utility")
+    outward = vec3(spec["normal"])
+    hit = Hitinfo(vec3(spec["point"]), outward, float(spec.get("t", 1.0)), material)
+    setter = getattr(hit, "set_face_normal", None)
+    if callable(setter):
+        setter(ray, outward)
+    uv = spec.get("uv")
+    if uv is not None:
+        set_uv = getattr(hit, "set_uv", None)
+        if callable(set_uv):
+            set_uv(float(uv[0]), float(uv[1]))
+        else:
+            hit.u, hit.v = float(uv[0]), float(uv[1])
+    return hit
+
+
+def hit_uv(hit):
+    get = getattr(hit, "getUV", None)
+    if callable(get):
+        uv = get()
+    else:
+        uv = (getattr(hit, "u", None), getattr(hit, "v", None))
+    return [out_num(uv[0], "the hit's u"), out_num(uv[1], "the hit's v")]
+
+
+def picture_file(spec):
+    """Writes the request's picture as a PNG in the working folder; its name."""
+    import numpy as np
+    from PIL import Image
+    w, h = int(spec["width"]), int(spec["height"])
+    data = bytes(int(b) for b in spec["rgb"])
+    name = "rtoracle_texture_%dx%d_%08x.png" % (w, h, hash(data) & 0xFFFFFFFF)
+    if not os.path.exists(name):
+        px = np.frombuffer(data, dtype=np.uint8).reshape(h, w, 3)
+        Image.fromarray(px).save(name)
+    return name
+
+
+def make_texture(spec):
+    kind = spec["type"]
+    if kind == "solid":
+        return find_class(("SolidColor", "Solid_color", "SolidTexture"), "RT_texture")(
+            color(spec["color"]))
+    if kind == "checker":
+        return find_class(("CheckerTexture", "Checker_texture", "Checker"), "RT_texture")(
+            float(spec["scale"]), color(spec["even"]), color(spec["odd"]))
+    if kind == "image":
+        return find_class(("ImageTexture", "Image_texture"), "RT_texture")(picture_file(spec))
+    raise ValueError("unknown texture type %r" % kind)
+
+
+def make_material(spec):
+    if spec is None:
+        return None
+    kind = spec["type"]
+    home = "RT_material"
+    if kind == "lambertian":
+        return find_class("Lambertian", home)(color(spec["albedo"]))
+    if kind == "textured":
+        return find_class(("TextureColor", "Texture_color", "Textured"), home)(
+            make_texture(spec["texture"]))
+    if kind == "mirror":
+        return find_class("Mirror", home)(color(spec["albedo"]))
+    if kind == "dielectric":
+        return find_class("Dielectric", home)(color(spec["albedo"]), float(spec["ior"]))
+    if kind == "metal":
+        return find_class("Metal", home)(color(spec["albedo"]), float(spec["roughness"]))
+    if kind == "diffuse_light":
+        return find_class(("Diffuse_light", "DiffuseLight", "Diffuse_Light"), home)(
+            color(spec["color"]))
+    if kind in ("phong", "blinn"):
+        cls = find_class("Phong" if kind == "phong" else "Blinn", home)
+        return cls(color(spec["albedo"]), float(spec["kd"]), float(spec["ks"]),
+                   float(spec["alpha"]))
+    if kind == "cook_torrance":
+        cls = find_class(("CookTorrance", "Cook_Torrance", "Cooktorrance"), home)
+        args = [float(spec["kd"]), float(spec["ks"]), float(spec["alpha"]), float(spec["ior"])]
+        # Week 8's constructor takes the albedo first; weeks 9 and 10's do not.
+        if positional_count(cls.__init__) == 6:
+            args.insert(0, color(spec.get("albedo", [1.0, 1.0, 1.0])))
+        return cls(*args)
+    raise ValueError("unknown material type %r" % kind)
+
+
+def make_object(spec):
+    material = make_material(spec.get("material"))
+    kind = spec["type"]
+    if kind == "sphere":
+        s = find_class("Sphere", "RT_object")(vec3(spec["center"]), float(spec["radius"]),
+                                              material)
+        if spec.get("moving_to") is not None:
+            method(s, "add_moving", "Sphere")(vec3(spec["moving_to"]))
+        return s
+    if kind == "quad":
+        return find_class("Quad", "RT_object")(vec3(spec["q"]), vec3(spec["u"]),
+                                               vec3(spec["v"]), material)
+    raise ValueError("unknown object type %r" % kind)
+
+
+def make_scene(objects):
+    scene = find_class("Scene", "RT_scene")()
+    add = method(scene, "add_object", "Scene")
+    for o in objects:
+        add(make_object(o))
+    find_lights = getattr(scene, "find_lights", None)
+    if callable(find_lights):
+        find_lights()
+    return scene
+
+
+# ---------------------------------------------------------------------------------------------
+# Replacing the random functions for one call.
+
+class _Values:
+    def __init__(self, name, values, wrap):
+        self.name = name
+        self.values = list(values)
+        self.wrap = wrap
+        self.drawn = 0
+
+    def next(self):
+        if self.drawn >= len(self.values):
+            raise RandomExhausted(
+                "%s was called more than the %d times the request allows"
+                % (self.name, len(self.values)))
+        v = self.values[self.drawn]
+        self.drawn += 1
+        return v
+
+
+class _FixedGenerator:
+    """Stands for the camera's numpy Generator: .random() and .uniform() return given values."""
+
+    def __init__(self, values):
+        self.values = values
+
+    def random(self, *args, **kwargs):
+        return self.values.next()
+
+    def uniform(self, low=0.0, high=1.0, *args, **kwargs):
+        return low + self.values.next() * (high - low)
+
+
+class Replaced:
+    """Replaces the course's random functions named in `spec` for a `with` block."""
+
+    VECTORS = ("random_vec3_unit", "random_cosine_hemisphere_on_z", "random_in_unit_disk")
+
+    def __init__(self, spec):
+        self.spec = spec or {}
+        self.undo = []
+        self.counters = {}
+
+    def __enter__(self):
+        for name, values in self.spec.items():
+            if name == "rng":
+                self.counters[name] = _Values(name, [float(v) for v in values], None)
+                continue
+            if name == "random_double":
+                counter = _Values(name, [float(v) for v in values], None)
+
+                def replacement(min=0.0, max=1.0, _c=counter):
+                    return min + _c.next() * (max - min)
+            elif name in self.VECTORS:
+                counter = _Values(name, [vec3(v) for v in values], None)
+
+                def replacement(*args, _c=counter):
+                    return _c.next()
+            else:
+                raise ValueError("cannot replace %r" % name)
+            self.counters[name] = counter
+            original = getattr(module("RT_utility"), name, None)
+            self._swap(name, original, replacement)
+        return self
+
+    def _swap(self, name, original, replacement):
+        swapped = False
+        for _, m in modules():
+            value = getattr(m, name, None)
+            if value is not None and (value is original or m is module("RT_utility")):
+                self.undo.append((m, name, value))
+                setattr(m, name, replacement)
+                swapped = True
+        if not swapped:
+            util = module("RT_utility")
+            if util is not None:
+                self.undo.append((util, name, None))
+                setattr(util, name, replacement)
+
+    def generator(self):
+        c = self.counters.get("rng")
+        return _FixedGenerator(c) if c is not None else None
+
+    def draws(self):
+        return {name: c.drawn for name, c in self.counters.items()}
+
+    def __exit__(self, *exc):
+        for m, name, value in reversed(self.undo):
+            if value is None:
+                try:
+                    delattr(m, name)
+                except AttributeError:
+                    pass
+            else:
+                setattr(m, name, value)
+        return False
+
+
+class Seeded:
+    """Seeds numpy's global generator, Python's random and new default_rng()s for a block."""
+
+    def __init__(self, seed):
+        self.seed = int(seed) & 0xFFFFFFFF
+
+    def __enter__(self):
+        import random
+        import numpy as np
+        np.random.seed(self.seed)
+        random.seed(self.seed)
+        self.np = np
+        self.original = np.random.default_rng
+        made = [0]
+        original, seed = self.original, self.seed
+
+        def default_rng(*args, **kwargs):
+            made[0] += 1
+            return original((seed + 7919 * made[0]) & 0xFFFFFFFF)
+
+        np.random.default_rng = default_rng
+        return self
+
+    def __exit__(self, *exc):
+        self.np.random.default_rng = self.original
+        return False
+
+
+# ---------------------------------------------------------------------------------------------
+# The requests.
+
+def op_reflect(req):
+    f = find_function("reflect")
+    return {"vector": out_vec(f(vec3(req["v"]), vec3(req["n"])), "reflect")}
+
+
+def op_refract(req):
+    f = find_function("refract")
+    with Replaced({"random_double": req.get("random", [])}) as r:
+        out = f(vec3(req["v"]), vec3(req["n"]), float(req["ratio"]))
+    return {"vector": out_vec(out, "refract"), "draws": r.draws()}
+
+
+def op_schlick(req):
+    f = find_function("schlick", ("reflectance",))
+    return {"value": out_num(f(float(req["cosine"]), float(req["ratio"])), "schlick")}
+
+
+def op_halfvector(req):
+    f = find_function("halfvector", ("half_vector",), "RT_utility")
+    return {"vector": out_vec(f(vec3(req["v"]), vec3(req["l"])), "halfvector")}
+
+
+def op_sphere_uv(req):
+    Sphere = find_class("Sphere", "RT_object")
+    s = Sphere(vec3([0, 0, 0]), 1.0, None)
+    get_uv = getattr(s, "get_uv", None)
+    if not callable(get_uv):
+        get_uv = find_function("get_uv", ("get_sphere_uv",), "RT_object")
+    uv = get_uv(vec3(req["normal"]))
+    if uv is None:
+        raise BadReturn("Sphere.get_uv returned None")
+    return {"uv": [out_num(uv[0], "get_uv's u"), out_num(uv[1], "get_uv's v")]}
+
+
+def intersect_answer(hit):
+    if hit is None or hit is False:
+        return {"hit": False}
+    return {"hit": True, "t": out_num(hit.getT(), "getT()"),
+            "point": out_vec(hit.getP(), "getP()"),
+            "normal": out_vec(hit.getNormal(), "getNormal()"),
+            "front_face": bool(hit.front_face), "uv": hit_uv(hit)}
+
+
+def op_quad_uv(req):
+    q = make_object(dict(req["quad"], type="quad"))
+    return intersect_answer(q.intersect(make_ray(req["ray"]), make_interval(req["interval"])))
+
+
+def op_intersect_at_time(req):
+    s = make_object(dict(req["sphere"], type="sphere"))
+    return intersect_answer(s.intersect(make_ray(req["ray"]), make_interval(req["interval"])))
+
+
+def op_move_sphere(req):
+    s = make_object({"type": "sphere", "center": req["center"], "radius": 1.0,
+                     "moving_to": req["moving_to"]})
+    moved = method(s, "move_sphere", "Sphere")(float(req["time"]))
+    return {"center": out_vec(moved, "move_sphere")}
+
+
+def op_texture(req):
+    t = make_texture(req["texture"])
+    uv = req["uv"]
+    value = method(t, "tex_value", type(t).__name__)(float(uv[0]), float(uv[1]),
+                                                      vec3(req["point"]))
+    return {"color": out_vec(value, type(t).__name__ + ".tex_value")}
+
+
+def op_brdf(req):
+    m = make_material(req["material"])
+    view = make_ray(req["view"])
+    light = make_ray(req["light"])
+    hit = make_hit(req["hit"], view, m)
+    value = method(m, "BRDF", type(m).__name__)(view, light, hit)
+    what = type(m).__name__ + ".BRDF"
+    if value is None:
+        raise BadReturn("%s returned None" % what)
+    if isinstance(value, (int, float)) or type(value).__name__.startswith("float"):
+        return {"value": out_num(value, what)}
+    return {"color": out_vec(value, what)}
+
+
+def scatter_once(m, ray, hit, what):
+    s = method(m, "scattering", type(m).__name__)(ray, hit)
+    if s is None:
+        return None
+    r = getattr(s, "scattered_ray", None)
+    a = getattr(s, "attenuation_color", None)
+    if r is None or a is None:
+        raise BadReturn("%s returned a %s without scattered_ray and attenuation_color"
+                        % (what, type(s).__name__))
+    get_time = getattr(r, "getTime", None)
+    time = get_time() if callable(get_time) else getattr(r, "time", 0.0)
+    return (out_vec(r.getOrigin(), what + "'s ray origin"),
+            out_vec(r.getDirection(), what + "'s ray direction"),
+            out_num(time if time is not None else 0.0, what + "'s ray time"),
+            out_vec(a, what + "'s attenuation"))
+
+
+def op_scatter(req):
+    m = make_material(req["material"])
+    ray = make_ray(req["ray"])
+    hit = make_hit(req["hit"], ray, m)
+    what = type(m).__name__ + ".scattering"
+    with Seeded(req.get("seed", 0)), Replaced(req.get("replace")) as r:
+        out = scatter_once(m, ray, hit, what)
+    if out is None:
+        return {"scattered": False, "draws": r.draws()}
+    return {"scattered": True, "origin": out[0], "direction": out[1], "time": out[2],
+            "attenuation": out[3], "draws": r.draws()}
+
+
+def op_onb(req):
+    cls = find_class(("ONB", "Onb", "OrthonormalBasis"), "RT_utility")
+    o = cls()
+    method(o, "build_from_w", cls.__name__)(vec3(req["w"]))
+    x, y, z = (float(c) for c in req["local"])
+    local = method(o, "local", cls.__name__)(x, y, z)
+    return {"u": out_vec(getattr(o, "u", None), "ONB.u"),
+            "v": out_vec(getattr(o, "v", None), "ONB.v"),
+            "w": out_vec(getattr(o, "w", None), "ONB.w"),
+            "local": out_vec(local, "ONB.local")}
+
+
+CAMERA_FIELDS = (("img_width", "width", int), ("aspect_ratio", "aspect_ratio", float),
+                 ("samples_per_pixel", "spp", int), ("vertical_fov", "vfov", float),
+                 ("look_from", "look_from", vec3), ("look_at", "look_at", vec3),
+                 ("vec_up", "vup", vec3), ("max_depth", "max_depth", int))
+
+
+def make_camera(spec):
+    cam = find_class("Camera", "RT_camera")()
+    for attr, key, conv in CAMERA_FIELDS:
+        if key in spec:
+            setattr(cam, attr, conv(spec[key]))
+    init = method(cam, "init_camera", "Camera")
+    init(float(spec.get("defocus_angle", 0.0)), float(spec.get("focus_distance", 10.0)))
+    return cam
+
+
+def camera_attr(cam, names, what):
+    for n in names:
+        v = getattr(cam, n, None)
+        if v is not None:
+            return v
+    raise NotFound("the camera has no %s (looked for %s)" % (what, ", ".join(names)))
+
+
+def op_camera(req):
+    cam = make_camera(req["camera"])
+    return {
+        "center": out_vec(camera_attr(cam, ("center", "camera_center"), "centre"), "center"),
+        "u": out_vec(camera_attr(cam, ("u",), "u"), "u"),
+        "v": out_vec(camera_attr(cam, ("v",), "v"), "v"),
+        "w": out_vec(camera_attr(cam, ("w",), "w"), "w"),
+        "pixel00": out_vec(camera_attr(cam, ("pixel00_location", "pixel00_loc"), "pixel00"),
+                           "pixel00_location"),
+        "pixel_du": out_vec(camera_attr(cam, ("pixel_du", "pixel_delta_u"), "pixel_du"),
+                            "pixel_du"),
+        "pixel_dv": out_vec(camera_attr(cam, ("pixel_dv", "pixel_delta_v"), "pixel_dv"),
+                            "pixel_dv"),
+        "defocus_radius": out_num(camera_attr(cam, ("defocus_radius",), "defocus_radius"),
+                                  "defocus_radius"),
+        "height": int(camera_attr(cam, ("img_height", "image_height"), "image height")),
+    }
+
+
+def op_occlusion(req):
+    scene = make_scene(req["objects"])
+    f = method(scene, "find_occlusion", "Scene")
+    return {"occluded": out_bool(f(make_ray(req["ray"]), make_interval(req["interval"])),
+                                 "Scene.find_occlusion")}
+
+
+def make_integrator(spec):
+    cls = find_class("Integrator", "RT_integrator")
+    spec = spec or {}
+    count = positional_count(cls.__init__)
+    if count is not None and count >= 3:
+        return cls(bool(spec.get("direct_light", True)), bool(spec.get("sky", False)))
+    return cls()
+
+
+def op_shade(req):
+    scene = make_scene(req["objects"])
+    integrator = make_integrator(req.get("integrator"))
+    f = method(integrator, "compute_scattering", "Integrator")
+    with Seeded(req.get("seed", 0)):
+        value = f(make_ray(req["ray"]), scene, int(req.get("depth", 1)))
+    return {"color": out_vec(value, "Integrator.compute_scattering")}
+
+
+def sample_count(req):
+    n = int(req["n"])
+    if not 1 <= n <= MAX_SAMPLES:
+        raise ValueError("n must be 1 to %d" % MAX_SAMPLES)
+    return n
+
+
+def op_sample_unit_vector(req):
+    return sample_vectors(req, "random_vec3_unit", ("random_unit_vector",))
+
+
+def op_sample_cosine_hemisphere(req):
+    return sample_vectors(req, "random_cosine_hemisphere_on_z", ("random_cosine_direction",))
+
+
+def op_sample_unit_disk(req):
+    return sample_vectors(req, "random_in_unit_disk", ())
+
+
+def sample_vectors(req, name, aliases):
+    f = find_function(name, aliases)
+    n = sample_count(req)
+    with Seeded(req["seed"]):
+        samples = [out_vec(f(), name) for _ in range(n)]
+    return {"samples": samples}
+
+
+def op_sample_scatter(req):
+    m = make_material(req["material"])
+    ray = make_ray(req["ray"])
+    hit = make_hit(req["hit"], ray, m)
+    what = type(m).__name__ + ".scattering"
+    n = sample_count(req)
+    samples = []
+    with Seeded(req["seed"]):
+        for _ in range(n):
+            s = scatter_once(m, ray, hit, what)
+            samples.append(None if s is None else s[0] + s[1] + s[3])
+    return {"samples": samples}
+
+
+def op_sample_camera_ray(req):
+    n = sample_count(req)
+    samples = []
+    with Seeded(req["seed"]):
+        cam = make_camera(req["camera"])
+        i, j = (int(c) for c in req["pixel"])
+        stratum = req.get("stratum")
+        if stratum is not None:
+            f = method(cam, "get_jittered_ray", "Camera")
+            args = (i, j, int(stratum[0]), int(stratum[1]))
+            what = "Camera.get_jittered_ray"
+        else:
+            f = method(cam, "get_ray", "Camera")
+            args = (i, j)
+            what = "Camera.get_ray"
+        for _ in range(n):
+            r = f(*args)
+            if r is None:
+                raise BadReturn("%s returned None" % what)
+            get_time = getattr(r, "getTime", None)
+            time = get_time() if callable(get_time) else getattr(r, "time", 0.0)
+            samples.append(out_vec(r.getOrigin(), what + "'s origin")
+                           + out_vec(r.getDirection(), what + "'s direction")
+                           + [out_num(time if time is not None else 0.0, what + "'s time")])
+    return {"samples": samples}
+
+
+HANDLERS = {name: globals()["op_" + name] for name in OPS}
+
+
+def answer(req):
+    """The result object of a function request (raises what the submission raises)."""
+    return HANDLERS[req["op"]](req)
