@@ -109,26 +109,76 @@ pub fn markdown_block(s: &str, info: &str) -> String {
     out
 }
 
-/// Text for use inside a Markdown sentence (a file name, a one-line message): one line (control
-/// characters and newlines escaped as in [`terminal_line`]), each ASCII punctuation mark that
-/// Markdown gives a meaning to escaped with a backslash, and `<`, `>`, `&` written as HTML
-/// entities, so it cannot start a heading, a list, a link, an image, emphasis, code, a table
-/// cell or an HTML tag.
+/// Text for use inside a Markdown sentence, a heading or a table cell (a file name, a one-line
+/// message): one line (control characters and newlines escaped as in [`terminal_line`]) that
+/// renders as the same characters in CommonMark and GitHub's Markdown, and reads as they are in
+/// a renderer that shows backslashes (Python-Markdown's plain fallback, Gradescope's text): only
+/// what would change the rendering is escaped, nothing else.
+///
+/// - `<`, `>`, `&` become HTML entities (no tag, autolink or entity);
+/// - a backslash before a backslash; `` ` ``, `*`, `~`, `[`, `]`, `|` and `$` after one (no
+///   code span, emphasis, strikethrough, link or image, table cell, math), and `_` unless it
+///   sits between two letters or digits (`RT_object.py` stays as it is);
+/// - `#` after one at the start or after a space (no heading, nor a heading's closing `#`s);
+///   `-`, `+`, `=` and an ordered list's `1.` / `1)` after one at the start (no list or setext
+///   line when the text begins a line);
+/// - the `:` of `://` and the `.` of `www.` after one, so a URL in the text does not become an
+///   extended autolink.
+///
+/// Everything else (`.`, `-` or `+` inside a word, `(`, `)`, `=`, `:`, quotes, `!`) stays as it
+/// is: with `[` and `]` escaped nothing else can make a link.
 pub fn markdown_inline(s: &str) -> String {
     let line = terminal_line(s);
+    let chars: Vec<char> = line.chars().collect();
     let mut out = String::with_capacity(line.len() + 8);
-    for c in line.chars() {
-        match c {
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '&' => out.push_str("&amp;"),
-            '\\' | '`' | '*' | '_' | '{' | '}' | '[' | ']' | '(' | ')' | '#' | '+' | '-' | '.'
-            | '!' | '|' | '~' | '=' | ':' | '"' | '\'' | '$' | '^' => {
-                out.push('\\');
-                out.push(c);
+    // Where the text starts (after leading spaces): list markers and headings matter there.
+    let start = chars.iter().position(|c| *c != ' ').unwrap_or(chars.len());
+    let ordered_marker = {
+        let digits = chars[start..]
+            .iter()
+            .take_while(|c| c.is_ascii_digit())
+            .count();
+        (digits > 0 && matches!(chars.get(start + digits), Some('.' | ')')))
+            .then_some(start + digits)
+    };
+    for (i, &c) in chars.iter().enumerate() {
+        let escape = match c {
+            '<' => {
+                out.push_str("&lt;");
+                continue;
             }
-            c => out.push(c),
+            '>' => {
+                out.push_str("&gt;");
+                continue;
+            }
+            '&' => {
+                out.push_str("&amp;");
+                continue;
+            }
+            // Between two letters or digits `_` is text (no emphasis starts or ends there).
+            '_' => {
+                !(i > 0
+                    && chars[i - 1].is_alphanumeric()
+                    && chars.get(i + 1).is_some_and(|n| n.is_alphanumeric()))
+            }
+            '\\' | '`' | '*' | '~' | '[' | ']' | '|' | '$' => true,
+            '#' => i == start || chars[i - 1] == ' ',
+            '-' | '+' | '=' => i == start,
+            '.' | ')' if Some(i) == ordered_marker => true,
+            ':' => chars.get(i + 1) == Some(&'/') && chars.get(i + 2) == Some(&'/'),
+            '.' => {
+                i >= 3
+                    && chars[i - 3..i]
+                        .iter()
+                        .zip("www".chars())
+                        .all(|(a, b)| a.to_ascii_lowercase() == b)
+            }
+            _ => false,
+        };
+        if escape {
+            out.push('\\');
         }
+        out.push(c);
     }
     out
 }
@@ -222,8 +272,17 @@ mod tests {
     #[test]
     fn markdown_inline_defuses_links_headings_and_html() {
         let s = markdown_inline("# [x](http://e) <b>&");
-        assert_eq!(s, "\\# \\[x\\]\\(http\\://e\\) &lt;b&gt;&amp;");
+        assert_eq!(s, "\\# \\[x\\](http\\://e) &lt;b&gt;&amp;");
         assert!(!markdown_inline("a\nb").contains('\n'));
+        assert_eq!(markdown_inline("- a"), "\\- a");
+        assert_eq!(markdown_inline("12. a"), "12\\. a");
+        assert_eq!(markdown_inline("see www.e.org"), "see www\\.e.org");
+        assert_eq!(markdown_inline("a # b #"), "a \\# b \\#");
+        assert_eq!(markdown_inline("RT_object.py _x_"), "RT_object.py \\_x\\_");
+        assert_eq!(
+            markdown_inline("*x* _y_ `z` ~w~ a|b $m$ \\"),
+            "\\*x\\* \\_y\\_ \\`z\\` \\~w\\~ a\\|b \\$m\\$ \\\\"
+        );
     }
 
     #[test]

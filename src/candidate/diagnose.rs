@@ -78,6 +78,54 @@ impl Diagnosis {
     }
 }
 
+/// How to correct each mistake of the catalogue, as an imperative a student can follow (the
+/// course's names: `oc = origin - center`, `half_b`, `n = u x v`, `w = n / (n . n)`, `D`,
+/// alpha and beta); `None` for a mistake without one written here.
+pub fn fix(mistake_id: &str) -> Option<&'static str> {
+    Some(match mistake_id {
+        "sphere-far-root-first" => {
+            "try the near root (-half_b - sqrt_disc) / a first, and the far one only when the near one is outside the interval"
+        }
+        "sphere-no-interval-check" => {
+            "return None when neither root is inside the interval (cInterval.surrounds(root))"
+        }
+        "sphere-unnormalised-normal" => "divide (P - C) by the radius for the outward normal",
+        "sphere-abs-radius-in-normal" => {
+            "divide (P - C) by the radius itself, not by its absolute value"
+        }
+        "sphere-r-instead-of-r-squared" => "use c = |oc|^2 - r * r",
+        "sphere-sign-error-in-b" => "use half_b = oc . d, with oc = origin - center",
+        "sphere-disc-without-a" => "use the discriminant half_b^2 - a * c",
+        "sphere-front-face-reversed" | "quad-front-face-reversed" => {
+            "front_face is True when the ray's direction and the outward normal point opposite ways (d . n < 0)"
+        }
+        "sphere-sqrt-precedence" => {
+            "write the root as (-half_b - sqrt_disc) / a, with the parentheses"
+        }
+        "sphere-normal-not-flipped" => "call set_face_normal(ray, outward_normal) on the hit",
+        "quad-sign-error-in-alpha" => "use alpha = w . (p x v)",
+        "quad-w-is-unit-normal" => "use w = n / (n . n) with n = u x v, not normalised",
+        "quad-no-parallel-test" => {
+            "return None when |n . d| is below a small epsilon (the ray is parallel to the plane)"
+        }
+        "quad-wrong-d" | "quad-d-from-u" => "use D = normal . Q, with the unit normal",
+        "quad-no-interval-check" => "return None when t is outside the interval",
+        "quad-u-v-swapped-in-beta" | "quad-beta-uses-v" => "use beta = w . (u x p)",
+        "quad-unnormalised-normal" => "normalise n = u x v for the quad's normal",
+        "quad-interior-upper-bounds-only" => {
+            "check 0 <= alpha <= 1 and 0 <= beta <= 1 for the interior"
+        }
+        "triangle-missing-third-edge" => "also check alpha + beta <= 1",
+        "triangle-no-parallel-test" => {
+            "return None when the determinant is zero (the ray is parallel to the triangle)"
+        }
+        "triangle-absolute-epsilon" => {
+            "scale the epsilon by the triangle's size (or test the determinant against 0)"
+        }
+        _ => return None,
+    })
+}
+
 /// A description for each mistake of the catalogue, as the phrase after "those of".
 pub fn describe(mistake_id: &str) -> String {
     let known = match mistake_id {

@@ -24,7 +24,8 @@ impl CheckReport {
         self.write_header(&mut s);
         self.write_table(&mut s);
         self.write_verdict(&mut s);
-        self.write_failures(&mut s, max_failures);
+        let rest = self.write_diagnosed(&mut s);
+        rest.write_failures(&mut s, max_failures);
         self.write_stderr_tail(&mut s);
         s
     }
@@ -95,6 +96,10 @@ impl CheckReport {
             row(s, kind.name(), c);
         }
         row(s, "all", &self.counts);
+        let _ = writeln!(
+            s,
+            "(total: the definite vectors, which are judged; the ambiguous and any ones are run and not counted in it)"
+        );
     }
 
     /// The verdict, and what explains it: required shapes not run, the triangles' winding,
@@ -145,7 +150,11 @@ impl CheckReport {
             );
         }
         if let Some(w) = self.triangle_winding {
-            let _ = writeln!(s, "triangles: your triangles face {}", w.formula());
+            let _ = writeln!(
+                s,
+                "triangles: your triangles face {}; either winding is accepted (front_face is judged by yours)",
+                w.formula()
+            );
         }
         for d in &self.diagnosis {
             let _ = writeln!(s, "diagnosis: {}", d.sentence());
@@ -166,6 +175,31 @@ impl CheckReport {
                 terminal_line(&n.reason)
             );
         }
+    }
+
+    /// For each shape whose failures a diagnosis explains all of: the fix, and one of its
+    /// failures with how to reproduce it (the others would only say the same). Returns the
+    /// report with those failures taken out, for [`CheckReport::write_failures`] to show the
+    /// rest.
+    fn write_diagnosed(&self, s: &mut String) -> CheckReport {
+        let mut rest = self.clone();
+        for d in self.diagnosis.iter().filter(|d| d.explained == d.of) {
+            let Some(first) = self.failures.iter().find(|f| f.shape == d.shape) else {
+                continue;
+            };
+            s.push('\n');
+            if let Some(fix) = super::diagnose::fix(&d.mistake_id) {
+                let _ = writeln!(s, "fix for the {} failures: {fix}", d.shape);
+            }
+            let _ = writeln!(
+                s,
+                "one of the {} {} failures, all explained by the diagnosis:",
+                d.of, d.shape
+            );
+            write_failure(s, first);
+            rest.failures.retain(|f| f.shape != d.shape);
+        }
+        rest
     }
 
     /// The first `max_failures` failures, or one cause said once when all share it. Failures
@@ -290,9 +324,13 @@ fn write_case(s: &mut String, f: &Failure) {
         let _ = writeln!(s, "  request: {}", terminal_line(&f.request));
         let _ = writeln!(s, "  expected: {}", f.expected_text);
     } else {
-        let _ = writeln!(s, "  reproduce (run in the submission folder):");
+        // Unindented, so that it can be pasted into a file as it is.
+        let _ = writeln!(
+            s,
+            "  reproduce: save these lines as repro.py in the submission folder and run `python3 repro.py`:\n"
+        );
         for line in f.repro.lines() {
-            let _ = writeln!(s, "    {}", terminal_line(line));
+            let _ = writeln!(s, "{}", terminal_line(line));
         }
     }
 }

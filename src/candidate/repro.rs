@@ -64,7 +64,19 @@ fn expected_as(e: &Expect, dialect: &Dialect) -> String {
             }
             s
         }
-        Class::Ambiguous => "ambiguous (not scored)".to_string(),
+        // The exact answer, which rounding may turn either way: a hit when it has a `t`.
+        Class::Ambiguous => {
+            let mut exact = e.clone();
+            exact.class = if e.t.is_some() {
+                Class::Hit
+            } else {
+                Class::Miss
+            };
+            format!(
+                "exactly {}, where rounding decides (not scored)",
+                expected_as(&exact, dialect)
+            )
+        }
         Class::Any => "anything (not scored)".to_string(),
     }
 }

@@ -8,7 +8,7 @@ use rtoracle::grade::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, gr
 use rtoracle::oracle::vectors::read_vectors;
 
 /// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--vectors FILE.jsonl] [--out DIR] [--format all|json,gradescope,junit,markdown]`
-/// or `rtoracle grade --batch DIR --out OUT`.
+/// or `rtoracle grade --batch DIR [--shard K/N] --out OUT`, or `rtoracle grade --merge OUT... --out DIR`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// A submission folder in the course's layout (RT_object.py, week04_sphere.png, week04_quad.png).
@@ -17,6 +17,16 @@ pub struct Args {
     /// Grade every sub-folder of DIR as a submission, in parallel, and write a gradebook.
     #[arg(long, value_name = "DIR")]
     batch: Option<PathBuf>,
+    /// With --batch: grade only share K of N of its sub-folders (each folder's share follows
+    /// from its name alone, so N runs with 1/N ... N/N, on any machines, grade each folder
+    /// once); join their --out folders with --merge.
+    #[arg(long, value_name = "K/N", requires = "batch", value_parser = batch::Shard::parse)]
+    shard: Option<batch::Shard>,
+    /// Join the --out folders of a batch's shards (--batch DIR --shard K/N) into --out: every
+    /// submission's reports, and the gradebook and summary of the whole batch, as one run
+    /// without --shard writes them.
+    #[arg(long, value_name = "OUT", num_args = 1.., conflicts_with_all = ["submission", "batch"])]
+    merge: Vec<PathBuf>,
     /// The rubric (TOML); default: the built-in week-4 rubric (see --print-rubric).
     #[arg(long, value_name = "FILE.toml")]
     rubric: Option<PathBuf>,
@@ -46,6 +56,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    if !args.merge.is_empty() {
+        return run_merge(&args);
+    }
     let rubric = match &args.rubric {
         Some(path) => Rubric::from_file(path)?,
         None => Rubric::week04(),
@@ -85,8 +98,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .map_err(|e| anyhow::anyhow!("{}: {e}", rubric.source))?;
 
     if let Some(dir) = &args.batch {
-        let entries =
-            pool.install(|| batch::grade_batch(dir, &rubric, &code, &images, &args.out, &formats))?;
+        let entries = pool.install(|| {
+            batch::grade_batch_shard(
+                dir, &rubric, &code, &images, &args.out, &formats, args.shard,
+            )
+        })?;
         print_batch(&entries, &args)?;
     } else {
         let submission = args.submission.as_ref().expect("clap requires it");
@@ -192,6 +208,35 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         python_requires: rubric.python_requires.clone(),
         ..Default::default()
     })
+}
+
+/// `--merge`: the shards joined into `--out`, each submission's score on stdout, one line each,
+/// and where the gradebook is on stderr.
+fn run_merge(args: &Args) -> anyhow::Result<ExitCode> {
+    let merged = rtoracle::grade::merge::merge_shards(&args.merge, &args.out)?;
+    for row in &merged.rows {
+        match &row.result {
+            Ok(r) => outln!(
+                "{}: {} / {}",
+                terminal_line(&row.name),
+                r.score,
+                r.max_score
+            )?,
+            Err(msg) => outln!(
+                "{}: not graded: {}",
+                terminal_line(&row.name),
+                terminal_line(msg)
+            )?,
+        }
+    }
+    let graded = merged.rows.iter().filter(|r| r.result.is_ok()).count();
+    errln!(
+        "merged {} shards: graded {graded} of {} submissions; gradebook in {}",
+        args.merge.len(),
+        merged.rows.len(),
+        args.out.join("gradebook.csv").display()
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 /// A batch's scores on stdout, one line each, and where the gradebook is on stderr.

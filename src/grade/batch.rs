@@ -1,6 +1,12 @@
 //! Grading a folder of submissions: one report folder each, `gradebook.csv` and `summary.md`.
 //! Submissions are graded in parallel on rayon's current pool; one that breaks grading is a row
 //! marked `error` and never stops the batch.
+//!
+//! A batch can be spread over machines: `--shard K/N` grades the share [`Shard::holds`] gives
+//! shard K (decided by each folder's name alone, so the same on every machine and whatever other
+//! folders there are), and every batch also writes `batch.json` ([`BatchFile`]: the rows the
+//! gradebook and summary are made from), from which [`super::merge`] joins the shards into the
+//! gradebook and summary an unsharded run writes, byte for byte.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -10,6 +16,8 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 use super::batch_copies::flag_shared_noise;
 use super::copies::CopyFinding;
@@ -63,10 +71,54 @@ pub fn folder_name(name: &std::ffi::OsStr) -> String {
 
 /// The batch's own files in its output folder: a submission folder of one of these names is
 /// an error row of the batch, not graded (its reports would take their place).
-pub const BATCH_FILES: [&str; 2] = ["gradebook.csv", "summary.md"];
+pub const BATCH_FILES: [&str; 3] = ["gradebook.csv", "summary.md", "batch.json"];
 
-/// Grades every submission in `dir` into `out/<name>/` and writes `out/gradebook.csv` and
-/// `out/summary.md`.
+/// One share of a batch: shard `k` of `n` (1 <= k <= n), as `--shard K/N` names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// Which share, from 1.
+    pub k: u64,
+    /// How many shares.
+    pub n: u64,
+}
+
+impl Shard {
+    /// Reads `K/N`.
+    pub fn parse(text: &str) -> Result<Shard, String> {
+        let (k, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("{text:?} is not K/N (shard K of N, as 2/3)"))?;
+        let (k, n) = match (k.trim().parse::<u64>(), n.trim().parse::<u64>()) {
+            (Ok(k), Ok(n)) => (k, n),
+            _ => return Err(format!("{text:?} is not K/N with whole numbers (as 2/3)")),
+        };
+        if n == 0 || k == 0 || k > n {
+            return Err(format!("{text:?}: K must be from 1 to N, and N at least 1"));
+        }
+        Ok(Shard { k, n })
+    }
+
+    /// Whether the submission folder `name` is in this share: its shard is 1 + the first 8
+    /// bytes of the SHA-256 of its name (UTF-8), read as a big-endian number, modulo N. A
+    /// folder's shard depends on its name and N only, so every machine agrees on it and adding
+    /// or removing other folders never moves it; the shares are even up to chance (each holds
+    /// a folder with probability 1/N).
+    pub fn holds(&self, name: &str) -> bool {
+        let digest = Sha256::digest(name.as_bytes());
+        let mut first = [0u8; 8];
+        first.copy_from_slice(&digest[..8]);
+        u64::from_be_bytes(first) % self.n + 1 == self.k
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.k, self.n)
+    }
+}
+
+/// Grades every submission in `dir` into `out/<name>/` and writes `out/gradebook.csv`,
+/// `out/summary.md` and `out/batch.json`.
 pub fn grade_batch(
     dir: &Path,
     rubric: &Rubric,
@@ -75,12 +127,35 @@ pub fn grade_batch(
     out: &Path,
     formats: &[Format],
 ) -> Result<Vec<BatchEntry>, GradeError> {
+    grade_batch_shard(dir, rubric, code, images, out, formats, None)
+}
+
+/// [`grade_batch`] on the share `shard` of the submissions (all of them for `None`); the
+/// gradebook and summary are the share's, and `batch.json` says which share of which folders
+/// it holds.
+pub fn grade_batch_shard(
+    dir: &Path,
+    rubric: &Rubric,
+    code: &dyn CodeChecker,
+    images: &dyn ImageChecker,
+    out: &Path,
+    formats: &[Format],
+    shard: Option<Shard>,
+) -> Result<Vec<BatchEntry>, GradeError> {
     if !dir.is_dir() {
         return Err(GradeError::NoSubmission(dir.to_path_buf()));
     }
     // Everything is written into a fresh folder beside `out` and swapped in whole at the end.
     let output = OutputDir::create(out, "", &REPORT_FOLDER)?;
-    let subs = submissions(dir, Some(output.target()))?;
+    let all = submissions(dir, Some(output.target()))?;
+    let batch: Vec<String> = all
+        .iter()
+        .map(|s| folder_name(s.file_name().unwrap_or_default()))
+        .collect();
+    let subs: Vec<PathBuf> = all
+        .into_iter()
+        .filter(|s| shard.is_none_or(|sh| sh.holds(&folder_name(s.file_name().unwrap_or_default()))))
+        .collect();
     let bar = if std::io::stderr().is_terminal() {
         let bar =
             ProgressBar::with_draw_target(Some(subs.len() as u64), ProgressDrawTarget::stderr());
@@ -113,8 +188,9 @@ pub fn grade_batch(
                     });
                 }
                 if BATCH_FILES.contains(&name.as_str()) {
+                    // Named by the folder alone: a row says the same in every shard's run.
                     return Err(GradeError::Output {
-                        path: output.shown(&name),
+                        path: PathBuf::from(&name),
                         message: "a submission folder cannot have the name of the batch's own \
                                   report; rename it to grade it"
                             .to_string(),
@@ -146,8 +222,14 @@ pub fn grade_batch(
     bar.finish_and_clear();
     let mut entries = entries;
     flag_copies(&mut entries, &output, formats)?;
-    output.write("gradebook.csv", gradebook_csv(rubric, &entries).as_bytes())?;
-    output.write("summary.md", summary_md(rubric, &entries).as_bytes())?;
+    let file = BatchFile {
+        format: BATCH_FORMAT.to_string(),
+        rubric: BatchRubric::of(rubric),
+        shard,
+        batch,
+        rows: entries.iter().map(BatchRow::of).collect(),
+    };
+    file.write_into(&output)?;
     output.commit()?;
     Ok(entries)
 }
@@ -180,23 +262,189 @@ fn flag_copies(
     Ok(())
 }
 
-/// `gradebook.csv`: `submission,score,max_score`, one column per rubric group, then `status`.
-pub fn gradebook_csv(rubric: &Rubric, entries: &[BatchEntry]) -> String {
-    let mut csv = String::from("submission,score,max_score");
-    for g in &rubric.groups {
-        csv.push(',');
-        csv.push_str(&csv_cell(&g.id));
+/// What `batch.json` says it is (and which version of its layout).
+pub const BATCH_FORMAT: &str = "rtoracle-batch-1";
+
+/// What the gradebook and summary need of the rubric.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BatchRubric {
+    /// Its name.
+    pub name: String,
+    /// Its groups' ids, in order (the gradebook's columns).
+    pub groups: Vec<String>,
+    /// Points available.
+    pub max_score: f64,
+}
+
+impl BatchRubric {
+    /// The facts of `rubric`.
+    pub fn of(rubric: &Rubric) -> BatchRubric {
+        BatchRubric {
+            name: rubric.name.clone(),
+            groups: rubric.groups.iter().map(|g| g.id.clone()).collect(),
+            max_score: rubric.max_score(),
+        }
     }
-    csv.push_str(",status\n");
-    for e in entries {
-        csv.push_str(&csv_cell(&e.name));
-        match &e.result {
-            Ok(r) => {
-                let groups: BTreeMap<String, f64> = r
+}
+
+/// One check as the summary counts it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RowCheck {
+    /// The check's id.
+    pub id: String,
+    /// Its name.
+    pub name: String,
+    /// Points earned and available.
+    pub score: f64,
+    /// Points available.
+    pub max_score: f64,
+    /// Whether it failed or could not run (a check of a 0-point group loses nothing but can
+    /// still fail).
+    pub failed: bool,
+    /// The failing vectors it showed the student: id and message.
+    pub failures: Vec<(String, String)>,
+    /// Its group's id.
+    #[serde(default)]
+    pub group: String,
+    /// For an image check: the image's file and what the copy checks found of it.
+    #[serde(default)]
+    pub image: Option<RowImage>,
+}
+
+/// What the summary says of an image check: its file and the copies found.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RowImage {
+    /// The image's file in the submission.
+    pub file: String,
+    /// What the copy checks found of it.
+    pub copies: Vec<CopyFinding>,
+}
+
+/// A graded submission as the gradebook and summary use it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RowScores {
+    /// Points earned.
+    pub score: f64,
+    /// Points available.
+    pub max_score: f64,
+    /// Points per group id, in rubric order.
+    pub groups: Vec<(String, f64)>,
+    /// Its checks.
+    pub checks: Vec<RowCheck>,
+    /// Whether its code could not be run at all.
+    pub fatal: bool,
+    /// Every definite vector it failed.
+    pub failed_vectors: Vec<(String, ShapeKind)>,
+}
+
+/// One submission of a batch as its gradebook and summary use it (what `batch.json` keeps).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BatchRow {
+    /// The sub-folder's name.
+    pub name: String,
+    /// Its scores, or why grading it failed.
+    pub result: Result<RowScores, String>,
+}
+
+impl BatchRow {
+    /// The row of `entry`.
+    pub fn of(entry: &BatchEntry) -> BatchRow {
+        let result = entry
+            .result
+            .as_ref()
+            .map_err(Clone::clone)
+            .map(|r| RowScores {
+                score: r.score,
+                max_score: r.max_score,
+                groups: r
                     .group_scores()
                     .into_iter()
                     .map(|(g, s, _)| (g, s))
-                    .collect();
+                    .collect(),
+                checks: r
+                    .checks
+                    .iter()
+                    .map(|c| RowCheck {
+                        id: c.id.clone(),
+                        name: c.name.clone(),
+                        score: c.score,
+                        max_score: c.max_score,
+                        failed: matches!(c.status, CheckStatus::Failed | CheckStatus::Error),
+                        failures: c
+                            .failures
+                            .iter()
+                            .map(|f| (f.id.clone(), f.message.clone()))
+                            .collect(),
+                        group: c.group.clone(),
+                        image: c.image.as_ref().map(|i| RowImage {
+                            file: i.file.clone(),
+                            copies: i.copies.clone(),
+                        }),
+                    })
+                    .collect(),
+                fatal: r.code.fatal.is_some(),
+                failed_vectors: r.code.failed_vectors.clone(),
+            });
+        BatchRow {
+            name: entry.name.clone(),
+            result,
+        }
+    }
+}
+
+/// `batch.json`: the rubric, the share graded (none: all), every submission folder of the batch
+/// (graded here or not) and the rows of those graded here, in name order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BatchFile {
+    /// [`BATCH_FORMAT`].
+    pub format: String,
+    /// The rubric's facts.
+    pub rubric: BatchRubric,
+    /// The share graded.
+    pub shard: Option<Shard>,
+    /// Every submission folder of the batch, in name order.
+    pub batch: Vec<String>,
+    /// The rows of the submissions graded, in name order.
+    pub rows: Vec<BatchRow>,
+}
+
+impl BatchFile {
+    /// Writes `gradebook.csv`, `summary.md` and `batch.json` into `output`.
+    pub fn write_into(&self, output: &OutputDir) -> Result<(), GradeError> {
+        output.write(
+            "gradebook.csv",
+            rows_gradebook_csv(&self.rubric, &self.rows).as_bytes(),
+        )?;
+        output.write(
+            "summary.md",
+            rows_summary_md(&self.rubric, &self.rows).as_bytes(),
+        )?;
+        let json = serde_json::to_string_pretty(self).expect("a batch file always serialises");
+        output.write("batch.json", (json + "\n").as_bytes())?;
+        Ok(())
+    }
+}
+
+/// `gradebook.csv`: `submission,score,max_score`, one column per rubric group, then `status`.
+pub fn gradebook_csv(rubric: &Rubric, entries: &[BatchEntry]) -> String {
+    let rows: Vec<BatchRow> = entries.iter().map(BatchRow::of).collect();
+    rows_gradebook_csv(&BatchRubric::of(rubric), &rows)
+}
+
+/// [`gradebook_csv`] from rows.
+pub fn rows_gradebook_csv(rubric: &BatchRubric, rows: &[BatchRow]) -> String {
+    let mut csv = String::from("submission,score,max_score");
+    for g in &rubric.groups {
+        csv.push(',');
+        csv.push_str(&csv_cell(g));
+    }
+    csv.push_str(",status\n");
+    for e in rows {
+        csv.push_str(&csv_cell(&e.name));
+        match &e.result {
+            Ok(r) => {
+                let groups: BTreeMap<&str, f64> =
+                    r.groups.iter().map(|(g, s)| (g.as_str(), *s)).collect();
                 let _ = write!(
                     csv,
                     ",{},{}",
@@ -204,13 +452,13 @@ pub fn gradebook_csv(rubric: &Rubric, entries: &[BatchEntry]) -> String {
                     csv_cell(&r.max_score.to_string())
                 );
                 for g in &rubric.groups {
-                    let points = groups.get(&g.id).copied().unwrap_or(0.0);
+                    let points = groups.get(g.as_str()).copied().unwrap_or(0.0);
                     let _ = write!(csv, ",{}", csv_cell(&points.to_string()));
                 }
                 csv.push_str(",ok\n");
             }
             Err(msg) => {
-                let _ = write!(csv, ",,{}", csv_cell(&rubric.max_score().to_string()));
+                let _ = write!(csv, ",,{}", csv_cell(&rubric.max_score.to_string()));
                 for _ in &rubric.groups {
                     csv.push(',');
                 }
@@ -249,7 +497,13 @@ fn most_failed(
 
 /// `summary.md`: the score distribution and the most common failures.
 pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
-    let graded: Vec<&GradeReport> = entries
+    let rows: Vec<BatchRow> = entries.iter().map(BatchRow::of).collect();
+    rows_summary_md(&BatchRubric::of(rubric), &rows)
+}
+
+/// [`summary_md`] from rows.
+pub fn rows_summary_md(rubric: &BatchRubric, entries: &[BatchRow]) -> String {
+    let graded: Vec<&RowScores> = entries
         .iter()
         .filter_map(|e| e.result.as_ref().ok())
         .collect();
@@ -261,11 +515,11 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         entries.len() - graded.len()
     );
     if !graded.is_empty() {
-        score_distribution(&mut md, &graded, rubric.max_score());
+        score_distribution(&mut md, &graded, rubric.max_score);
         common_failures(&mut md, &graded);
         copies_section(&mut md, entries);
     }
-    let errors: Vec<&BatchEntry> = entries.iter().filter(|e| e.result.is_err()).collect();
+    let errors: Vec<&BatchRow> = entries.iter().filter(|e| e.result.is_err()).collect();
     if !errors.is_empty() {
         md.push_str("\n## Not graded\n\n");
         for e in errors {
@@ -282,7 +536,7 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
 
 /// The images that are not a render of the submission's code: the course's, the reference
 /// tracer's, and the pairs that share their noise (for review). Nothing when there is none.
-fn copies_section(md: &mut String, entries: &[BatchEntry]) {
+fn copies_section(md: &mut String, entries: &[BatchRow]) {
     let mut zeroed = Vec::new();
     let mut pairs = std::collections::BTreeSet::new();
     for e in entries {
@@ -346,7 +600,7 @@ fn copies_section(md: &mut String, entries: &[BatchEntry]) {
 }
 
 /// The scores' mean, median and range, and a histogram by tenths of `max`.
-fn score_distribution(md: &mut String, graded: &[&GradeReport], max: f64) {
+fn score_distribution(md: &mut String, graded: &[&RowScores], max: f64) {
     let mut scores: Vec<f64> = graded.iter().map(|r| r.score).collect();
     scores.sort_by(f64::total_cmp);
     let n = scores.len();
@@ -391,35 +645,30 @@ fn score_distribution(md: &mut String, graded: &[&GradeReport], max: f64) {
 }
 
 /// The checks that lost points (or failed), and the vectors failed most often.
-fn common_failures(md: &mut String, graded: &[&GradeReport]) {
+fn common_failures(md: &mut String, graded: &[&RowScores]) {
     let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
     // Per vector: its shape, how many submissions failed it (having run it), one message.
     let mut vectors: BTreeMap<String, (ShapeKind, usize, String)> = BTreeMap::new();
     let mut examples: BTreeMap<String, String> = BTreeMap::new();
     let mut fatal = 0usize;
     for r in graded {
-        if r.code.fatal.is_some() {
+        if r.fatal {
             fatal += 1;
         }
         for c in &r.checks {
             // A check of a 0-point group loses nothing but can still fail.
-            let failed = matches!(c.status, CheckStatus::Failed | CheckStatus::Error);
-            if c.score < c.max_score || failed {
+            if c.score < c.max_score || c.failed {
                 let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
                 e.1 += 1;
             }
             // The example is a message a student was shown.
-            for f in &c.failures {
-                examples.entry(f.id.clone()).or_insert(f.message.clone());
+            for (id, message) in &c.failures {
+                examples.entry(id.clone()).or_insert(message.clone());
             }
         }
         // Every vector the submission failed, once (a check shows only its first few).
-        let failed: BTreeMap<&String, ShapeKind> = r
-            .code
-            .failed_vectors
-            .iter()
-            .map(|(id, s)| (id, *s))
-            .collect();
+        let failed: BTreeMap<&String, ShapeKind> =
+            r.failed_vectors.iter().map(|(id, s)| (id, *s)).collect();
         for (id, shape) in failed {
             vectors
                 .entry(id.clone())

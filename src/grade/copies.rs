@@ -115,7 +115,7 @@ impl Fingerprint {
 }
 
 /// How two images' noise compares.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct NoiseMatch {
     /// Pixels busy in both images.
     pub common_busy: usize,
@@ -157,7 +157,7 @@ pub fn shared_noise(a: &Fingerprint, b: &Fingerprint) -> NoiseMatch {
 }
 
 /// What the copy checks found about one uploaded image.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum CopyFinding {
     /// Pixel for pixel the course's published image `file`.

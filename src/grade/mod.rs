@@ -38,6 +38,7 @@ pub(crate) mod fakes;
 pub mod image_checker;
 pub mod inputs;
 pub mod intake;
+pub mod merge;
 pub mod pack;
 pub mod render;
 pub mod report;

@@ -12,7 +12,7 @@ use super::run::grade;
 use crate::output::{OutputDir, Replaceable};
 
 /// Whether `name` is a file rtoracle's reports consist of (so an old report folder may be
-/// replaced whole): a report, a heatmap, a batch's gradebook or summary.
+/// replaced whole): a report, a heatmap, a batch's gradebook, summary or `batch.json`.
 fn is_report_file(name: &str) -> bool {
     matches!(
         name,
@@ -22,6 +22,7 @@ fn is_report_file(name: &str) -> bool {
             | "feedback.md"
             | "gradebook.csv"
             | "summary.md"
+            | "batch.json"
     ) || (name.starts_with("heatmap-") && name.ends_with(".png"))
 }
 

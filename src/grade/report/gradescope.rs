@@ -1,12 +1,17 @@
 //! `results.json` in Gradescope's autograder format: `score` (the sum of the tests'),
 //! `execution_time` (seconds, a number), `output`, and `tests[]` with `name`, `number`,
 //! `score`, `max_score`, `status` (`passed` / `failed`), `output`, `visibility` and `tags`.
+//!
+//! Every `output` is Markdown, and says so (`"output_format": "md"`, at the top and in each
+//! test): the same words as `feedback.md` ([`super::feedback`]), escaped only where Markdown
+//! would otherwise change them. The tests come in rubric order, the notes on ambiguous vectors
+//! (not scored) last.
 
 use serde_json::{Value, json};
 
-use super::markdown::{check_body, worth_showing};
+use super::feedback::{Shown, ambiguous_body, check_body, is_ambiguous_note, worth_showing};
 use crate::escape::markdown_inline;
-use crate::grade::{CheckStatus, GradeReport};
+use crate::grade::{CheckResult, CheckStatus, GradeReport};
 
 /// Text the submission controls, for Gradescope's Markdown: each line escaped with
 /// [`markdown_inline`] (so `<`, `>` and `&` are entities and nothing is a link, a heading or
@@ -27,21 +32,30 @@ pub(crate) fn quoted(s: &str) -> String {
     out
 }
 
-/// One test's output (Markdown): the message, the smallest failing case and its reproduction.
-/// The heatmaps are not on Gradescope, so nothing points to them, and the diagnosis of an image
-/// is said once (it is in the message).
-fn test_output(check: &crate::grade::CheckResult) -> String {
-    check_body(check, true, quoted)
-        .replace(" (outlined in the heatmap)", "")
+/// One test's output (Markdown): the message, the smallest failing case and its reproduction
+/// (an error an earlier test showed is referred to); for a note on ambiguous vectors, the short
+/// note. The heatmaps are not on Gradescope, so nothing points to them, and the diagnosis of an
+/// image is said once (it is in the message).
+fn test_output(check: &CheckResult, report: &GradeReport, shown: &mut Shown) -> String {
+    let body = if is_ambiguous_note(check) {
+        ambiguous_body(check, &report.checks)
+    } else {
+        check_body(check, quoted, shown, &check.name)
+    };
+    body.replace(" (outlined in the heatmap)", "")
         .trim_end()
         .to_string()
 }
 
 /// The Gradescope value.
 pub fn value(report: &GradeReport) -> Value {
-    let tests: Vec<Value> = report
+    let mut shown = Shown::default();
+    let ordered = report
         .checks
         .iter()
+        .filter(|c| !is_ambiguous_note(c))
+        .chain(report.checks.iter().filter(|c| is_ambiguous_note(c)));
+    let tests: Vec<Value> = ordered
         .filter(|c| worth_showing(c))
         .enumerate()
         .map(|(i, c)| {
@@ -51,7 +65,7 @@ pub fn value(report: &GradeReport) -> Value {
                 "score": c.score,
                 "max_score": c.max_score,
                 "status": if matches!(c.status, CheckStatus::Passed | CheckStatus::Skipped) { "passed" } else { "failed" },
-                "output": test_output(c),
+                "output": test_output(c, report, &mut shown),
                 "output_format": "md",
                 "visibility": c.visibility.name(),
                 "tags": c.tags,

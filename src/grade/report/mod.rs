@@ -1,6 +1,7 @@
 //! The report formats, all written from one [`GradeReport`]: [`Format`] names them and renders
 //! one, [`write_reports`] writes them into a folder.
 
+mod feedback;
 pub mod gradescope;
 pub mod json;
 pub mod junit;
