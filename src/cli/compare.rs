@@ -2,18 +2,19 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
+use rtoracle::compare::noise_model::recorded_scene;
 use rtoracle::compare::{
     CandidateImage, CompareOptions, Comparison, Encoding, Golden, check_size, compare_image,
-    golden_for_scene, golden_spp, report, write_heatmap, write_report_to,
+    report, write_heatmap, write_report_to,
 };
-use rtoracle::image_io::decode_exr;
+use rtoracle::golden::{GoldenRecord, GoldenScene, cache_dir};
 
 /// `rtoracle compare CANDIDATE (--scene NAME|FILE.toml [--golden FILE.exr] | --golden FILE.exr) [--spp N] [--encoding E]
 /// [--json] [--heatmap OUT.png] [--report DIR]`
 #[derive(Debug, clap::Args)]
 #[command(group(clap::ArgGroup::new("reference").required(true).multiple(true).args(["scene", "golden"])))]
 pub struct Args {
-    /// The image to judge: a PNG (8-bit RGB or RGBA) or an EXR.
+    /// The image to judge: a PNG (8-bit RGB or RGBA), a PPM (P3 or P6, 8-bit) or an EXR.
     candidate: PathBuf,
     /// Compare with the golden of this built-in scene (see `rtoracle scenes`), or of this scene
     /// file (`.toml`; its golden rendered once and cached, as grading does).
@@ -24,8 +25,8 @@ pub struct Args {
     /// gives the candidate's default spp.
     #[arg(long, value_name = "FILE.exr")]
     golden: Option<PathBuf>,
-    /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes; 20 with
-    /// --golden alone, which does not say the scene's).
+    /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes; with
+    /// --golden alone, the scene's that the golden records, else 20).
     #[arg(long, value_name = "N", value_parser = super::num::spp)]
     spp: Option<u32>,
     /// How the candidate's 8-bit codes encode linear values.
@@ -45,7 +46,7 @@ pub struct Args {
 
 /// The summary printed without `--json`; `pictures` says whether `--heatmap` or `--report` was
 /// given (a FAIL without them says how to see where it fails).
-fn summary(c: &Comparison, candidate: &Path, pictures: bool) -> String {
+fn summary(c: &Comparison, candidate: &Path, pictures: bool, spp_note: Option<&str>) -> String {
     let mut s = format!(
         "{} {}: {}x{}, {} spp against a {} spp golden{}, {} encoding\n",
         if c.passed() { "PASS" } else { "FAIL" },
@@ -60,6 +61,9 @@ fn summary(c: &Comparison, candidate: &Path, pictures: bool) -> String {
             .unwrap_or_default(),
         c.encoding
     );
+    if let Some(note) = spp_note {
+        s.push_str(&format!("  {note}\n"));
+    }
     s.push_str("  scale      tests  smallest adjusted p  (threshold)  largest |z|  failing\n");
     for r in &c.scales {
         s.push_str(&format!(
@@ -128,80 +132,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .transpose()?;
     // The candidate first: a bad candidate is reported before any golden work.
     let candidate = CandidateImage::load(&args.candidate)?;
-    let (golden, default_spp): (Box<dyn FnOnce(u32) -> anyhow::Result<Golden>>, u32) =
-        match (&args.scene, &args.golden) {
-            (Some(name), Some(path)) => {
-                // The golden given, checked against the scene (as a rubric's `golden` is).
-                let (_, description) = super::render::load_scene(name)?;
-                let bytes = std::fs::read(path).map_err(|e| {
-                    let why = match e.kind() {
-                        std::io::ErrorKind::NotFound => "no such file".to_string(),
-                        std::io::ErrorKind::IsADirectory => "is a folder".to_string(),
-                        _ => e.to_string(),
-                    };
-                    anyhow::anyhow!("--golden {}: {why}", path.display())
-                })?;
-                let image =
-                    rtoracle::golden::golden_fits(&bytes, path, &description).map_err(|why| {
-                        anyhow::anyhow!(
-                            "--golden {}: {why}; make it with `rtoracle golden {name} -o {}`",
-                            path.display(),
-                            path.display()
-                        )
-                    })?;
-                let g = Golden::from_exr_image(image, path)?;
-                check_size(&args.candidate, &candidate, g.width, g.height)?;
-                (
-                    Box::new(move |_| Ok(g)),
-                    description.image.samples_per_pixel,
-                )
-            }
-            (Some(name), None) => {
-                let (_, description) = super::render::load_scene(name)?;
-                let camera = description.camera(None);
-                check_size(&args.candidate, &candidate, camera.width, camera.height)?;
-                let default_spp = description.image.samples_per_pixel;
-                if rtoracle::scene::builtin(name).is_ok() {
-                    let name = name.clone();
-                    (
-                        Box::new(move |spp| Ok(golden_for_scene(&name, spp)?)),
-                        default_spp,
-                    )
-                } else {
-                    // A scene file: its golden from the cache, as grading gets it.
-                    let label = Path::new(name)
-                        .file_name()
-                        .map_or_else(|| name.clone(), |n| n.to_string_lossy().to_string());
-                    (
-                        Box::new(move |spp| {
-                            let spp = golden_spp(spp);
-                            let cached = rtoracle::golden::cache_dir()
-                                .map(|d| rtoracle::golden::cache_file(&d, &description, spp));
-                            if !cached.is_some_and(|p| p.is_file()) {
-                                errln!(
-                                    "rendering the golden of {} at {spp} spp (once; it is cached)",
-                                    rtoracle::escape::terminal_line(&label)
-                                );
-                            }
-                            let made =
-                                rtoracle::golden::cached_golden(&description, &label, spp, true)?;
-                            let path = made.path.unwrap_or_else(|| PathBuf::from(&label));
-                            let image = decode_exr(&made.bytes, &path)?;
-                            Ok(Golden::from_exr_image(image, &path)?)
-                        }),
-                        default_spp,
-                    )
-                }
-            }
-            (None, Some(path)) => {
-                let g = Golden::from_exr(path)?;
-                check_size(&args.candidate, &candidate, g.width, g.height)?;
-                (Box::new(move |_| Ok(g)), 20)
-            }
-            (None, None) => anyhow::bail!("give --scene NAME or --golden FILE.exr"),
-        };
+    let (golden, default_spp, spp_note) = reference(&args, &candidate)?;
     let spp = args.spp.unwrap_or(default_spp);
     let golden = golden(spp)?;
+    let spp_note = spp_note.filter(|_| args.spp.is_none());
     let options = CompareOptions {
         samples_per_pixel: spp,
         encoding,
@@ -219,7 +153,106 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         outln!("{}", report::to_json(&comparison))?;
     } else {
         let pictures = args.heatmap.is_some() || args.report.is_some();
-        out!("{}", summary(&comparison, &args.candidate, pictures))?;
+        out!(
+            "{}",
+            summary(&comparison, &args.candidate, pictures, spp_note.as_deref())
+        )?;
     }
     Ok(ExitCode::from(if comparison.passed() { 0 } else { 1 }))
+}
+
+/// The golden, made once the candidate's samples per pixel are known.
+type GoldenFor = Box<dyn FnOnce(u32) -> anyhow::Result<Golden>>;
+
+/// The scene `--scene` names: a scene file (`.toml`, or an existing file) or a built-in.
+fn golden_scene(name: &str) -> anyhow::Result<GoldenScene> {
+    let path = Path::new(name);
+    Ok(if name.ends_with(".toml") || path.is_file() {
+        GoldenScene::from_file(path)?
+    } else {
+        GoldenScene::builtin(name)?
+    })
+}
+
+/// Reads `--golden`, naming it in errors as the option.
+fn read_golden_file(path: &Path) -> anyhow::Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| {
+        let why = match e.kind() {
+            std::io::ErrorKind::NotFound => "no such file".to_string(),
+            std::io::ErrorKind::IsADirectory => "is a folder".to_string(),
+            _ => e.to_string(),
+        };
+        anyhow::anyhow!("--golden {}: {why}", path.display())
+    })
+}
+
+/// What the candidate is compared with: the golden (given the candidate's spp), the default spp,
+/// and, with `--golden` alone, where that default came from.
+fn reference(
+    args: &Args,
+    candidate: &CandidateImage,
+) -> anyhow::Result<(GoldenFor, u32, Option<String>)> {
+    match (&args.scene, &args.golden) {
+        (Some(name), Some(path)) => {
+            // The golden given, checked against the scene (as a rubric's `golden` is).
+            let scene = golden_scene(name)?;
+            let bytes = read_golden_file(path)?;
+            let image = scene.fits(&bytes, path).map_err(|why| {
+                anyhow::anyhow!(
+                    "--golden {}: {why}; make it with `rtoracle golden {name} -o {}`",
+                    path.display(),
+                    path.display()
+                )
+            })?;
+            let mut g = Golden::from_exr_image(image, path)?;
+            g.scene = Some(scene.name.clone());
+            check_size(&args.candidate, candidate, g.width, g.height)?;
+            let spp = scene.description.image.samples_per_pixel;
+            Ok((Box::new(move |_| Ok(g)), spp, None))
+        }
+        (Some(name), None) => {
+            let scene = golden_scene(name)?;
+            let camera = scene.description.camera(None);
+            check_size(&args.candidate, candidate, camera.width, camera.height)?;
+            let spp = scene.description.image.samples_per_pixel;
+            let golden: GoldenFor = Box::new(move |spp| {
+                Ok(Golden::of_scene(&scene, spp, cache_dir().as_deref(), true)?)
+            });
+            Ok((golden, spp, None))
+        }
+        (None, Some(path)) => {
+            let bytes = read_golden_file(path)?;
+            let image = rtoracle::image_io::decode_exr(&bytes, path)?;
+            let (spp, note) = recorded_spp(&GoldenRecord::of(&image));
+            let g = Golden::from_exr_image(image, path)?;
+            check_size(&args.candidate, candidate, g.width, g.height)?;
+            Ok((Box::new(move |_| Ok(g)), spp, Some(note)))
+        }
+        (None, None) => anyhow::bail!("give --scene NAME or --golden FILE.exr"),
+    }
+}
+
+/// The candidate's samples per pixel a golden's attributes imply, and a line saying so: the
+/// scene's own, when the golden records its scene ([`recorded_scene`]: the TOML a scene file's
+/// golden holds, or the built-in scene it names, hashes agreeing); else 20, the course's.
+fn recorded_spp(record: &GoldenRecord) -> (u32, String) {
+    let Some(d) = recorded_scene(record) else {
+        return (
+            20,
+            "judged as a render of 20 spp: this golden does not say its scene's samples per pixel (--spp N to change)".to_string(),
+        );
+    };
+    let n = d.image.samples_per_pixel;
+    let name = rtoracle::escape::terminal_line(record.scene.as_deref().unwrap_or("its scene"));
+    let which = if record.scene_toml.is_some() {
+        format!("{name}, the scene this golden holds")
+    } else {
+        format!("the built-in scene {name}, which this golden is of")
+    };
+    (
+        n,
+        format!(
+            "judged as a render of {n} spp, the samples_per_pixel of {which} (--spp N to change)"
+        ),
+    )
 }

@@ -2,13 +2,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use rtoracle::compare::golden_spp;
 use rtoracle::golden::{
-    GOLDEN_SEED, GOLDEN_SPP, Tolerance, compare_goldens, golden_bytes, golden_bytes_of,
-    golden_file_name,
+    GOLDEN_SEED, GOLDEN_SPP, GoldenScene, Tolerance, cache_dir, compare_goldens, golden_file_name,
+    golden_of, golden_spp, render_golden_bytes,
 };
 use rtoracle::image_io::{decode_exr, write_atomically};
-use rtoracle::scene::{SceneDescription, builtin, builtin_names};
+use rtoracle::scene::{builtin, builtin_names};
 
 /// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`, or
 /// `rtoracle golden FILE.toml -o FILE.exr [--spp N]` for a scene file.
@@ -86,19 +85,16 @@ fn write_scene_file(file: &Path, out: &Path, spp: Option<u32>) -> anyhow::Result
             );
         }
     }
-    let description = SceneDescription::from_file(file)?;
-    // The grader's golden of this scene, so that the bytes are the cache's.
-    let spp = spp.unwrap_or_else(|| golden_spp(description.image.samples_per_pixel));
+    let scene = GoldenScene::from_file(file)?;
+    // The grader's golden of this scene, from (or into) the same cache, so that grading it later
+    // renders nothing.
+    let spp = spp.unwrap_or_else(|| golden_spp(scene.description.image.samples_per_pixel));
     if out.extension().and_then(|e| e.to_str()) != Some("exr") {
         anyhow::bail!("-o {}: the golden must be an .exr file", out.display());
     }
     rtoracle::output::check_output_file(out, "-o")?;
-    let name = file
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| file.display().to_string());
     let start = Instant::now();
-    let bytes = golden_bytes_of(&description, &name, spp, GOLDEN_SEED, true)?;
+    let bytes = golden_of(&scene, spp, cache_dir().as_deref(), true)?.bytes;
     write_atomically(out, &bytes)?;
     outln!(
         "wrote {} ({spp} spp, seed {GOLDEN_SEED}, {} bytes) in {:.1} s",
@@ -116,7 +112,7 @@ fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
     for scene in scenes {
         let path = dir.join(golden_file_name(scene));
         let start = Instant::now();
-        let bytes = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
+        let bytes = render_golden_bytes(&GoldenScene::builtin(scene)?, spp, true)?;
         if created.is_none() && !dir.is_dir() {
             // Made and registered in one step, so a signal's cleanups cannot miss it.
             let made = || std::fs::create_dir(dir).map(|()| dir.to_path_buf());
@@ -150,7 +146,7 @@ fn check(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
     }
     let mut all_equal = true;
     for (scene, (path, bytes, on_disk)) in scenes.iter().zip(committed) {
-        let fresh = golden_bytes(scene, spp, GOLDEN_SEED, true)?;
+        let fresh = render_golden_bytes(&GoldenScene::builtin(scene)?, spp, true)?;
         if fresh == bytes {
             outln!("{}: identical bytes", path.display())?;
             continue;

@@ -59,6 +59,41 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let formats = Format::parse_list(&args.format)?;
     // Every input and the output folder are checked before any grading.
+    check_inputs(&args)?;
+    let code = code_checker(&args, &rubric)?;
+    // Said once the grading is done, so bad input stays one line on stderr.
+    let public_seed = (code.python.is_some() && code.vectors.is_none() && rubric.seed == 0).then_some(
+        "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
+    );
+    let images = rtoracle::grade::CompareImageChecker::default();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("cannot start the worker threads")?;
+
+    // The goldens first (a scene file's is rendered once, on every thread), so one that
+    // cannot be made stops the grading before it starts.
+    pool.install(|| images.prepare(&rubric.image_scenes()))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", rubric.source))?;
+
+    if let Some(dir) = &args.batch {
+        let entries =
+            pool.install(|| batch::grade_batch(dir, &rubric, &code, &images, &args.out, &formats))?;
+        print_batch(&entries, &args)?;
+    } else {
+        let submission = args.submission.as_ref().expect("clap requires it");
+        let report = pool
+            .install(|| grade_to_dir(submission, &rubric, &code, &images, &args.out, &formats))?;
+        print_report(&report, &args)?;
+    }
+    if let Some(w) = public_seed {
+        errln!("{w}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The submission (or batch) folder, `--python` and `--out`, checked before any grading.
+fn check_inputs(args: &Args) -> anyhow::Result<()> {
     match (&args.submission, &args.batch) {
         (None, None) => anyhow::bail!(
             "give a SUBMISSION folder to grade, or --batch DIR to grade every sub-folder of DIR \
@@ -111,13 +146,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             );
         }
     }
+    Ok(())
+}
+
+/// The code checker of `rubric`. Before grading anything: a sandbox that keeps the code from
+/// running as root (fail closed), and a Python with the rubric's modules that the sandbox user
+/// can run. A rubric of images only runs no code, so it needs neither (its checker's `python`
+/// stays `None`).
+fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecker> {
     let vectors = match &args.vectors {
         Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
         None => None,
     };
-    // Before grading anything: a sandbox that keeps the code from running as root (fail
-    // closed), and a Python with the rubric's modules that the sandbox user can run. A rubric
-    // of images only runs no code, so it needs neither.
     let runs_code = rubric
         .groups
         .iter()
@@ -134,7 +174,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         None
     };
-    let code = CourseCodeChecker {
+    Ok(CourseCodeChecker {
         seed: rubric.seed,
         vectors,
         case_timeout: Duration::from_millis(args.case_timeout_ms),
@@ -143,50 +183,32 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         python,
         python_requires: rubric.python_requires.clone(),
         ..Default::default()
-    };
-    // Said once the grading is done, so bad input stays one line on stderr.
-    let public_seed = (runs_code && code.vectors.is_none() && rubric.seed == 0).then_some(
-        "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
-    );
-    let images = rtoracle::grade::CompareImageChecker::default();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .context("cannot start the worker threads")?;
+    })
+}
 
-    // The goldens first (a scene file's is rendered once, on every thread), so one that
-    // cannot be made stops the grading before it starts.
-    pool.install(|| images.prepare(&rubric.image_scenes()))
-        .map_err(|e| anyhow::anyhow!("{}: {e}", rubric.source))?;
-
-    if let Some(dir) = &args.batch {
-        let entries =
-            pool.install(|| batch::grade_batch(dir, &rubric, &code, &images, &args.out, &formats))?;
-        let graded = entries.iter().filter(|e| e.result.is_ok()).count();
-        for e in &entries {
-            match &e.result {
-                Ok(r) => outln!("{}: {} / {}", terminal_line(&e.name), r.score, r.max_score)?,
-                Err(msg) => outln!(
-                    "{}: not graded: {}",
-                    terminal_line(&e.name),
-                    terminal_line(msg)
-                )?,
-            }
+/// A batch's scores on stdout, one line each, and where the gradebook is on stderr.
+fn print_batch(entries: &[batch::BatchEntry], args: &Args) -> anyhow::Result<()> {
+    let graded = entries.iter().filter(|e| e.result.is_ok()).count();
+    for e in entries {
+        match &e.result {
+            Ok(r) => outln!("{}: {} / {}", terminal_line(&e.name), r.score, r.max_score)?,
+            Err(msg) => outln!(
+                "{}: not graded: {}",
+                terminal_line(&e.name),
+                terminal_line(msg)
+            )?,
         }
-        errln!(
-            "graded {graded} of {} submissions; gradebook in {}",
-            entries.len(),
-            args.out.join("gradebook.csv").display()
-        );
-        if let Some(w) = public_seed {
-            errln!("{w}");
-        }
-        return Ok(ExitCode::SUCCESS);
     }
+    errln!(
+        "graded {graded} of {} submissions; gradebook in {}",
+        entries.len(),
+        args.out.join("gradebook.csv").display()
+    );
+    Ok(())
+}
 
-    let submission = args.submission.as_ref().expect("clap requires it");
-    let report =
-        pool.install(|| grade_to_dir(submission, &rubric, &code, &images, &args.out, &formats))?;
+/// A submission's checks and total on stdout, and where the reports are on stderr.
+fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::Result<()> {
     // Unscored checks are listed only when some ambiguous vector differs (no `0 / 0` rows).
     for c in report
         .checks
@@ -217,8 +239,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         report.execution_time,
         args.out.display()
     );
-    if let Some(w) = public_seed {
-        errln!("{w}");
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }

@@ -47,13 +47,8 @@ pub fn parse_profile(text: &str) -> Result<Profile, String> {
 const MAX_PIXELS: usize = 100_000_000;
 
 /// Loads a built-in scene by name, or a scene file when the argument ends in `.toml` or names an
-/// existing file.
-pub fn load_scene(name: &str) -> anyhow::Result<(String, SceneDescription)> {
-    load_scene_with(name, None)
-}
-
-/// [`load_scene`], with a built-in scene's image textures from the course's files in
-/// `textures` (refused for a scene file, whose textures are its own).
+/// existing file; a built-in scene's image textures come from the course's files in `textures`
+/// (refused for a scene file, whose textures are its own).
 pub fn load_scene_with(
     name: &str,
     textures: Option<&std::path::Path>,

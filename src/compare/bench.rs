@@ -36,11 +36,17 @@ pub fn run() -> String {
     let description = crate::scene::builtin(scene).expect("a built-in scene");
     let golden_spp = 1024;
     let t = Instant::now();
-    let golden = Golden::render(&description, scene, golden_spp, false).expect("renders");
+    let bytes = crate::golden::render_golden_bytes(
+        &crate::golden::GoldenScene::builtin(scene).expect("a built-in scene"),
+        golden_spp,
+        false,
+    )
+    .expect("renders");
     let render_time = t.elapsed();
     let dir = tempfile::tempdir().expect("a temporary folder");
-    let golden_path = dir.path().join("golden.bin");
-    std::fs::write(&golden_path, golden.to_cache_bytes()).expect("writes");
+    let golden_path = dir.path().join("golden.exr");
+    std::fs::write(&golden_path, &bytes).expect("writes");
+    let golden = Golden::from_exr(&golden_path).expect("decodes");
     let honest_path = dir.path().join("honest.png");
     let shifted_path = dir.path().join("jitter01.png");
     crate::image_io::write_png(
@@ -78,13 +84,9 @@ pub fn run() -> String {
     let failing = time(5, || {
         compare_image(&shifted, &golden, &options).expect("compares")
     });
-    let load_golden = time(runs, || {
-        Golden::from_cache_bytes(&std::fs::read(&golden_path).expect("reads"), None)
-            .expect("decodes")
-    });
+    let load_golden = time(runs, || Golden::from_exr(&golden_path).expect("decodes"));
     let whole = time(runs, || {
-        let g = Golden::from_cache_bytes(&std::fs::read(&golden_path).expect("reads"), None)
-            .expect("decodes");
+        let g = Golden::from_exr(&golden_path).expect("decodes");
         let c = compare_file(&honest_path, &g, &options).expect("compares");
         super::report::to_json(&c)
     });

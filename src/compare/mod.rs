@@ -11,9 +11,9 @@
 pub mod bench;
 pub mod diagnose;
 pub mod encoding;
-pub mod golden;
 pub mod heatmap;
 pub mod mistakes;
+pub mod noise_model;
 pub mod report;
 pub mod stats;
 pub mod verdict;
@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 pub use encoding::{ENCODINGS, Encoding};
-pub use golden::{Golden, golden_for_scene, golden_spp};
 pub use heatmap::write_heatmap;
+pub use noise_model::Golden;
 pub use report::{write_report, write_report_to};
 pub use verdict::{Evaluation, evaluate};
 

@@ -171,6 +171,406 @@ pub struct Evaluation {
     pub encoding: Option<Encoding>,
 }
 
+/// The grids over an image: 8- and 32-pixel tiles, and the cells regions are built from.
+#[derive(Clone, Copy)]
+struct Grids {
+    width: usize,
+    height: usize,
+    /// Tiles of 8 pixels a row.
+    t8x: usize,
+    /// Tiles of 32 pixels a row.
+    t32x: usize,
+    /// Cells a row and a column.
+    cx: usize,
+    cy: usize,
+}
+
+impl Grids {
+    fn of(width: usize, height: usize) -> Self {
+        let grid = |s: usize| (width.div_ceil(s), height.div_ceil(s));
+        let (t8x, _) = grid(8);
+        let (t32x, _) = grid(32);
+        let (cx, cy) = grid(CELL);
+        Grids {
+            width,
+            height,
+            t8x,
+            t32x,
+            cx,
+            cy,
+        }
+    }
+
+    /// The sums of channel `c` of the `size`-pixel tile (8 or 32) holding pixel `(x, y)`.
+    #[inline]
+    fn tile(&self, size: usize, x: usize, y: usize, c: usize) -> usize {
+        let tx = if size == 8 { self.t8x } else { self.t32x };
+        ((y / size) * tx + x / size) * 3 + c
+    }
+
+    /// The cell holding pixel `(x, y)`.
+    #[inline]
+    fn cell(&self, x: usize, y: usize) -> usize {
+        (y / CELL) * self.cx + x / CELL
+    }
+}
+
+/// What the test claims of the candidate and the golden, from the options.
+#[derive(Clone, Copy)]
+struct Claim {
+    /// The candidate's samples per pixel `N`.
+    n: f64,
+    /// The golden's samples per pixel `M`.
+    m: f64,
+    lambda: f64,
+    /// Each scale's share of `alpha`.
+    threshold: f64,
+    /// Pixel-scale tests (pixels times channels).
+    pixel_tests: f64,
+}
+
+/// One channel of one pixel: the candidate's interval `[lo, hi]` against the golden's mean
+/// `mu`, per-sample variance `s2` and bound `b`.
+struct Term {
+    lo: f64,
+    hi: f64,
+    mu: f64,
+    s2: f64,
+    b: f64,
+    /// `lo - mu_hi`: how much brighter the candidate surely is (when positive).
+    above: f64,
+    /// `mu_lo - hi`: how much darker (when positive).
+    below: f64,
+    /// The variance of the candidate's mean minus the golden's under the claim.
+    variance: f64,
+    /// Bernstein's bound on one term.
+    bound: f64,
+    /// The pixel test's p-value (before the Sidak correction).
+    p: f64,
+    /// Its signed z.
+    z: f64,
+    /// The golden's slack for `f32` and float-order rounding.
+    slack: f64,
+}
+
+impl Term {
+    #[inline]
+    fn of(lo: f64, hi: f64, mu: f64, s2: f64, b: f64, claim: &Claim) -> Self {
+        // The golden's range: its mean up to f32 and float-order rounding.
+        let slack = 1e-6 * (1.0 + mu.abs());
+        let (mu_lo, mu_hi) = (mu - slack, mu + slack);
+        // Samples the golden may have missed: an unseen event of probability up to
+        // about 4/M with the neighbourhood's contrast.
+        let s2_eff = s2.max(4.0 * b * b / claim.m);
+        let variance = claim.lambda * s2_eff / claim.n + s2 / claim.m;
+        let bound = b / claim.n;
+        let above = lo - mu_hi;
+        let below = mu_lo - hi;
+        let (t, sign) = if above > 0.0 {
+            (above, 1.0)
+        } else if below > 0.0 {
+            (below, -1.0)
+        } else {
+            (0.0, 0.0)
+        };
+        Term {
+            lo,
+            hi,
+            mu,
+            s2,
+            b,
+            above,
+            below,
+            variance,
+            bound,
+            p: bernstein_p(t, variance, bound),
+            z: sign * z_of(t, variance),
+            slack,
+        }
+    }
+}
+
+/// The sums the effective spp and the noise check are computed from.
+#[derive(Default)]
+struct NoiseSums {
+    /// The effective spp's numerator, denominator and pixel-channels.
+    neff_num: f64,
+    neff_den: f64,
+    neff_count: usize,
+    /// Squared residuals, their bound under the claim of N samples, the bound on their
+    /// variance and the largest one's cap.
+    sq_sum: f64,
+    sq_bound: f64,
+    sq_var: f64,
+    sq_max: f64,
+}
+
+/// What the pass over the pixels accumulates.
+struct PixelPass {
+    tiles8: Vec<Sums>,
+    tiles32: Vec<Sums>,
+    global: [Sums; 3],
+    /// The worst evidence per cell.
+    cells: Vec<Option<Worst>>,
+    pixel_min_p: f64,
+    pixel_max_z: f64,
+    pixel_failing: usize,
+    z_map: Vec<f32>,
+    /// Sum of (candidate mid-point - golden) per channel.
+    bias: [f64; 3],
+    noise: NoiseSums,
+    misfit: f64,
+}
+
+impl PixelPass {
+    /// Runs the pixel-scale tests and fills the tiles' sums.
+    fn run(iv: &Intervals, golden: &Golden, claim: &Claim, g: &Grids) -> Self {
+        let mut pass = PixelPass {
+            tiles8: vec![Sums::default(); g.t8x * g.height.div_ceil(8) * 3],
+            tiles32: vec![Sums::default(); g.t32x * g.height.div_ceil(32) * 3],
+            global: [Sums::default(); 3],
+            cells: vec![None; g.cx * g.cy],
+            pixel_min_p: 1.0,
+            pixel_max_z: 0.0,
+            pixel_failing: 0,
+            z_map: vec![0.0f32; g.width * g.height],
+            bias: [0.0; 3],
+            noise: NoiseSums::default(),
+            misfit: 0.0,
+        };
+        for y in 0..g.height {
+            for x in 0..g.width {
+                pass.pixel(x, y, iv, golden, claim, g);
+            }
+        }
+        pass
+    }
+
+    fn pixel(
+        &mut self,
+        x: usize,
+        y: usize,
+        iv: &Intervals,
+        golden: &Golden,
+        claim: &Claim,
+        g: &Grids,
+    ) {
+        let i = y * g.width + x;
+        let mut best_z = 0.0f64;
+        // A pixel's channels come from the same samples: its terms are summed first, and
+        // the pixels (independent) enter the bound as one term each.
+        let (mut px_sq, mut px_bound, mut px_cap) = (0.0f64, 0.0f64, 0.0f64);
+        for c in 0..3 {
+            let mu = golden.mean[i][c];
+            let s2 = golden.variance[i][c];
+            let b = golden.bound[i][c];
+            let (lo, hi) = (iv.lo[i][c], iv.hi[i][c]);
+            let t = Term::of(lo, hi, mu, s2, b, claim);
+            let z = t.z;
+            self.misfit += (z * z).min(100.0);
+            if z.abs() > best_z.abs() {
+                best_z = z;
+            }
+            self.pixel_max_z = self.pixel_max_z.max(z.abs());
+            if t.p < 1.0 {
+                let adjusted = sidak(t.p, claim.pixel_tests);
+                self.pixel_min_p = self.pixel_min_p.min(adjusted);
+                if adjusted < claim.threshold {
+                    self.pixel_failing += 1;
+                    let w = Worst {
+                        p: adjusted,
+                        scale: 0,
+                        channel: c,
+                        z,
+                    };
+                    mark(&mut self.cells[g.cell(x, y)], w);
+                }
+            }
+            let mid = 0.5 * (lo + hi);
+            self.bias[c] += mid - mu;
+            // Pixels whose noise shows through the quantisation enter the sums; the others
+            // are decided exactly at the pixel scale (a rule that reads only the golden).
+            let width_here = iv.width_at(mu);
+            if t.variance.sqrt() >= width_here {
+                let (above, below, variance, bound) = (t.above, t.below, t.variance, t.bound);
+                self.tiles8[g.tile(8, x, y, c)].add(above, below, variance, bound);
+                self.tiles32[g.tile(32, x, y, c)].add(above, below, variance, bound);
+                self.global[c].add(above, below, variance, bound);
+                if s2 > 0.0 && hi - lo < 1.0 {
+                    let (sq, e, cap) = self.noise.add(&t, claim);
+                    px_sq += sq;
+                    px_bound += e;
+                    px_cap += cap;
+                }
+            }
+        }
+        self.z_map[i] = best_z as f32;
+        if px_cap > 0.0 {
+            let n = &mut self.noise;
+            n.sq_sum += px_sq;
+            n.sq_bound += px_bound;
+            n.sq_var += px_cap * px_bound;
+            n.sq_max = n.sq_max.max(px_cap);
+        }
+    }
+
+    /// The pixel scale's result.
+    fn pixel_scale(&self, claim: &Claim) -> ScaleResult {
+        ScaleResult {
+            scale: SCALES[0].into(),
+            tests: claim.pixel_tests as usize,
+            smallest_adjusted_p: self.pixel_min_p,
+            threshold: claim.threshold,
+            largest_abs_z: self.pixel_max_z,
+            failing: self.pixel_failing,
+        }
+    }
+
+    /// The result of the tile scale `scale` (1: 8 pixels, 2: 32), marking the cells of its
+    /// failing tiles (the 8x8 ones tile8's sums counted pixels in).
+    fn tile_scale(&mut self, scale: usize, g: &Grids, threshold: f64) -> ScaleResult {
+        let sums = if scale == 1 {
+            &self.tiles8
+        } else {
+            &self.tiles32
+        };
+        let tests = sums.len();
+        let (mut min_p, mut max_z) = (1.0f64, 0.0f64);
+        let mut failing = vec![];
+        for (k, s) in sums.iter().enumerate() {
+            let (p, z) = s.test();
+            max_z = max_z.max(z.abs());
+            if p >= 1.0 {
+                continue;
+            }
+            self.misfit += if scale == 1 { (z * z).min(100.0) } else { 0.0 };
+            let adjusted = sidak(p, tests as f64);
+            min_p = min_p.min(adjusted);
+            if adjusted < threshold {
+                failing.push((k, adjusted, z));
+            }
+        }
+        for &(k, adjusted, z) in &failing {
+            self.mark_tile(k, scale, g, adjusted, z);
+        }
+        ScaleResult {
+            scale: SCALES[scale].into(),
+            tests,
+            smallest_adjusted_p: min_p,
+            threshold,
+            largest_abs_z: max_z,
+            failing: failing.len(),
+        }
+    }
+
+    /// Marks the cells of the failing tile `k / 3` (channel `k % 3`) of the tile scale `scale`:
+    /// only those whose pixels entered the sum (cells are 8x8 tiles).
+    fn mark_tile(&mut self, k: usize, scale: usize, g: &Grids, adjusted: f64, z: f64) {
+        let (size, tx) = if scale == 1 { (8, g.t8x) } else { (32, g.t32x) };
+        let tile = k / 3;
+        let (x0, y0) = ((tile % tx) * size, (tile / tx) * size);
+        for yy in (y0..(y0 + size).min(g.height)).step_by(CELL) {
+            for xx in (x0..(x0 + size).min(g.width)).step_by(CELL) {
+                if self.tiles8[g.tile(8, xx, yy, k % 3)].count == 0 {
+                    continue;
+                }
+                let w = Worst {
+                    p: adjusted,
+                    scale,
+                    channel: k % 3,
+                    z,
+                };
+                mark(&mut self.cells[g.cell(xx, yy)], w);
+            }
+        }
+    }
+
+    /// The global scale's result, and its worst failing channel.
+    fn global_scale(&self, threshold: f64) -> (ScaleResult, Option<Worst>) {
+        let (mut g_min, mut g_z, mut g_fail, mut g_worst) = (1.0f64, 0.0f64, 0usize, None);
+        for (c, s) in self.global.iter().enumerate() {
+            let (p, z) = s.test();
+            g_z = g_z.max(z.abs());
+            let adjusted = sidak(p, 3.0);
+            if adjusted < g_min {
+                g_min = adjusted;
+            }
+            if adjusted < threshold {
+                g_fail += 1;
+                let w = Worst {
+                    p: adjusted,
+                    scale: 3,
+                    channel: c,
+                    z,
+                };
+                mark(&mut g_worst, w);
+            }
+        }
+        let result = ScaleResult {
+            scale: SCALES[3].into(),
+            tests: 3,
+            smallest_adjusted_p: g_min,
+            threshold,
+            largest_abs_z: g_z,
+            failing: g_fail,
+        };
+        (result, g_worst)
+    }
+}
+
+impl NoiseSums {
+    /// Adds one pixel-channel whose noise shows through the quantisation; returns its squared
+    /// residual, the bound on its expectation and its cap under the claim.
+    fn add(&mut self, t: &Term, claim: &Claim) -> (f64, f64, f64) {
+        let Term {
+            lo, hi, mu, s2, b, ..
+        } = *t;
+        let mid = 0.5 * (lo + hi);
+        self.neff_num += s2;
+        self.neff_den += (mid - mu).powi(2) - (hi - lo).powi(2) / 12.0 - s2 / claim.m;
+        self.neff_count += 1;
+        // Under the claim, d = mid - mu = (mean - mu) + (mid - mean) with
+        // E (mean - mu)^2 <= lambda s2_eff / n + s2 / m (the variance the tests
+        // allow) and |mid - mean| <= w / 2, so E d^2 <= e (Minkowski), and
+        // |d| <= b + w / 2 + slack, so d^2 <= cap and Var d^2 <= cap e.
+        let w = hi - lo;
+        let e = (t.variance.sqrt() + w / 2.0).powi(2);
+        let cap = (b + w / 2.0 + t.slack).powi(2);
+        ((mid - mu).powi(2), e, cap)
+    }
+
+    /// The effective spp, when enough pixels show their noise.
+    fn effective_spp(&self) -> Option<f64> {
+        (self.neff_count >= NOISE_MIN_PIXELS && self.neff_den > 0.0)
+            .then(|| self.neff_num / self.neff_den)
+    }
+
+    /// Whether the candidate is as noisy as `claimed_spp` samples allow, when enough pixels
+    /// show their noise.
+    fn check(&self, claimed_spp: u32) -> Option<NoiseCheck> {
+        (self.neff_count >= NOISE_MIN_PIXELS).then(|| {
+            // Bernstein's inequality for the sum of the independent squared residuals (bounded
+            // by sq_max, variances summing to at most sq_var) above its bound under the claim.
+            let excess = self.sq_sum - self.sq_bound;
+            let p = if excess <= 0.0 {
+                1.0
+            } else {
+                (-excess * excess / (2.0 * self.sq_var + 2.0 * self.sq_max * excess / 3.0))
+                    .exp()
+                    .min(1.0)
+            };
+            NoiseCheck {
+                claimed_spp,
+                effective_spp: self.effective_spp(),
+                pixels: self.neff_count,
+                p,
+                threshold: NOISE_ALPHA,
+                passed: p >= NOISE_ALPHA,
+            }
+        })
+    }
+}
+
 /// Runs the statistic on a candidate read with `encoding` against `golden`.
 pub fn evaluate(
     candidate: &CandidateImage,
@@ -180,231 +580,27 @@ pub fn evaluate(
 ) -> Evaluation {
     let (width, height) = (golden.width, golden.height);
     let iv = Intervals::of(candidate, encoding);
-    let n = options.samples_per_pixel.max(1) as f64;
-    let m = golden.samples_per_pixel as f64;
-    let lambda = options.lambda;
-    let threshold = options.alpha / SCALES.len() as f64;
-
-    let grid = |s: usize| (width.div_ceil(s), height.div_ceil(s));
-    let (t8x, t8y) = grid(8);
-    let (t32x, t32y) = grid(32);
-    let (cx, cy) = grid(CELL);
-    let mut tiles8 = vec![Sums::default(); t8x * t8y * 3];
-    let mut tiles32 = vec![Sums::default(); t32x * t32y * 3];
-    let mut global = [Sums::default(); 3];
-    let mut cells: Vec<Option<Worst>> = vec![None; cx * cy];
-
-    let pixel_tests = (width * height * 3) as f64;
-    let mut pixel_min_p = 1.0f64;
-    let mut pixel_max_z = 0.0f64;
-    let mut pixel_failing = 0usize;
-    let mut z_map = vec![0.0f32; width * height];
-    let mut bias = [0.0f64; 3];
-    let (mut neff_num, mut neff_den, mut neff_count) = (0.0f64, 0.0f64, 0usize);
-    let mut misfit = 0.0f64;
-    // The noise check: squared residuals against their bound under the claim of N samples.
-    let (mut sq_sum, mut sq_bound, mut sq_var, mut sq_max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-
-    for y in 0..height {
-        for x in 0..width {
-            let i = y * width + x;
-            let mut best_z = 0.0f64;
-            // A pixel's channels come from the same samples: its terms are summed first, and
-            // the pixels (independent) enter the bound as one term each.
-            let (mut px_sq, mut px_bound, mut px_cap) = (0.0f64, 0.0f64, 0.0f64);
-            for c in 0..3 {
-                let mu = golden.mean[i][c];
-                let s2 = golden.variance[i][c];
-                let b = golden.bound[i][c];
-                let (lo, hi) = (iv.lo[i][c], iv.hi[i][c]);
-                // The golden's range: its mean up to f32 and float-order rounding.
-                let slack = 1e-6 * (1.0 + mu.abs());
-                let (mu_lo, mu_hi) = (mu - slack, mu + slack);
-                // Samples the golden may have missed: an unseen event of probability up to
-                // about 4/M with the neighbourhood's contrast.
-                let s2_eff = s2.max(4.0 * b * b / m);
-                let variance = lambda * s2_eff / n + s2 / m;
-                let bound = b / n;
-                let above = lo - mu_hi;
-                let below = mu_lo - hi;
-                let (t, sign) = if above > 0.0 {
-                    (above, 1.0)
-                } else if below > 0.0 {
-                    (below, -1.0)
-                } else {
-                    (0.0, 0.0)
-                };
-                let p = bernstein_p(t, variance, bound);
-                let z = sign * z_of(t, variance);
-                misfit += (z * z).min(100.0);
-                if z.abs() > best_z.abs() {
-                    best_z = z;
-                }
-                pixel_max_z = pixel_max_z.max(z.abs());
-                if p < 1.0 {
-                    let adjusted = sidak(p, pixel_tests);
-                    pixel_min_p = pixel_min_p.min(adjusted);
-                    if adjusted < threshold {
-                        pixel_failing += 1;
-                        mark(
-                            &mut cells[(y / CELL) * cx + x / CELL],
-                            Worst {
-                                p: adjusted,
-                                scale: 0,
-                                channel: c,
-                                z,
-                            },
-                        );
-                    }
-                }
-                let mid = 0.5 * (lo + hi);
-                bias[c] += mid - mu;
-                // Pixels whose noise shows through the quantisation enter the sums; the others
-                // are decided exactly at the pixel scale (a rule that reads only the golden).
-                let width_here = iv.width_at(mu);
-                if variance.sqrt() >= width_here {
-                    tiles8[((y / 8) * t8x + x / 8) * 3 + c].add(above, below, variance, bound);
-                    tiles32[((y / 32) * t32x + x / 32) * 3 + c].add(above, below, variance, bound);
-                    global[c].add(above, below, variance, bound);
-                    if s2 > 0.0 && hi - lo < 1.0 {
-                        neff_num += s2;
-                        neff_den += (mid - mu).powi(2) - (hi - lo).powi(2) / 12.0 - s2 / m;
-                        neff_count += 1;
-                        // Under the claim, d = mid - mu = (mean - mu) + (mid - mean) with
-                        // E (mean - mu)^2 <= lambda s2_eff / n + s2 / m (the variance the tests
-                        // allow) and |mid - mean| <= w / 2, so E d^2 <= e (Minkowski), and
-                        // |d| <= b + w / 2 + slack, so d^2 <= cap and Var d^2 <= cap e.
-                        let w = hi - lo;
-                        let e = (variance.sqrt() + w / 2.0).powi(2);
-                        let cap = (b + w / 2.0 + slack).powi(2);
-                        px_sq += (mid - mu).powi(2);
-                        px_bound += e;
-                        px_cap += cap;
-                    }
-                }
-            }
-            z_map[i] = best_z as f32;
-            if px_cap > 0.0 {
-                sq_sum += px_sq;
-                sq_bound += px_bound;
-                sq_var += px_cap * px_bound;
-                sq_max = sq_max.max(px_cap);
-            }
-        }
-    }
-
-    let tiles8_counts: Vec<usize> = tiles8.iter().map(|s| s.count).collect();
-    let mut scales = vec![ScaleResult {
-        scale: SCALES[0].into(),
-        tests: pixel_tests as usize,
-        smallest_adjusted_p: pixel_min_p,
-        threshold,
-        largest_abs_z: pixel_max_z,
-        failing: pixel_failing,
-    }];
-    let mut tile_scale = |sums: &[Sums], scale: usize, size: usize, tx: usize| -> ScaleResult {
-        let tests = sums.len() as f64;
-        let (mut min_p, mut max_z, mut failing) = (1.0f64, 0.0f64, 0usize);
-        for (k, s) in sums.iter().enumerate() {
-            let (p, z) = s.test();
-            max_z = max_z.max(z.abs());
-            if p >= 1.0 {
-                continue;
-            }
-            misfit += if scale == 1 { (z * z).min(100.0) } else { 0.0 };
-            let adjusted = sidak(p, tests);
-            min_p = min_p.min(adjusted);
-            if adjusted < threshold {
-                failing += 1;
-                let tile = k / 3;
-                let (x0, y0) = ((tile % tx) * size, (tile / tx) * size);
-                for yy in (y0..(y0 + size).min(height)).step_by(CELL) {
-                    for xx in (x0..(x0 + size).min(width)).step_by(CELL) {
-                        // Only the cells whose pixels entered the sum (cells are 8x8 tiles).
-                        if tiles8_counts[((yy / 8) * t8x + xx / 8) * 3 + k % 3] == 0 {
-                            continue;
-                        }
-                        mark(
-                            &mut cells[(yy / CELL) * cx + xx / CELL],
-                            Worst {
-                                p: adjusted,
-                                scale,
-                                channel: k % 3,
-                                z,
-                            },
-                        );
-                    }
-                }
-            }
-        }
-        ScaleResult {
-            scale: SCALES[scale].into(),
-            tests: sums.len(),
-            smallest_adjusted_p: min_p,
-            threshold,
-            largest_abs_z: max_z,
-            failing,
-        }
+    let claim = Claim {
+        n: options.samples_per_pixel.max(1) as f64,
+        m: golden.samples_per_pixel as f64,
+        lambda: options.lambda,
+        threshold: options.alpha / SCALES.len() as f64,
+        pixel_tests: (width * height * 3) as f64,
     };
-    scales.push(tile_scale(&tiles8, 1, 8, t8x));
-    scales.push(tile_scale(&tiles32, 2, 32, t32x));
+    let grids = Grids::of(width, height);
+    let mut pass = PixelPass::run(&iv, golden, &claim, &grids);
+    let mut scales = vec![pass.pixel_scale(&claim)];
+    scales.push(pass.tile_scale(1, &grids, claim.threshold));
+    scales.push(pass.tile_scale(2, &grids, claim.threshold));
+    let (global, global_worst) = pass.global_scale(claim.threshold);
+    scales.push(global);
 
-    let (mut g_min, mut g_z, mut g_fail, mut g_worst) = (1.0f64, 0.0f64, 0usize, None);
-    for (c, s) in global.iter().enumerate() {
-        let (p, z) = s.test();
-        g_z = g_z.max(z.abs());
-        let adjusted = sidak(p, 3.0);
-        if adjusted < g_min {
-            g_min = adjusted;
-        }
-        if adjusted < threshold {
-            g_fail += 1;
-            mark(
-                &mut g_worst,
-                Worst {
-                    p: adjusted,
-                    scale: 3,
-                    channel: c,
-                    z,
-                },
-            );
-        }
-    }
-    scales.push(ScaleResult {
-        scale: SCALES[3].into(),
-        tests: 3,
-        smallest_adjusted_p: g_min,
-        threshold,
-        largest_abs_z: g_z,
-        failing: g_fail,
-    });
-
-    let mut regions = regions_of(&cells, cx, cy, width, height);
-    if let (true, Some(w)) = (regions.is_empty(), g_worst) {
+    let mut regions = regions_of(&pass.cells, grids.cx, grids.cy, width, height);
+    if let (true, Some(w)) = (regions.is_empty(), global_worst) {
         regions.push(region(0, 0, width, height, w));
     }
-    let effective_spp =
-        (neff_count >= NOISE_MIN_PIXELS && neff_den > 0.0).then(|| neff_num / neff_den);
-    let noise = (neff_count >= NOISE_MIN_PIXELS).then(|| {
-        // Bernstein's inequality for the sum of the independent squared residuals (bounded by
-        // sq_max, variances summing to at most sq_var) above its bound under the claim.
-        let excess = sq_sum - sq_bound;
-        let p = if excess <= 0.0 {
-            1.0
-        } else {
-            (-excess * excess / (2.0 * sq_var + 2.0 * sq_max * excess / 3.0))
-                .exp()
-                .min(1.0)
-        };
-        NoiseCheck {
-            claimed_spp: options.samples_per_pixel,
-            effective_spp,
-            pixels: neff_count,
-            p,
-            threshold: NOISE_ALPHA,
-            passed: p >= NOISE_ALPHA,
-        }
-    });
+    let effective_spp = pass.noise.effective_spp();
+    let noise = pass.noise.check(options.samples_per_pixel);
     let passed = scales.iter().all(|s| s.failing == 0) && noise.as_ref().is_none_or(|n| n.passed);
     let pixels = (width * height) as f64;
     Evaluation {
@@ -412,10 +608,10 @@ pub fn evaluate(
         scales,
         regions,
         noise,
-        z_map,
-        bias: bias.map(|b| b / pixels),
+        z_map: pass.z_map,
+        bias: pass.bias.map(|b| b / pixels),
         effective_spp,
-        misfit,
+        misfit: pass.misfit,
         encoding: iv.encoding,
     }
 }

@@ -13,8 +13,8 @@ use rayon::prelude::*;
 
 use super::inputs::{CodeChecker, ImageChecker};
 use super::report::Format;
+use super::result::{CheckStatus, GradeError, GradeReport, round2};
 use super::rubric::Rubric;
-use super::run::{GradeError, GradeReport, round2};
 use super::write::{REPORT_FOLDER, grade_into};
 use crate::escape::{csv_cell, markdown_inline};
 use crate::oracle::vectors::ShapeKind;
@@ -196,7 +196,6 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         .iter()
         .filter_map(|e| e.result.as_ref().ok())
         .collect();
-    let max = rubric.max_score();
     let mut md = format!(
         "# Batch summary ({} rubric)\n\n{} submissions, {} graded, {} could not be graded.\n",
         rubric.name,
@@ -205,117 +204,8 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
         entries.len() - graded.len()
     );
     if !graded.is_empty() {
-        let mut scores: Vec<f64> = graded.iter().map(|r| r.score).collect();
-        scores.sort_by(f64::total_cmp);
-        let n = scores.len();
-        let mean = scores.iter().sum::<f64>() / n as f64;
-        let median = if n % 2 == 1 {
-            scores[n / 2]
-        } else {
-            (scores[n / 2 - 1] + scores[n / 2]) / 2.0
-        };
-        let _ = writeln!(
-            md,
-            "\nScore out of {max}: mean {}, median {}, min {}, max {}.\n",
-            round2(mean),
-            round2(median),
-            scores[0],
-            scores[n - 1]
-        );
-        md.push_str("| Score | Submissions |\n|---|---:|\n");
-        let mut buckets = [0usize; 11];
-        for s in &scores {
-            let frac = if max > 0.0 { s / max } else { 1.0 };
-            let b = if frac >= 1.0 {
-                10
-            } else {
-                (frac * 10.0).floor().clamp(0.0, 9.0) as usize
-            };
-            buckets[b] += 1;
-        }
-        for (i, count) in buckets.iter().enumerate() {
-            let label = if i == 10 {
-                "100%".to_string()
-            } else {
-                format!("{}-{}%", i * 10, i * 10 + 10)
-            };
-            let bar = if *count > 0 {
-                format!(" {}", "#".repeat(*count))
-            } else {
-                String::new()
-            };
-            let _ = writeln!(md, "| {label} | {count}{bar} |");
-        }
-        // Checks that lost points, and the vectors failed most often.
-        let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
-        // Per vector: its shape, how many submissions failed it (having run it), one message.
-        let mut vectors: BTreeMap<String, (ShapeKind, usize, String)> = BTreeMap::new();
-        let mut examples: BTreeMap<String, String> = BTreeMap::new();
-        let mut fatal = 0usize;
-        for r in &graded {
-            if r.code.fatal.is_some() {
-                fatal += 1;
-            }
-            for c in &r.checks {
-                // A check of a 0-point group loses nothing but can still fail.
-                let failed = matches!(
-                    c.status,
-                    super::run::CheckStatus::Failed | super::run::CheckStatus::Error
-                );
-                if c.score < c.max_score || failed {
-                    let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
-                    e.1 += 1;
-                }
-                // The example is a message a student was shown.
-                for f in &c.failures {
-                    examples.entry(f.id.clone()).or_insert(f.message.clone());
-                }
-            }
-            // Every vector the submission failed, once (a check shows only its first few).
-            let failed: BTreeMap<&String, ShapeKind> = r
-                .code
-                .failed_vectors
-                .iter()
-                .map(|(id, s)| (id, *s))
-                .collect();
-            for (id, shape) in failed {
-                vectors
-                    .entry(id.clone())
-                    .or_insert((shape, 0, String::new()))
-                    .1 += 1;
-            }
-        }
-        for (id, (_, _, example)) in vectors.iter_mut() {
-            *example = examples
-                .get(id)
-                .cloned()
-                .unwrap_or_else(|| "(not among the failures shown to any student)".to_string());
-        }
-        md.push_str("\n## Most common failures\n\n");
-        if checks.is_empty() {
-            md.push_str("Every submission passed every check.\n");
-        } else {
-            let mut rows: Vec<_> = checks.into_iter().collect();
-            rows.sort_by(|a, b| b.1.1.cmp(&a.1.1).then(a.0.cmp(&b.0)));
-            md.push_str("| Check | Submissions losing points |\n|---|---:|\n");
-            for (id, (name, count)) in rows {
-                let _ = writeln!(md, "| `{id}` {name} | {count} |");
-            }
-        }
-        if fatal > 0 {
-            let _ = writeln!(md, "\n{fatal} submission(s) could not be imported.");
-        }
-        if !vectors.is_empty() {
-            md.push_str("\n| Vector | Submissions failing it | Example |\n|---|---:|---|\n");
-            for (id, count, msg) in most_failed(vectors, VECTORS_SHOWN) {
-                let _ = writeln!(
-                    md,
-                    "| `{}` | {count} | {} |",
-                    id.replace('`', "'"),
-                    markdown_inline(&msg)
-                );
-            }
-        }
+        score_distribution(&mut md, &graded, rubric.max_score());
+        common_failures(&mut md, &graded);
     }
     let errors: Vec<&BatchEntry> = entries.iter().filter(|e| e.result.is_err()).collect();
     if !errors.is_empty() {
@@ -332,11 +222,126 @@ pub fn summary_md(rubric: &Rubric, entries: &[BatchEntry]) -> String {
     md
 }
 
+/// The scores' mean, median and range, and a histogram by tenths of `max`.
+fn score_distribution(md: &mut String, graded: &[&GradeReport], max: f64) {
+    let mut scores: Vec<f64> = graded.iter().map(|r| r.score).collect();
+    scores.sort_by(f64::total_cmp);
+    let n = scores.len();
+    let mean = scores.iter().sum::<f64>() / n as f64;
+    let median = if n % 2 == 1 {
+        scores[n / 2]
+    } else {
+        (scores[n / 2 - 1] + scores[n / 2]) / 2.0
+    };
+    let _ = writeln!(
+        md,
+        "\nScore out of {max}: mean {}, median {}, min {}, max {}.\n",
+        round2(mean),
+        round2(median),
+        scores[0],
+        scores[n - 1]
+    );
+    md.push_str("| Score | Submissions |\n|---|---:|\n");
+    let mut buckets = [0usize; 11];
+    for s in &scores {
+        let frac = if max > 0.0 { s / max } else { 1.0 };
+        let b = if frac >= 1.0 {
+            10
+        } else {
+            (frac * 10.0).floor().clamp(0.0, 9.0) as usize
+        };
+        buckets[b] += 1;
+    }
+    for (i, count) in buckets.iter().enumerate() {
+        let label = if i == 10 {
+            "100%".to_string()
+        } else {
+            format!("{}-{}%", i * 10, i * 10 + 10)
+        };
+        let bar = if *count > 0 {
+            format!(" {}", "#".repeat(*count))
+        } else {
+            String::new()
+        };
+        let _ = writeln!(md, "| {label} | {count}{bar} |");
+    }
+}
+
+/// The checks that lost points (or failed), and the vectors failed most often.
+fn common_failures(md: &mut String, graded: &[&GradeReport]) {
+    let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
+    // Per vector: its shape, how many submissions failed it (having run it), one message.
+    let mut vectors: BTreeMap<String, (ShapeKind, usize, String)> = BTreeMap::new();
+    let mut examples: BTreeMap<String, String> = BTreeMap::new();
+    let mut fatal = 0usize;
+    for r in graded {
+        if r.code.fatal.is_some() {
+            fatal += 1;
+        }
+        for c in &r.checks {
+            // A check of a 0-point group loses nothing but can still fail.
+            let failed = matches!(c.status, CheckStatus::Failed | CheckStatus::Error);
+            if c.score < c.max_score || failed {
+                let e = checks.entry(c.id.clone()).or_insert((c.name.clone(), 0));
+                e.1 += 1;
+            }
+            // The example is a message a student was shown.
+            for f in &c.failures {
+                examples.entry(f.id.clone()).or_insert(f.message.clone());
+            }
+        }
+        // Every vector the submission failed, once (a check shows only its first few).
+        let failed: BTreeMap<&String, ShapeKind> = r
+            .code
+            .failed_vectors
+            .iter()
+            .map(|(id, s)| (id, *s))
+            .collect();
+        for (id, shape) in failed {
+            vectors
+                .entry(id.clone())
+                .or_insert((shape, 0, String::new()))
+                .1 += 1;
+        }
+    }
+    for (id, (_, _, example)) in vectors.iter_mut() {
+        *example = examples
+            .get(id)
+            .cloned()
+            .unwrap_or_else(|| "(not among the failures shown to any student)".to_string());
+    }
+    md.push_str("\n## Most common failures\n\n");
+    if checks.is_empty() {
+        md.push_str("Every submission passed every check.\n");
+    } else {
+        let mut rows: Vec<_> = checks.into_iter().collect();
+        rows.sort_by(|a, b| b.1.1.cmp(&a.1.1).then(a.0.cmp(&b.0)));
+        md.push_str("| Check | Submissions losing points |\n|---|---:|\n");
+        for (id, (name, count)) in rows {
+            let _ = writeln!(md, "| `{id}` {name} | {count} |");
+        }
+    }
+    if fatal > 0 {
+        let _ = writeln!(md, "\n{fatal} submission(s) could not be imported.");
+    }
+    if !vectors.is_empty() {
+        md.push_str("\n| Vector | Submissions failing it | Example |\n|---|---:|---|\n");
+        for (id, count, msg) in most_failed(vectors, VECTORS_SHOWN) {
+            let _ = writeln!(
+                md,
+                "| `{}` | {count} | {} |",
+                id.replace('`', "'"),
+                markdown_inline(&msg)
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grade::fakes::*;
     use crate::grade::inputs::{FailureKind, FailureSummary};
-    use crate::grade::run::fakes::*;
 
     /// Makes a submission folder with fake images for each of `names` in a new temporary
     /// folder and grades them as a batch with `code` (JSON reports into its `out`). Returns the

@@ -172,92 +172,118 @@ impl CodeChecker for CourseCodeChecker {
                 counts.definite_total += 1;
             }
         }
-        let fatal = |out: &mut CodeOutcome, msg: String| {
-            for counts in out.per_group.values_mut() {
-                counts.not_run = counts.definite_total;
-            }
-            out.fatal = Some(msg);
-        };
-        let has_object = std::fs::symlink_metadata(submission.join("RT_object.py"))
-            .map(|m| m.is_file())
-            .unwrap_or(false);
-        if !has_object {
-            fatal(&mut out, "RT_object.py is not in the submission".into());
-            return out;
-        }
-        // Probed once per process (cached): a batch pays for it once.
-        let python =
-            match python::choose(self.python.as_deref(), &self.python_requires, &self.policy) {
-                Ok(p) => p,
-                Err(e) => {
-                    fatal(&mut out, e.to_string());
-                    return out;
-                }
-            };
-        let started = CandidateCommand::python_course_with(submission, Some(&python), true)
-            .and_then(|command| Session::start(command, self.options()));
-        let mut session = match started {
+        let mut session = match self.start(submission) {
             Ok(s) => s,
-            Err(HarnessError::Python(e)) => {
-                fatal(&mut out, format!("cannot run the Python interpreter: {e}"));
-                return out;
-            }
-            Err(e) => {
-                fatal(&mut out, e.to_string());
+            Err(msg) => {
+                fatal(&mut out, msg);
                 return out;
             }
         };
-        let sandbox_dir = session.sandbox_dir().to_path_buf();
-        let inside_dir = session.sandbox_inside_dir();
-        let submission_dir =
-            std::path::absolute(submission).unwrap_or_else(|_| submission.to_path_buf());
-        let strip = |text: &str| {
-            let text = if inside_dir != sandbox_dir {
-                let to = submission_dir.display().to_string();
-                crate::sandbox::replace_path(text, &inside_dir, &to)
-            } else {
-                text.to_string()
-            };
-            strip_dirs(&text, &[&sandbox_dir, &submission_dir])
-        };
+        let paths = PathStripper::new(&session, submission);
         out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
-        let finish = |out: &mut CodeOutcome, session: &Session| {
-            out.stderr_tail = strip(&session.stderr_tail());
-            out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
-        };
-        if let Some(e) = &session.hello().error {
+        let failure = if let Some(e) = &session.hello().error {
             let text = if e.traceback.trim().is_empty() {
                 e.to_string()
             } else {
                 e.traceback.trim_end().to_string()
             };
-            let msg = format!("importing the submission failed:\n{}", strip(&text));
-            fatal(&mut out, msg);
-            finish(&mut out, &session);
-            return out;
-        }
-        if let Some(why) = session.start_failure() {
-            let msg = format!("Python could not import the submission: {}", strip(why));
-            fatal(&mut out, msg);
-            finish(&mut out, &session);
-            return out;
-        }
-        let outcomes = match session.run(&cases) {
-            Ok(o) => o,
-            Err(e) => {
-                fatal(&mut out, e.to_string());
-                finish(&mut out, &session);
-                return out;
-            }
+            Some(format!(
+                "importing the submission failed:\n{}",
+                paths.strip(&text)
+            ))
+        } else {
+            session.start_failure().map(|why| {
+                format!(
+                    "Python could not import the submission: {}",
+                    paths.strip(why)
+                )
+            })
         };
+        match failure {
+            Some(msg) => fatal(&mut out, msg),
+            None => match session.run(&cases) {
+                Ok(outcomes) => self.tally(&cases, &outcomes, &mut out, &paths),
+                Err(e) => fatal(&mut out, e.to_string()),
+            },
+        }
+        out.stderr_tail = paths.strip(&session.stderr_tail());
+        out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
+        out
+    }
+}
 
-        // Students' triangles are judged by their own winding; the failures are diagnosed.
-        let winding = decide_winding(&cases, &outcomes);
+/// Marks every vector not run, for `msg`: nothing of the code could be checked.
+fn fatal(out: &mut CodeOutcome, msg: String) {
+    for counts in out.per_group.values_mut() {
+        counts.not_run = counts.definite_total;
+    }
+    out.fatal = Some(msg);
+}
+
+/// Names files as the student knows them: without the sandbox's folder (inside and outside)
+/// or the grader's copy of the submission.
+struct PathStripper {
+    sandbox_dir: PathBuf,
+    inside_dir: PathBuf,
+    submission_dir: PathBuf,
+}
+
+impl PathStripper {
+    fn new(session: &Session, submission: &Path) -> Self {
+        PathStripper {
+            sandbox_dir: session.sandbox_dir().to_path_buf(),
+            inside_dir: session.sandbox_inside_dir(),
+            submission_dir: std::path::absolute(submission)
+                .unwrap_or_else(|_| submission.to_path_buf()),
+        }
+    }
+
+    fn strip(&self, text: &str) -> String {
+        let text = if self.inside_dir != self.sandbox_dir {
+            let to = self.submission_dir.display().to_string();
+            crate::sandbox::replace_path(text, &self.inside_dir, &to)
+        } else {
+            text.to_string()
+        };
+        strip_dirs(&text, &[&self.sandbox_dir, &self.submission_dir])
+    }
+}
+
+impl CourseCodeChecker {
+    /// Starts the course adapter on `submission` in the sandbox, or says why it cannot run.
+    fn start(&self, submission: &Path) -> Result<Session, String> {
+        let has_object = std::fs::symlink_metadata(submission.join("RT_object.py"))
+            .map(|m| m.is_file())
+            .unwrap_or(false);
+        if !has_object {
+            return Err("RT_object.py is not in the submission".into());
+        }
+        // Probed once per process (cached): a batch pays for it once.
+        let python = python::choose(self.python.as_deref(), &self.python_requires, &self.policy)
+            .map_err(|e| e.to_string())?;
+        CandidateCommand::python_course_with(submission, Some(&python), true)
+            .and_then(|command| Session::start(command, self.options()))
+            .map_err(|e| match e {
+                HarnessError::Python(e) => format!("cannot run the Python interpreter: {e}"),
+                e => e.to_string(),
+            })
+    }
+
+    /// Counts the outcomes per shape and keeps the failures: students' triangles judged by
+    /// their own winding, the failures diagnosed.
+    fn tally(
+        &self,
+        cases: &[Case],
+        outcomes: &[Outcome],
+        out: &mut CodeOutcome,
+        paths: &PathStripper,
+    ) {
+        let winding = decide_winding(cases, outcomes);
         out.triangle_winding = winding;
-        out.diagnosis = crate::candidate::diagnose::diagnose(&cases, &outcomes, winding);
+        out.diagnosis = crate::candidate::diagnose::diagnose(cases, outcomes, winding);
         let mut definite_failures = Vec::new();
         let mut ambiguous_failures = Vec::new();
-        for (case, outcome) in cases.iter().zip(&outcomes) {
+        for (case, outcome) in cases.iter().zip(outcomes) {
             let kind = case.shape.kind();
             let definite = case.expect.class.is_definite();
             let counts = out.per_group.get_mut(&kind).expect("asked for");
@@ -308,7 +334,7 @@ impl CodeChecker for CourseCodeChecker {
                 definite,
                 expected: serde_json::to_value(&case.expect).unwrap_or_default(),
                 actual,
-                message: strip(&message),
+                message: paths.strip(&message),
                 repro: python_repro(case),
             };
             if definite {
@@ -321,8 +347,6 @@ impl CodeChecker for CourseCodeChecker {
         ambiguous_failures.sort_by_key(|f| f.shape);
         out.failures = definite_failures;
         out.failures.extend(ambiguous_failures);
-        finish(&mut out, &session);
-        out
     }
 }
 

@@ -4,24 +4,23 @@
 //!
 //! This adapter lives in `grade`, not in `compare`, so the comparison knows nothing of rubrics.
 //! It promises: each golden is obtained once per checker (a batch shares one checker) and kept
-//! in memory; a scene file's golden is the rubric's `golden` when it names one, else the one in
-//! the cache ([`crate::golden::cached_golden`]), rendered there the first time (one line on
-//! stderr says so, and indicatif's bar shows the progress when stderr is a terminal). An image
-//! of a scene file is judged as a render of the scene's own `samples_per_pixel` (the count its
-//! students are told to use), with a golden of [`golden_spp`] of it; built-in scenes use the
-//! options' count (20, the course's).
+//! in memory; a scene file's golden is the rubric's `golden` when it names one, else the one
+//! [`crate::golden::golden_of`] gives, as for a built-in scene (embedded, cached, or rendered
+//! into the cache the first time: one line on stderr says so, and indicatif's bar shows the
+//! progress when stderr is a terminal). An image of a scene file is judged as a render of the
+//! scene's own `samples_per_pixel` (the count its students are told to use), with a golden of
+//! [`golden_spp`] of it; built-in scenes use the options' count (20, the course's). A golden's
+//! SHA-256 is that of its EXR bytes.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use sha2::{Digest, Sha256};
-
 use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict, SceneFile, SceneSource};
 use crate::compare::{
-    CandidateImage, CompareError, CompareOptions, Golden, check_size, compare_image,
-    golden_for_scene, golden_spp, write_heatmap,
+    CandidateImage, CompareError, CompareOptions, Golden, check_size, compare_image, write_heatmap,
 };
+use crate::golden::{FoundGolden, GoldenScene, golden_of, golden_spp, sha256_hex};
 use crate::image_io::decode_exr;
 
 /// Grades images with [`compare_image`] against the golden of each scene: for built-in scenes
@@ -65,9 +64,9 @@ impl CompareImageChecker {
         }
         let (golden, sha) = match scene {
             SceneSource::Builtin(name) => {
-                let g = golden_for_scene(name, self.options.samples_per_pixel)?;
-                let sha = hex(&Sha256::digest(g.to_cache_bytes()));
-                (g, sha)
+                let scene =
+                    GoldenScene::builtin(name).map_err(|e| CompareError::Golden(e.to_string()))?;
+                self.found(&scene, self.options.samples_per_pixel)?
             }
             SceneSource::File(f) => self.file_golden(f)?,
         };
@@ -84,58 +83,45 @@ impl CompareImageChecker {
         }
     }
 
+    /// The golden of `scene` for candidates of `candidate_spp` from [`golden_of`] (with this
+    /// checker's cache folder), and its SHA-256.
+    fn found(
+        &self,
+        scene: &GoldenScene,
+        candidate_spp: u32,
+    ) -> Result<(Golden, String), CompareError> {
+        let dir = self.cache_dir.clone().or_else(crate::golden::cache_dir);
+        let FoundGolden {
+            bytes,
+            image,
+            source,
+            ..
+        } = golden_of(scene, golden_spp(candidate_spp), dir.as_deref(), true)
+            .map_err(|e| CompareError::Golden(e.to_string()))?;
+        let mut golden = Golden::from_exr_image(image, &source)?;
+        golden.scene = Some(scene.name.clone());
+        Ok((golden, sha256_hex(&bytes)))
+    }
+
     fn file_golden(&self, f: &SceneFile) -> Result<(Golden, String), CompareError> {
-        let (bytes, path) = match &f.golden {
-            Some(g) => (g.bytes.clone(), g.path.clone()),
-            None => {
-                let spp = golden_spp(f.description.image.samples_per_pixel);
-                let camera = f.description.camera(None);
-                let dir = self.cache_dir.clone().or_else(crate::golden::cache_dir);
-                let cache_file = dir
-                    .as_ref()
-                    .map(|d| crate::golden::cache_file(d, &f.description, spp));
-                if !cache_file.as_ref().is_some_and(|p| p.is_file()) {
-                    crate::output::stderr_line(&format!(
-                        "rendering the golden of {} ({}x{}, {spp} spp), once per cache{}",
-                        crate::escape::terminal_line(&f.label),
-                        camera.width,
-                        camera.height,
-                        cache_file.as_ref().map_or(String::new(), |p| format!(
-                            ": {}",
-                            crate::escape::terminal_line(&p.display().to_string())
-                        ))
-                    ));
-                }
-                let made = crate::golden::cached_golden_in(
-                    dir.as_deref(),
-                    &f.description,
-                    &f.label,
-                    spp,
-                    true,
-                )
-                .map_err(|e| CompareError::Golden(e.to_string()))?;
-                if let Some(why) = &made.warning {
-                    crate::output::stderr_line(&format!(
-                        "warning: the golden of {} is not cached ({}); it is rendered again next time",
-                        crate::escape::terminal_line(&f.label),
-                        crate::escape::terminal_line(why)
-                    ));
-                }
-                let path = made
-                    .path
-                    .clone()
-                    .unwrap_or_else(|| f.path.with_extension("exr"));
-                (made.bytes, path)
+        match &f.golden {
+            Some(g) => {
+                let image = decode_exr(&g.bytes, &g.path)?;
+                let golden = Golden::from_exr_image(image, &g.path)?;
+                Ok((golden, sha256_hex(&g.bytes)))
             }
-        };
-        let image = decode_exr(&bytes, &path)?;
-        let golden = Golden::from_exr_image(image, &path)?;
-        Ok((golden, hex(&Sha256::digest(&bytes))))
+            None => {
+                let scene = golden_scene_of(f).map_err(|e| CompareError::Golden(e.to_string()))?;
+                self.found(&scene, f.description.image.samples_per_pixel)
+            }
+        }
     }
 }
 
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
+/// What the golden of a rubric's scene file is made from: the scene, named by its label, reading
+/// its other files from its folder.
+pub(crate) fn golden_scene_of(f: &SceneFile) -> Result<GoldenScene, crate::golden::GoldenError> {
+    GoldenScene::from_description(&f.label, f.description.clone(), f.path.parent())
 }
 
 fn file_name(path: &Path) -> String {

@@ -28,13 +28,17 @@ pub mod autograder;
 pub mod batch;
 pub mod bench;
 pub mod checkers;
+#[cfg(test)]
+pub(crate) mod fakes;
 pub mod image_checker;
 pub mod inputs;
 pub mod intake;
 pub mod pack;
 pub mod report;
+mod result;
 pub mod rubric;
 mod run;
+mod score;
 mod write;
 
 pub use checkers::CourseCodeChecker;
@@ -44,9 +48,10 @@ pub use inputs::{
     ImageVerdict, SceneFile, SceneSource,
 };
 pub use report::{Format, write_reports};
-pub use rubric::{GoldenFile, Group, GroupKind, Rubric, RubricError, Visibility};
-pub use run::{
+pub use result::{
     CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, GradeError, GradeReport, ImageResult,
-    Reproducibility, grade, round2, smallest_failure,
+    Reproducibility, round2, smallest_failure,
 };
+pub use rubric::{GoldenFile, Group, GroupKind, Rubric, RubricError, Visibility};
+pub use run::grade;
 pub use write::{REPORT_FOLDER, grade_to_dir};

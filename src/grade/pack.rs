@@ -2,7 +2,8 @@
 //!
 //! [`pack_rubric`] promises: every image group on a scene file gets its scene file (the
 //! original bytes, so its SHA-256 in `report.json` is the instructor's file's) and a golden
-//! (the rubric's own, else the cached one, rendered now if missing) under
+//! (the rubric's own, else [`crate::golden::golden_of`]'s, rendered into the cache now if
+//! missing) under
 //! [`PACKED_SCENES`]`/`, and the packed rubric names them there, so grading from the package
 //! never renders. Built-in scenes need nothing: their goldens are in the binary.
 
@@ -10,7 +11,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::rubric::{GroupKind, Rubric};
-use crate::compare::golden_spp;
+use crate::golden::{cache_dir, golden_of, golden_spp};
 
 /// The folder of the package (beside `rubric.toml`) holding the scene files and goldens.
 pub const PACKED_SCENES: &str = "rtoracle-scenes";
@@ -85,16 +86,13 @@ pub fn pack_rubric(rubric: &Rubric, rubric_text: &str) -> Result<PackedRubric, P
             Some(g) => g.bytes.clone(),
             None => {
                 let spp = golden_spp(scene.description.image.samples_per_pixel);
-                let made =
-                    crate::golden::cached_golden(&scene.description, &scene.label, spp, true)
-                        .map_err(|e| {
-                            PackError::Golden(
-                                rubric.source.clone(),
-                                scene.label.clone(),
-                                e.to_string(),
-                            )
-                        })?;
-                rendered += usize::from(made.rendered);
+                let fail = |e: crate::golden::GoldenError| {
+                    PackError::Golden(rubric.source.clone(), scene.label.clone(), e.to_string())
+                };
+                let made = super::image_checker::golden_scene_of(scene)
+                    .and_then(|g| golden_of(&g, spp, cache_dir().as_deref(), true))
+                    .map_err(fail)?;
+                rendered += usize::from(made.rendered());
                 made.bytes
             }
         };

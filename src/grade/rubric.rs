@@ -43,7 +43,7 @@
 //! missing file, an unparsable scene or a golden of another scene stops the grading before it
 //! starts, with one line naming the rubric. Without a `golden`, the image checker renders the
 //! golden the first time it is needed and keeps it in the cache
-//! ([`crate::golden::cached_golden`]).
+//! ([`crate::golden::golden_of`]).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -450,113 +450,126 @@ impl Rubric {
         Ok(())
     }
 
-    fn validate(&self) -> Result<(), RubricError> {
-        let invalid = |message: String| RubricError::Invalid {
+    fn invalid(&self, message: String) -> RubricError {
+        RubricError::Invalid {
             path: self.source.clone(),
             message,
-        };
+        }
+    }
+
+    fn validate(&self) -> Result<(), RubricError> {
         if self.groups.is_empty() {
-            return Err(invalid("the rubric has no [[group]]".into()));
+            return Err(self.invalid("the rubric has no [[group]]".into()));
         }
         let budget = self.code_time_budget_seconds;
         if !(budget.is_finite() && budget > 0.0 && budget <= 86_400.0) {
-            return Err(invalid(format!(
+            return Err(self.invalid(format!(
                 "code_time_budget_seconds = {budget}: it must be more than 0 and at most 86400"
             )));
         }
         let mut ids = BTreeSet::new();
         for g in &self.groups {
             if g.id.is_empty() || g.id.contains(char::is_whitespace) {
-                return Err(invalid(format!(
+                return Err(self.invalid(format!(
                     "group id {:?} must be non-empty without spaces",
                     g.id
                 )));
             }
             if !ids.insert(g.id.as_str()) {
-                return Err(invalid(format!("group id {:?} appears twice", g.id)));
+                return Err(self.invalid(format!("group id {:?} appears twice", g.id)));
             }
             if !(g.points.is_finite() && g.points >= 0.0) {
-                return Err(invalid(format!(
+                return Err(self.invalid(format!(
                     "group {:?}: points must be a number >= 0, found {}",
                     g.id, g.points
                 )));
             }
             match g.kind {
-                GroupKind::Code => {
-                    if g.shape.is_none() {
-                        return Err(invalid(format!(
-                            "code group {:?} needs a shape (sphere, quad or triangle)",
-                            g.id
-                        )));
-                    }
-                    if g.file.is_some() || g.scene.is_some() || g.golden.is_some() {
-                        return Err(invalid(format!(
-                            "code group {:?} takes no file, scene or golden",
-                            g.id
-                        )));
-                    }
-                }
-                GroupKind::Image => {
-                    if !g.id.starts_with("image.") {
-                        return Err(invalid(format!(
-                            "image group id {:?} must start with \"image.\"",
-                            g.id
-                        )));
-                    }
-                    let Some(scene) = &g.scene else {
-                        return Err(invalid(format!("image group {:?} needs a scene", g.id)));
-                    };
-                    let builtin = crate::scene::builtin(scene).is_ok();
-                    if !builtin && !scene.ends_with(".toml") {
-                        return Err(invalid(format!(
-                            "image group {:?}: unknown scene {scene:?} (known: {}; or a scene file FILE.toml relative to the rubric)",
-                            g.id,
-                            crate::scene::builtin_names().join(", ")
-                        )));
-                    }
-                    match &g.file {
-                        None if builtin => {
-                            return Err(invalid(format!(
-                                "image group {:?} needs a file (the image in the submission)",
-                                g.id
-                            )));
-                        }
-                        Some(file)
-                            if file.is_empty()
-                                || file.contains('/')
-                                || file.contains('\\')
-                                || file.starts_with('.') =>
-                        {
-                            return Err(invalid(format!(
-                                "image group {:?}: file {file:?} must be a plain file name",
-                                g.id
-                            )));
-                        }
-                        _ => {}
-                    }
-                    if !builtin {
-                        let stem = Path::new(scene)
-                            .file_stem()
-                            .map(|s| s.to_string_lossy().to_string())
-                            .unwrap_or_default();
-                        if g.file.is_none() && (stem.is_empty() || stem.starts_with('.')) {
-                            return Err(invalid(format!(
-                                "image group {:?}: give a file, the scene file's name {scene:?} makes no image name",
-                                g.id
-                            )));
-                        }
-                    }
-                    if g.score_ambiguous || g.shape.is_some() {
-                        return Err(invalid(format!(
-                            "image group {:?} takes no shape or score_ambiguous",
-                            g.id
-                        )));
-                    }
-                }
+                GroupKind::Code => self.validate_code_group(g)?,
+                GroupKind::Image => self.validate_image_group(g)?,
             }
         }
-        // One image file can answer one group only: two groups wanting the same file (two scene
-        // files of the same name, say) could never both pass.
+        self.validate_image_files()
+    }
+
+    fn validate_code_group(&self, g: &Group) -> Result<(), RubricError> {
+        if g.shape.is_none() {
+            return Err(self.invalid(format!(
+                "code group {:?} needs a shape (sphere, quad or triangle)",
+                g.id
+            )));
+        }
+        if g.file.is_some() || g.scene.is_some() || g.golden.is_some() {
+            return Err(self.invalid(format!(
+                "code group {:?} takes no file, scene or golden",
+                g.id
+            )));
+        }
+        Ok(())
+    }
+
+    fn validate_image_group(&self, g: &Group) -> Result<(), RubricError> {
+        if !g.id.starts_with("image.") {
+            return Err(self.invalid(format!(
+                "image group id {:?} must start with \"image.\"",
+                g.id
+            )));
+        }
+        let Some(scene) = &g.scene else {
+            return Err(self.invalid(format!("image group {:?} needs a scene", g.id)));
+        };
+        let builtin = crate::scene::builtin(scene).is_ok();
+        if !builtin && !scene.ends_with(".toml") {
+            return Err(self.invalid(format!(
+                "image group {:?}: unknown scene {scene:?} (known: {}; or a scene file FILE.toml relative to the rubric)",
+                g.id,
+                crate::scene::builtin_names().join(", ")
+            )));
+        }
+        match &g.file {
+            None if builtin => {
+                return Err(self.invalid(format!(
+                    "image group {:?} needs a file (the image in the submission)",
+                    g.id
+                )));
+            }
+            Some(file)
+                if file.is_empty()
+                    || file.contains('/')
+                    || file.contains('\\')
+                    || file.starts_with('.') =>
+            {
+                return Err(self.invalid(format!(
+                    "image group {:?}: file {file:?} must be a plain file name",
+                    g.id
+                )));
+            }
+            _ => {}
+        }
+        if !builtin {
+            let stem = Path::new(scene)
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_default();
+            if g.file.is_none() && (stem.is_empty() || stem.starts_with('.')) {
+                return Err(self.invalid(format!(
+                    "image group {:?}: give a file, the scene file's name {scene:?} makes no image name",
+                    g.id
+                )));
+            }
+        }
+        if g.score_ambiguous || g.shape.is_some() {
+            return Err(self.invalid(format!(
+                "image group {:?} takes no shape or score_ambiguous",
+                g.id
+            )));
+        }
+        Ok(())
+    }
+
+    /// One image file can answer one group only: two groups wanting the same file (two scene
+    /// files of the same name, say) could never both pass.
+    fn validate_image_files(&self) -> Result<(), RubricError> {
         let mut files: Vec<(String, &str)> = Vec::new();
         for g in self.groups.iter().filter(|g| g.kind == GroupKind::Image) {
             let file = match (&g.file, &g.scene) {
@@ -571,7 +584,7 @@ impl Rubric {
                 (None, None) => continue,
             };
             if let Some((_, first)) = files.iter().find(|(f, _)| *f == file) {
-                return Err(invalid(format!(
+                return Err(self.invalid(format!(
                     "image groups {first:?} and {:?} both want the image {file:?}; give one of them another `file`",
                     g.id
                 )));

@@ -6,8 +6,9 @@ use std::path::Path;
 
 use super::inputs::{CodeChecker, ImageChecker};
 use super::report::Format;
+use super::result::{GradeError, GradeReport};
 use super::rubric::Rubric;
-use super::run::{GradeError, GradeReport, grade};
+use super::run::grade;
 use crate::output::{OutputDir, Replaceable};
 
 /// Whether `name` is a file rtoracle's reports consist of (so an old report folder may be
@@ -82,7 +83,7 @@ pub(crate) fn grade_into(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grade::run::fakes::*;
+    use crate::grade::fakes::*;
     use crate::output::tests::names;
 
     #[test]

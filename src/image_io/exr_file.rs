@@ -13,7 +13,7 @@ use std::path::Path;
 
 use exr::prelude::{
     AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer, LayerAttributes,
-    ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
+    Layers, ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
 };
 
 use super::{ImageError, write_atomically};
@@ -241,141 +241,16 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, ImageError> {
 
 /// Decodes the bytes of an EXR file as [`read_exr`] does; `name` labels errors.
 pub fn decode_exr(bytes: &[u8], name: &Path) -> Result<ExrImage, ImageError> {
-    if bytes.len() < 4 || bytes[..4] != MAGIC {
-        return Err(ImageError::format(
-            name,
-            "is not an OpenEXR file (it does not start with the EXR magic number)",
-        ));
-    }
-    check_sizes(bytes, name)?;
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .all_layers()
-        .all_attributes()
-        .non_parallel()
-        .pedantic()
-        .from_buffered(Cursor::new(bytes))
-        .map_err(|e| {
-            ImageError::format(
-                name,
-                format!(
-                    "is a truncated or damaged OpenEXR file: {}",
-                    one_line(&e.to_string())
-                ),
-            )
-        })?;
-
+    let image = decode_layers(bytes, name)?;
     let layers = &image.layer_data;
-    let Some(main) = layers
-        .iter()
-        .find(|l| ["R", "G", "B"].iter().all(|c| find(l, c).is_some()))
-    else {
-        let names: Vec<String> = layers
-            .iter()
-            .flat_map(|l| {
-                let prefix = l
-                    .attributes
-                    .layer_name
-                    .as_ref()
-                    .map(|n| format!("{n}/"))
-                    .unwrap_or_default();
-                l.channel_data
-                    .list
-                    .iter()
-                    .map(move |c| format!("{prefix}{}", c.name))
-            })
-            .collect();
-        return Err(ImageError::format(
-            name,
-            format!(
-                "has no R, G, B channels (it has {})",
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            ),
-        ));
+    let main = main_layer(layers, name)?;
+    let samples = Samples {
+        name,
+        width: main.size.0,
+        height: main.size.1,
     };
-    let (width, height) = (main.size.0, main.size.1);
-    let count = width * height;
-    let values = |channel: &AnyChannel<FlatSamples>| -> Result<Vec<f32>, ImageError> {
-        if channel.sampling != exr::math::Vec2(1, 1) {
-            return Err(ImageError::format(
-                name,
-                format!(
-                    "channel {} is subsampled, which rtoracle does not read",
-                    channel.name
-                ),
-            ));
-        }
-        let v: Vec<f32> = channel.sample_data.values_as_f32().collect();
-        if v.len() != count {
-            return Err(ImageError::format(
-                name,
-                format!(
-                    "channel {} has {} samples for {width}x{height} pixels",
-                    channel.name,
-                    v.len()
-                ),
-            ));
-        }
-        Ok(v)
-    };
-    let triple = |channels: [&AnyChannel<FlatSamples>; 3]| -> Result<Vec<[f32; 3]>, ImageError> {
-        let [r, g, b] = channels.map(values);
-        let (r, g, b) = (r?, g?, b?);
-        Ok((0..count).map(|i| [r[i], g[i], b[i]]).collect())
-    };
-    let rgb = |layer| {
-        let get = |c| find(layer, c).expect("checked above");
-        triple([get("R"), get("G"), get("B")])
-    };
-    let mean = rgb(main)?;
-
-    // The variance: `variance.*` channels beside R, G, B, or a part named `variance`.
-    let prefixed = ["variance.R", "variance.G", "variance.B"].map(|c| find(main, c));
-    let variance = match prefixed {
-        [Some(r), Some(g), Some(b)] => Some(triple([r, g, b])?),
-        [None, None, None] => {
-            let part = layers.iter().find(|l| {
-                l.attributes
-                    .layer_name
-                    .as_ref()
-                    .is_some_and(|n| n.bytes() == b"variance")
-            });
-            match part {
-                Some(part) if part.size != main.size => {
-                    return Err(ImageError::format(
-                        name,
-                        "the variance part's size differs from the image's",
-                    ));
-                }
-                Some(part) if ["R", "G", "B"].iter().all(|c| find(part, c).is_some()) => {
-                    Some(rgb(part)?)
-                }
-                _ => None,
-            }
-        }
-        _ => {
-            let missing: Vec<&str> = ["variance.R", "variance.G", "variance.B"]
-                .into_iter()
-                .zip(prefixed)
-                .filter(|(_, c)| c.is_none())
-                .map(|(n, _)| n)
-                .collect();
-            return Err(ImageError::format(
-                name,
-                format!(
-                    "has a partial variance layer (missing {})",
-                    missing.join(", ")
-                ),
-            ));
-        }
-    };
-
+    let mean = samples.rgb(main)?;
+    let variance = variance_of(layers, main, &samples)?;
     let mut attributes: Vec<(String, String)> = image
         .attributes
         .other
@@ -392,12 +267,180 @@ pub fn decode_exr(bytes: &[u8], name: &Path) -> Result<ExrImage, ImageError> {
     attributes.sort();
     attributes.dedup();
     Ok(ExrImage {
-        width,
-        height,
+        width: samples.width,
+        height: samples.height,
         mean,
         variance,
         attributes,
     })
+}
+
+/// A decoded file's layers: every channel of every part.
+type Decoded = Image<Layers<AnyChannels<FlatSamples>>>;
+
+/// One layer of a decoded file.
+type DecodedLayer = Layer<AnyChannels<FlatSamples>>;
+
+/// Checks the magic number and the header's sizes, then decodes every channel of every part.
+fn decode_layers(bytes: &[u8], name: &Path) -> Result<Decoded, ImageError> {
+    if bytes.len() < 4 || bytes[..4] != MAGIC {
+        return Err(ImageError::format(
+            name,
+            "is not an OpenEXR file (it does not start with the EXR magic number)",
+        ));
+    }
+    check_sizes(bytes, name)?;
+    exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .non_parallel()
+        .pedantic()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| {
+            ImageError::format(
+                name,
+                format!(
+                    "is a truncated or damaged OpenEXR file: {}",
+                    one_line(&e.to_string())
+                ),
+            )
+        })
+}
+
+/// The first layer with `R`, `G` and `B` channels, or an error listing the channels there are.
+fn main_layer<'a>(layers: &'a [DecodedLayer], name: &Path) -> Result<&'a DecodedLayer, ImageError> {
+    if let Some(main) = layers
+        .iter()
+        .find(|l| ["R", "G", "B"].iter().all(|c| find(l, c).is_some()))
+    {
+        return Ok(main);
+    }
+    let names: Vec<String> = layers
+        .iter()
+        .flat_map(|l| {
+            let prefix = l
+                .attributes
+                .layer_name
+                .as_ref()
+                .map(|n| format!("{n}/"))
+                .unwrap_or_default();
+            l.channel_data
+                .list
+                .iter()
+                .map(move |c| format!("{prefix}{}", c.name))
+        })
+        .collect();
+    Err(ImageError::format(
+        name,
+        format!(
+            "has no R, G, B channels (it has {})",
+            if names.is_empty() {
+                "none".to_string()
+            } else {
+                names.join(", ")
+            }
+        ),
+    ))
+}
+
+/// Reads the samples of a file's channels, which must each hold one sample per pixel.
+struct Samples<'a> {
+    /// The file, for errors.
+    name: &'a Path,
+    width: usize,
+    height: usize,
+}
+
+impl Samples<'_> {
+    /// The samples of one channel as `f32`.
+    fn values(&self, channel: &AnyChannel<FlatSamples>) -> Result<Vec<f32>, ImageError> {
+        let (width, height) = (self.width, self.height);
+        if channel.sampling != exr::math::Vec2(1, 1) {
+            return Err(ImageError::format(
+                self.name,
+                format!(
+                    "channel {} is subsampled, which rtoracle does not read",
+                    channel.name
+                ),
+            ));
+        }
+        let v: Vec<f32> = channel.sample_data.values_as_f32().collect();
+        if v.len() != width * height {
+            return Err(ImageError::format(
+                self.name,
+                format!(
+                    "channel {} has {} samples for {width}x{height} pixels",
+                    channel.name,
+                    v.len()
+                ),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// Three channels as one RGB pixel each.
+    fn triple(&self, channels: [&AnyChannel<FlatSamples>; 3]) -> Result<Vec<[f32; 3]>, ImageError> {
+        let [r, g, b] = channels.map(|c| self.values(c));
+        let (r, g, b) = (r?, g?, b?);
+        Ok((0..self.width * self.height)
+            .map(|i| [r[i], g[i], b[i]])
+            .collect())
+    }
+
+    /// The `R`, `G`, `B` channels of a layer known to have them.
+    fn rgb(&self, layer: &DecodedLayer) -> Result<Vec<[f32; 3]>, ImageError> {
+        let get = |c| find(layer, c).expect("checked above");
+        self.triple([get("R"), get("G"), get("B")])
+    }
+}
+
+/// The variance: `variance.*` channels beside R, G, B, or a part named `variance`; `None` when
+/// the file has neither, an error when it has part of one.
+fn variance_of(
+    layers: &[DecodedLayer],
+    main: &DecodedLayer,
+    samples: &Samples<'_>,
+) -> Result<Option<Vec<[f32; 3]>>, ImageError> {
+    let prefixed = ["variance.R", "variance.G", "variance.B"].map(|c| find(main, c));
+    match prefixed {
+        [Some(r), Some(g), Some(b)] => Ok(Some(samples.triple([r, g, b])?)),
+        [None, None, None] => {
+            let part = layers.iter().find(|l| {
+                l.attributes
+                    .layer_name
+                    .as_ref()
+                    .is_some_and(|n| n.bytes() == b"variance")
+            });
+            match part {
+                Some(part) if part.size != main.size => Err(ImageError::format(
+                    samples.name,
+                    "the variance part's size differs from the image's",
+                )),
+                Some(part) if ["R", "G", "B"].iter().all(|c| find(part, c).is_some()) => {
+                    Ok(Some(samples.rgb(part)?))
+                }
+                _ => Ok(None),
+            }
+        }
+        _ => {
+            let missing: Vec<&str> = ["variance.R", "variance.G", "variance.B"]
+                .into_iter()
+                .zip(prefixed)
+                .filter(|(_, c)| c.is_none())
+                .map(|(n, _)| n)
+                .collect();
+            Err(ImageError::format(
+                samples.name,
+                format!(
+                    "has a partial variance layer (missing {})",
+                    missing.join(", ")
+                ),
+            ))
+        }
+    }
 }
 
 /// The smallest limit on the decoded pixel bytes of a file (see [`check_sizes`]).
@@ -473,10 +516,7 @@ pub fn exr_part_sizes(bytes: &[u8]) -> Result<Vec<(usize, usize, usize)>, String
 }
 
 /// The channel called `label` of `layer`.
-fn find<'a>(
-    layer: &'a Layer<AnyChannels<FlatSamples>>,
-    label: &str,
-) -> Option<&'a AnyChannel<FlatSamples>> {
+fn find<'a>(layer: &'a DecodedLayer, label: &str) -> Option<&'a AnyChannel<FlatSamples>> {
     layer
         .channel_data
         .list

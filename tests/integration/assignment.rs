@@ -715,7 +715,13 @@ fn honest_independent_renders_of_scene_files_at_1_and_50_spp_get_full_marks_flip
     );
     assert!(!p.join("q.exr").exists());
     // `golden FILE.toml` with no --spp makes the golden a grading of that scene uses.
-    let made = run_in(p, &["golden", "fifty.toml", "-o", "fifty.exr"]);
+    // From the cache the grading filled: the same bytes, rendering nothing.
+    let made = rtoracle()
+        .current_dir(p)
+        .env("RTORACLE_CACHE_DIR", &cache)
+        .args(["golden", "fifty.toml", "-o", "fifty.exr"])
+        .output()
+        .unwrap();
     assert!(made.status.success(), "{}", stderr(&made));
     assert!(
         String::from_utf8_lossy(&made.stdout).contains("(5000 spp, seed 0,"),
@@ -725,7 +731,12 @@ fn honest_independent_renders_of_scene_files_at_1_and_50_spp_get_full_marks_flip
     let d = SceneDescription::from_file(&p.join("fifty.toml")).unwrap();
     assert_eq!(
         std::fs::read(p.join("fifty.exr")).unwrap(),
-        std::fs::read(rtoracle::golden::cache_file(&cache, &d, 5000)).unwrap()
+        std::fs::read(rtoracle::golden::cache_file(
+            &cache,
+            &rtoracle::golden::GoldenScene::from_description("fifty.toml", d, None).unwrap(),
+            5000
+        ))
+        .unwrap()
     );
 }
 

@@ -26,8 +26,10 @@ fn golden(scene: &str) -> &'static Golden {
         _ => panic!("no test golden for {scene}"),
     };
     cell.get_or_init(|| {
-        rtoracle::compare::golden::embedded_golden(scene, rtoracle::compare::golden_spp(20))
-            .expect("the course goldens are embedded")
+        let scene = rtoracle::golden::GoldenScene::builtin(scene).unwrap();
+        let found = rtoracle::golden::golden_of(&scene, 4096, None, false).unwrap();
+        assert_eq!(found.origin, rtoracle::golden::GoldenOrigin::Embedded);
+        Golden::from_exr_image(found.image, &found.source).unwrap()
     })
 }
 
@@ -731,10 +733,10 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
         "broken.toml: malformed scene file",
     );
     // A golden made ahead of time, given with its scene: judged at the scene's 1 spp, as with
-    // the cached golden (alone, --golden cannot know the scene's spp and takes 20, which the
-    // honest 1-spp render fails).
+    // the cached golden (a 20-spp claim, which the honest 1-spp render fails, is tried below).
     let made = rtoracle()
         .current_dir(dir.path())
+        .env("RTORACLE_CACHE_DIR", cache())
         .args(["golden", "mine.toml", "-o", "mine.exr"])
         .output()
         .unwrap();
@@ -755,9 +757,26 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
             .code(),
         Some(1)
     );
+    // Alone, --golden judges at the spp of the scene the golden holds (1 here), and says so.
     let alone = compare_cli(dir.path(), &["honest.png", "--golden", "mine.exr"]);
-    assert_eq!(alone.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&alone.stdout).contains(", 20 spp against"));
+    let text = String::from_utf8_lossy(&alone.stdout);
+    assert_eq!(alone.status.code(), Some(0), "{text}");
+    assert!(text.contains(", 1 spp against"), "{text}");
+    assert!(
+        text.contains("judged as a render of 1 spp, the samples_per_pixel of mine.toml"),
+        "{text}"
+    );
+    // --spp still decides, and then nothing is said about where the count came from.
+    let given = compare_cli(
+        dir.path(),
+        &["honest.png", "--golden", "mine.exr", "--spp", "20"],
+    );
+    let text = String::from_utf8_lossy(&given.stdout);
+    assert_eq!(given.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains(", 20 spp against") && !text.contains("judged as"),
+        "{text}"
+    );
     // A golden of another scene, or none, is refused before any work.
     let mut other = d.clone();
     other.materials[0].albedo[0] += 0.1;
@@ -773,5 +792,59 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
     assert_bad_input(
         &compare_cli(dir.path(), &["honest.png", "--golden", "none.exr"]),
         "none.exr: no such file",
+    );
+}
+
+/// `--golden` alone with a built-in scene's golden judges at that scene's spp (20), and a golden
+/// that records no scene at 20 with a line saying it does not know.
+#[test]
+fn compare_with_a_golden_alone_uses_the_spp_it_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = rtoracle::scene::builtin("week04-quad").unwrap();
+    write(
+        dir.path(),
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 20, 8),
+    );
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("golden/week04-quad.exr");
+    let out = compare_cli(
+        dir.path(),
+        &["honest.png", "--golden", committed.to_str().unwrap()],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains(
+            "judged as a render of 20 spp, the samples_per_pixel of the built-in scene week04-quad"
+        ),
+        "{text}"
+    );
+    // The same pixels with no scene attributes: 20, and it says it does not know.
+    let mut image = rtoracle::image_io::read_exr(&committed).unwrap();
+    image.attributes.retain(|(k, _)| k == "rtoracle.spp");
+    let film = rtoracle::render::Film {
+        width: image.width,
+        height: image.height,
+        samples_per_pixel: 4096,
+        mean: image
+            .mean
+            .iter()
+            .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+            .collect(),
+        variance: image.variance.as_ref().map(|v| {
+            v.iter()
+                .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+                .collect()
+        }),
+    };
+    rtoracle::image_io::write_exr(&dir.path().join("bare.exr"), &film, &image.attributes).unwrap();
+    let out = compare_cli(dir.path(), &["honest.png", "--golden", "bare.exr"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains(
+            "judged as a render of 20 spp: this golden does not say its scene's samples per pixel"
+        ),
+        "{text}"
     );
 }

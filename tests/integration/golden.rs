@@ -14,8 +14,8 @@ use insta::internals::SnapshotContents;
 use insta::{Comparator, Snapshot};
 use rtoracle::golden::{
     ATTR_SCENE, ATTR_SCENE_SHA256, ATTR_SEED, ATTR_SPP, ATTR_VERSION, GOLDEN_SEED, GOLDEN_SPP,
-    Tolerance, compare_goldens, embedded_golden, golden_attributes, golden_bytes, golden_file_name,
-    render_golden, scene_sha256,
+    GoldenScene, Tolerance, compare_goldens, embedded_golden, embedded_scenes, golden_attributes,
+    golden_file_name, render_golden, render_golden_bytes, scene_sha256,
 };
 use rtoracle::image_io::{ExrImage, decode_exr, encode_exr, read_exr};
 use rtoracle::scene::{builtin, builtin_names};
@@ -173,7 +173,7 @@ fn assert_same_pixels(expected: &ExrImage, actual: &ExrImage, what: &str) {
 /// Regenerates a course golden at full spp, snapshots it, and checks it is the committed golden
 /// bit for bit (rendered in another process, so also across hash seeds and thread schedules).
 fn full_spp_snapshot(scene: &str) {
-    let bytes = golden_bytes(scene, GOLDEN_SPP, GOLDEN_SEED, false).unwrap();
+    let bytes = golden_bytes(scene, GOLDEN_SPP);
     let fresh = decode_exr(&bytes, Path::new("fresh")).unwrap();
     let file = committed(scene);
     assert_same_pixels(
@@ -216,7 +216,7 @@ fn prefix_mean_bound(s2: f64, n: f64, big_n: f64) -> f64 {
 fn reduced_spp_snapshot(scene: &str) {
     const N: u32 = 256;
     let description = builtin(scene).unwrap();
-    let film = render_golden(scene, N, GOLDEN_SEED, false).unwrap();
+    let film = render_golden(&GoldenScene::builtin(scene).unwrap(), N, false).unwrap();
     let golden = committed(scene);
     assert_eq!(golden.attribute(ATTR_SPP), Some("4096"));
     assert_eq!(
@@ -249,7 +249,7 @@ fn reduced_spp_snapshot(scene: &str) {
     }
     // Most pixels are flat, where the bound is exact equality.
     assert!(flat_checked > film.mean.len(), "{flat_checked}");
-    let attributes = golden_attributes(scene, &description, N, GOLDEN_SEED);
+    let attributes = golden_attributes(&GoldenScene::builtin(scene).unwrap(), N, GOLDEN_SEED);
     let bytes = encode_exr(&film, &attributes, Path::new(scene)).unwrap();
     assert_exr_snapshot(&format!("{scene}-{N}spp.exr"), bytes);
 }
@@ -292,21 +292,43 @@ fn snapshots_are_the_golden_files() {
     }
 }
 
+/// Every golden in `golden/` is compiled in, byte for byte, and is the golden of its built-in
+/// scene as the scene is now (else the library would render it again at run time: a built-in
+/// without a committed golden is still served, from the cache).
 #[test]
 fn embedded_goldens_are_the_files() {
-    for scene in builtin_names() {
+    let mut files: Vec<String> = std::fs::read_dir(golden_dir())
+        .unwrap()
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().to_string();
+            name.strip_suffix(".exr").map(String::from)
+        })
+        .collect();
+    files.sort();
+    let mut embedded: Vec<String> = embedded_scenes().into_iter().map(String::from).collect();
+    embedded.sort();
+    assert_eq!(
+        files, embedded,
+        "golden/*.exr and the embedded table differ"
+    );
+    for scene in embedded_scenes() {
         let file = std::fs::read(golden_dir().join(golden_file_name(scene))).unwrap();
         assert!(
             embedded_golden(scene) == Some(file.as_slice()),
             "{scene}: the embedded golden is stale; rebuild"
         );
+        let fits = GoldenScene::builtin(scene)
+            .unwrap()
+            .fits(&file, Path::new(scene));
+        assert!(fits.is_ok(), "golden/{scene}.exr: {}", fits.unwrap_err());
     }
     assert!(embedded_golden("no-such-scene").is_none());
 }
 
 #[test]
 fn goldens_have_the_documented_channels_and_attributes() {
-    for scene in builtin_names() {
+    for scene in embedded_scenes() {
         let g = committed(scene);
         let d = builtin(scene).unwrap();
         let camera = d.camera(None);
@@ -346,12 +368,12 @@ fn golden_bytes_do_not_depend_on_the_thread_count() {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| golden_bytes(scene, 16, GOLDEN_SEED, false).unwrap())
+                .install(|| golden_bytes(scene, 16))
         };
         let one = with(1);
         assert!(one == with(2), "{scene}: 1 vs 2 threads");
         assert!(one == with(3), "{scene}: 1 vs 3 threads");
-        assert!(one == golden_bytes(scene, 16, GOLDEN_SEED, false).unwrap());
+        assert!(one == golden_bytes(scene, 16));
     }
 }
 
@@ -458,14 +480,14 @@ fn openexr_reads_the_goldens() {
     if !openexr_python("openexr_reads_the_goldens") {
         return;
     }
-    let paths: Vec<String> = builtin_names()
+    let paths: Vec<String> = embedded_scenes()
         .iter()
         .map(|s| golden_dir().join(golden_file_name(s)).display().to_string())
         .collect();
     let mut args = vec![env!("CARGO_BIN_EXE_rtoracle")];
     args.extend(paths.iter().map(String::as_str));
     let report: serde_json::Value = serde_json::from_str(&python(OPENEXR_INSPECT, &args)).unwrap();
-    for (scene, path) in builtin_names().into_iter().zip(&paths) {
+    for (scene, path) in embedded_scenes().into_iter().zip(&paths) {
         let r = &report[path.as_str()];
         let ours = read_exr(Path::new(path)).unwrap();
         assert_eq!(r["width"], ours.width, "{scene}");
@@ -581,7 +603,7 @@ fn golden_cli_writes_then_checks_equal() {
     );
     assert!(stdout(&out).contains("wrote g/week04-quad.exr (2 spp, seed 0"));
     let written = std::fs::read(dir.path().join("g/triangles.exr")).unwrap();
-    assert!(written == golden_bytes("triangles", 2, 0, false).unwrap());
+    assert!(written == golden_bytes("triangles", 2));
 
     let mut check = args.to_vec();
     check.push("--check");
@@ -595,7 +617,7 @@ fn golden_check_names_the_differing_pixel() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("g")).unwrap();
     // A golden of 2 spp with one value changed: pixel (17, 5), channel G.
-    let bytes = golden_bytes("week04-quad", 2, 0, false).unwrap();
+    let bytes = golden_bytes("week04-quad", 2);
     let mut img = decode_exr(&bytes, Path::new("x")).unwrap();
     img.mean[5 * 400 + 17][1] += 0.25;
     let to_film = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
@@ -672,7 +694,7 @@ fn golden_check_rejects_unreadable_files() {
     let out = run_in(dir.path(), &check);
     assert_bad_input(&out, "g/week04-quad.exr: is not an OpenEXR file");
 
-    let good = golden_bytes("week04-quad", 1, 0, false).unwrap();
+    let good = golden_bytes("week04-quad", 1);
     std::fs::write(g.join("week04-quad.exr"), &good[..good.len() / 3]).unwrap();
     let out = run_in(dir.path(), &check);
     assert_bad_input(
@@ -703,4 +725,9 @@ fn golden_cli_rejects_bad_arguments() {
     );
     assert_bad_input(&out, "file");
     assert!(!dir.path().join("file/week04-quad.exr").exists());
+}
+
+/// The bytes of a fresh golden of the built-in `scene` at `spp`.
+fn golden_bytes(scene: &str, spp: u32) -> Vec<u8> {
+    render_golden_bytes(&GoldenScene::builtin(scene).unwrap(), spp, false).unwrap()
 }

@@ -933,3 +933,56 @@ fn nothing_names_a_design_note_outside_the_repository() {
         found.join("\n")
     );
 }
+
+/// Each package of `cargo tree` with the features it is built with, for the dependency `edges`
+/// given (`no-dev`: what `cargo run --release` builds; `all`: what `cargo test` builds).
+fn resolved_features(edges: &str) -> std::collections::BTreeMap<String, String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = Command::new(cargo)
+        .args(["tree", "--offline", "--locked", "--prefix", "none"])
+        .args(["-e", edges, "-f", "{p}|{f}"])
+        .current_dir(root())
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|line| {
+            let (package, features) = line.trim_end_matches(" (*)").split_once('|')?;
+            Some((package.trim().to_string(), features.trim().to_string()))
+        })
+        .collect()
+}
+
+/// The README's two set-up commands share one build: `cargo test --release` resolves, for every
+/// dependency, the features `cargo run --release` resolved. Cargo turns on the features that
+/// dev-dependencies ask of a shared dependency only when it builds tests, so a dev-dependency
+/// that asks for one makes the second command rebuild that dependency, everything above it and
+/// the library. The fix is to turn the same features on in `[dependencies]` (as `Cargo.toml`
+/// does for getrandom and once_cell).
+#[test]
+fn the_tests_resolve_the_features_of_the_release_build() {
+    let release = resolved_features("no-dev");
+    let tests = resolved_features("all");
+    assert!(release.len() > 20, "cargo tree listed {release:?}");
+    let differ: Vec<String> = release
+        .iter()
+        .filter_map(|(package, features)| {
+            let with_dev = tests.get(package)?;
+            (with_dev != features).then(|| {
+                format!(
+                    "{package}: [{features}] without the dev-dependencies, [{with_dev}] with them"
+                )
+            })
+        })
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "`cargo test --release` would rebuild these and the library; turn their features on in [dependencies]:\n{}",
+        differ.join("\n")
+    );
+}

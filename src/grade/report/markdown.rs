@@ -11,8 +11,8 @@
 use std::fmt::Write;
 
 use crate::escape::{markdown_block, markdown_inline};
+use crate::grade::result::smallest_case_sentence;
 use crate::grade::rubric::Visibility;
-use crate::grade::run::smallest_case_sentence;
 use crate::grade::{CheckResult, CheckStatus, GradeReport, smallest_failure};
 
 /// Points as short as they go: `15`, `7.5`, `33.33`.
@@ -209,7 +209,7 @@ pub fn render(report: &GradeReport) -> String {
 
 #[cfg(test)]
 mod tests {
-    use crate::grade::run::fakes::{FakeCode, all_pass, counts, fake_images};
+    use crate::grade::fakes::{FakeCode, all_pass, counts, fake_images};
     use crate::grade::{Rubric, grade, rubric::WEEK04_RUBRIC};
 
     #[test]

@@ -1,20 +1,29 @@
-//! Goldens: the reference's per-pixel mean and per-sample variance at many samples per pixel.
+//! The golden as the noise model reads it: per pixel and channel the mean of `M` samples, their
+//! per-sample variance, and a bound on how far one sample may lie from the mean.
+//!
+//! The goldens themselves (their files, the cache, how each scene gets one) are
+//! [`crate::golden`]'s; [`Golden::of_scene`] reads the one [`crate::golden::golden_of`] gives.
 
-use std::path::{Path, PathBuf};
-
-use sha2::{Digest, Sha256};
+use std::path::Path;
 
 use super::CompareError;
+use crate::golden::{ATTR_SPP, GoldenRecord, GoldenScene, golden_of, sha256_hex};
 use crate::image_io::ExrImage;
-use crate::render::{Film, RenderOptions, render};
+use crate::render::Film;
 use crate::scene::SceneDescription;
 
-/// The seed goldens are rendered with (distinct from any seed a test renders a candidate with).
-pub const GOLDEN_SEED: u64 = 0x676f_6c64_656e;
-
-/// Samples per pixel of a golden for candidates with `candidate_spp`: `max(4096, 100 N)`.
-pub fn golden_spp(candidate_spp: u32) -> u32 {
-    4096u32.max(candidate_spp.saturating_mul(100))
+/// The scene a golden's attributes record: the TOML it holds (a scene file's golden), else the
+/// built-in scene it names, when the recorded hash is that scene's.
+pub fn recorded_scene(record: &GoldenRecord) -> Option<SceneDescription> {
+    let want = record.scene_sha256.as_deref()?;
+    if let Some(toml) = &record.scene_toml {
+        let name = record.scene.as_deref().unwrap_or("the golden's scene");
+        return (sha256_hex(toml.as_bytes()) == want)
+            .then(|| SceneDescription::from_toml(toml, name).ok())
+            .flatten();
+    }
+    let scene = GoldenScene::builtin(record.scene.as_deref()?).ok()?;
+    (scene.scene_sha256() == want).then_some(scene.description)
 }
 
 /// A golden image: per pixel and channel the mean of `samples_per_pixel` samples and their
@@ -33,6 +42,9 @@ pub struct Golden {
     pub variance: Vec<[f64; 3]>,
     /// The scene's name, when known.
     pub scene: Option<String>,
+    /// The vertical field of view of the scene's camera in degrees, when known (the diagnosis
+    /// names a zoom as a field of view).
+    pub vfov: Option<f64>,
     /// Per pixel and channel, a bound on how far one sample may lie from the mean: the largest
     /// `|mu_nb - mu| + 3 sd_nb` over the 3x3 neighbourhood, at most 1. Edge-tolerant: a pixel
     /// beside an edge may receive samples of the other side that the golden never drew.
@@ -78,10 +90,17 @@ impl Golden {
                 .map(|v| v.map(|x| x.max(0.0)))
                 .collect(),
             scene,
+            vfov: None,
             bound: Vec::new(),
         };
         golden.bound = golden.neighbourhood_bound();
         Ok(golden)
+    }
+
+    /// The same golden with the camera's vertical field of view `vfov` (degrees) known.
+    pub fn with_vfov(mut self, vfov: Option<f64>) -> Self {
+        self.vfov = vfov;
+        self
     }
 
     fn neighbourhood_bound(&self) -> Vec<[f64; 3]> {
@@ -135,28 +154,24 @@ impl Golden {
     }
 
     /// A golden from an EXR already read (for instance one embedded in the binary); `source`
-    /// names it in errors.
+    /// names it in errors. The scene it records (the TOML it holds, or the built-in scene it
+    /// names, when the hashes agree) gives its camera's field of view.
     pub fn from_exr_image(image: ExrImage, source: &Path) -> Result<Self, CompareError> {
         let bad = |message: String| CompareError::Input {
             path: source.to_path_buf(),
             message,
         };
-        let attribute = |name: &str| {
-            image
-                .attributes
-                .iter()
-                .find(|(k, _)| k == name)
-                .map(|(_, v)| v.clone())
-        };
-        let spp = attribute("rtoracle.spp").ok_or_else(|| {
-            bad("has no 'rtoracle.spp' attribute (the golden's samples per pixel)".into())
-        })?;
-        let spp: u32 = spp.trim().parse().map_err(|_| {
+        let record = GoldenRecord::of(&image);
+        let spp = image.attribute(ATTR_SPP).ok_or_else(|| {
             bad(format!(
-                "its 'rtoracle.spp' attribute '{spp}' is not a count"
+                "has no '{ATTR_SPP}' attribute (the golden's samples per pixel)"
             ))
         })?;
-        let scene = attribute("rtoracle.scene");
+        let spp: u32 = spp
+            .trim()
+            .parse()
+            .map_err(|_| bad(format!("its '{ATTR_SPP}' attribute '{spp}' is not a count")))?;
+        let vfov = recorded_scene(&record).map(|d| d.camera.vfov);
         let variance = image
             .variance
             .ok_or_else(|| bad("has no 'variance' layer, so it cannot serve as a golden".into()))?;
@@ -169,28 +184,29 @@ impl Golden {
             spp,
             widen(image.mean),
             widen(variance),
-            scene,
+            record.scene,
         )
+        .map(|g| g.with_vfov(vfov))
         .map_err(|e| bad(e.to_string()))
     }
 
-    /// Renders the golden of a scene with `spp` samples per pixel and [`GOLDEN_SEED`].
-    pub fn render(
-        description: &SceneDescription,
-        name: &str,
-        spp: u32,
+    /// The golden of `scene` for candidates of `candidate_spp` samples per pixel: the one
+    /// [`golden_of`] gives with [`crate::golden::golden_spp`] samples, from the cache in
+    /// `cache` (`progress`: a line and a bar on stderr when it is rendered), named after the
+    /// scene as asked (a cached golden may carry the name of another file of the same content).
+    pub fn of_scene(
+        scene: &GoldenScene,
+        candidate_spp: u32,
+        cache: Option<&Path>,
         progress: bool,
     ) -> Result<Self, CompareError> {
-        let options = RenderOptions {
-            samples_per_pixel: spp,
-            seed: GOLDEN_SEED,
-            variance: true,
-            progress,
-            ..Default::default()
-        };
-        let film = render(&description.scene(), &description.camera(None), &options)
+        let spp = crate::golden::golden_spp(candidate_spp);
+        let found = golden_of(scene, spp, cache, progress)
             .map_err(|e| CompareError::Golden(e.to_string()))?;
-        Golden::from_film(&film, Some(name.to_string()))
+        let mut golden = Golden::from_exr_image(found.image, &found.source)?;
+        golden.scene = Some(scene.name.clone());
+        golden.vfov = Some(scene.description.camera.vfov);
+        Ok(golden)
     }
 
     /// The golden seen through a camera shifted by half a pixel along both axes (`sign` +1:
@@ -231,138 +247,8 @@ impl Golden {
             self.scene.clone(),
         )
         .expect("a shifted golden has the same size and finite values")
+        .with_vfov(self.vfov)
     }
-
-    /// The golden in rtoracle's cache format: a header line, then width, height and `M` as
-    /// little-endian `u32`, then the means and variances as little-endian `f32` (as in an EXR).
-    pub fn to_cache_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(32 + self.mean.len() * 24);
-        out.extend_from_slice(CACHE_MAGIC);
-        for v in [
-            self.width as u32,
-            self.height as u32,
-            self.samples_per_pixel,
-        ] {
-            out.extend_from_slice(&v.to_le_bytes());
-        }
-        for layer in [&self.mean, &self.variance] {
-            for p in layer.iter() {
-                for x in p {
-                    out.extend_from_slice(&(*x as f32).to_le_bytes());
-                }
-            }
-        }
-        out
-    }
-
-    /// Reads [`Golden::to_cache_bytes`]'s format.
-    pub fn from_cache_bytes(bytes: &[u8], scene: Option<String>) -> Result<Self, CompareError> {
-        let bad = || CompareError::Golden("the cached golden is corrupt".into());
-        let rest = bytes.strip_prefix(CACHE_MAGIC).ok_or_else(bad)?;
-        if rest.len() < 12 {
-            return Err(bad());
-        }
-        let word = |i: usize| u32::from_le_bytes(rest[4 * i..4 * i + 4].try_into().unwrap());
-        let (w, h, m) = (word(0) as usize, word(1) as usize, word(2));
-        let n = w.checked_mul(h).ok_or_else(bad)?;
-        let body = &rest[12..];
-        if body.len() != n * 24 {
-            return Err(bad());
-        }
-        let floats: Vec<f64> = body
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
-            .collect();
-        let layer = |k: usize| -> Vec<[f64; 3]> {
-            floats[k * 3 * n..(k + 1) * 3 * n]
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect()
-        };
-        Golden::new(w, h, m, layer(0), layer(1), scene)
-    }
-}
-
-const CACHE_MAGIC: &[u8] = b"rtoracle golden cache v1\n";
-
-/// The folder goldens are cached in: `$RTORACLE_CACHE_DIR`, else `$XDG_CACHE_HOME/rtoracle`,
-/// else `~/.cache/rtoracle`.
-pub fn cache_dir() -> Option<PathBuf> {
-    crate::golden::cache_dir()
-}
-
-/// The cache file of a scene's golden: keyed by the scene's content, `M`, the seed and the tool
-/// version, so a change to any of them renders a new golden.
-pub fn cache_path(dir: &Path, name: &str, description: &SceneDescription, spp: u32) -> PathBuf {
-    let mut hasher = Sha256::new();
-    hasher.update(description.to_toml().as_bytes());
-    hasher.update(format!(
-        "\nspp={spp}\nseed={GOLDEN_SEED}\nversion={}\n",
-        env!("CARGO_PKG_VERSION")
-    ));
-    let digest = hasher.finalize();
-    let hex: String = digest[..8].iter().map(|b| format!("{b:02x}")).collect();
-    let safe: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    dir.join(format!("golden-{safe}-{spp}spp-{hex}.bin"))
-}
-
-/// The golden compiled into the binary for the built-in scene `name`, when there is one, it was
-/// made from the scene as it is now (its `rtoracle.sceneSha256` attribute), and it has at least
-/// `spp` samples per pixel.
-pub fn embedded_golden(name: &str, spp: u32) -> Option<Golden> {
-    let description = crate::scene::builtin(name).ok()?;
-    let image = crate::golden::embedded_golden_image(name)?;
-    let made_from = image.attribute(crate::golden::ATTR_SCENE_SHA256)?;
-    if made_from != crate::golden::scene_sha256(&description) {
-        return None;
-    }
-    let label = format!(
-        "(embedded) golden/{}",
-        crate::golden::golden_file_name(name)
-    );
-    let golden = Golden::from_exr_image(image, Path::new(&label)).ok()?;
-    (golden.samples_per_pixel >= spp).then_some(golden)
-}
-
-/// The golden of the built-in scene `name` for candidates with `candidate_spp` samples per
-/// pixel (`M >= max(4096, 100 N)`): the one embedded in the binary when it is good enough,
-/// else read from the cache, else rendered once (with a progress bar) and cached atomically.
-pub fn golden_for_scene(name: &str, candidate_spp: u32) -> Result<Golden, CompareError> {
-    let description =
-        crate::scene::builtin(name).map_err(|e| CompareError::Golden(e.to_string()))?;
-    let spp = golden_spp(candidate_spp);
-    if let Some(golden) = embedded_golden(name, spp) {
-        return Ok(golden);
-    }
-    let cached = cache_dir().map(|d| cache_path(&d, name, &description, spp));
-    if let Some(path) = &cached {
-        if let Ok(bytes) = std::fs::read(path) {
-            if let Ok(g) = Golden::from_cache_bytes(&bytes, Some(name.to_string())) {
-                return Ok(g);
-            }
-        }
-    }
-    crate::output::stderr_line(&format!(
-        "rendering the golden of {name} at {spp} spp (once; it is cached)"
-    ));
-    let golden = Golden::render(&description, name, spp, true)?;
-    if let Some(path) = &cached {
-        // A cache that cannot be written costs time, not correctness.
-        if let Some(dir) = path.parent() {
-            let _ = std::fs::create_dir_all(dir);
-        }
-        let _ = crate::image_io::write_atomically(path, &golden.to_cache_bytes());
-    }
-    Ok(golden)
 }
 
 #[cfg(test)]
@@ -379,25 +265,6 @@ mod tests {
             None,
         )
         .unwrap()
-    }
-
-    #[test]
-    fn cache_bytes_round_trip_through_f32() {
-        let g = tiny();
-        let back = Golden::from_cache_bytes(&g.to_cache_bytes(), None).unwrap();
-        // Every value above is exact in f32 except 0.1, 0.2 and 0.01.
-        for (a, b) in g.mean.iter().zip(&back.mean) {
-            for c in 0..3 {
-                assert!((a[c] - b[c]).abs() <= a[c] * 1e-7);
-            }
-        }
-        assert_eq!(
-            (back.width, back.height, back.samples_per_pixel),
-            (2, 1, 16)
-        );
-        let mut bytes = g.to_cache_bytes();
-        bytes.pop();
-        assert!(Golden::from_cache_bytes(&bytes, None).is_err());
     }
 
     #[test]
@@ -440,34 +307,14 @@ mod tests {
     }
 
     #[test]
-    fn the_cache_key_follows_the_scene_and_the_sample_count() {
-        let dir = Path::new("/cache");
-        let d = crate::scene::builtin("week04-sphere").unwrap();
-        let a = cache_path(dir, "week04-sphere", &d, 4096);
-        assert_eq!(a, cache_path(dir, "week04-sphere", &d, 4096));
-        assert_ne!(a, cache_path(dir, "week04-sphere", &d, 8192));
-        let mut moved = d.clone();
-        moved.objects.pop();
-        assert_ne!(a, cache_path(dir, "week04-sphere", &moved, 4096));
-        assert!(a.starts_with(dir));
-    }
-
-    #[test]
-    fn the_course_goldens_are_embedded_at_4096_spp() {
+    fn the_course_goldens_serve_20_spp_candidates() {
         for scene in ["week04-sphere", "week04-quad"] {
-            let g = embedded_golden(scene, golden_spp(20)).expect("embedded");
+            let g = Golden::of_scene(&GoldenScene::builtin(scene).unwrap(), 20, None, false)
+                .expect("embedded");
             assert_eq!(g.samples_per_pixel, 4096);
             assert_eq!(g.scene.as_deref(), Some(scene));
             let camera = crate::scene::builtin(scene).unwrap().camera(None);
             assert_eq!((g.width, g.height), (camera.width, camera.height));
-            // Candidates with more than 40 spp need a golden with more samples than embedded.
-            assert!(embedded_golden(scene, golden_spp(41)).is_none());
         }
-    }
-
-    #[test]
-    fn golden_spp_follows_the_rule() {
-        assert_eq!(golden_spp(20), 4096);
-        assert_eq!(golden_spp(100), 10_000);
     }
 }
