@@ -212,6 +212,13 @@ impl GoldenScene {
             ));
         }
         let record = GoldenRecord::of(image);
+        // The profile is part of the scene's text too: say it first, as the more telling reason.
+        if record.profile != self.profile {
+            return Err(format!(
+                "was rendered in the {} profile ({ATTR_PROFILE}), not {}",
+                record.profile, self.profile
+            ));
+        }
         let want = self.scene_sha256();
         match &record.scene_sha256 {
             Some(h) if *h == want => {}
@@ -228,12 +235,6 @@ impl GoldenScene {
                     "holds a scene ({ATTR_SCENE_TOML}) whose hash is not its {ATTR_SCENE_SHA256}"
                 ));
             }
-        }
-        if record.profile != self.profile {
-            return Err(format!(
-                "was rendered in the {} profile ({ATTR_PROFILE}), not {}",
-                record.profile, self.profile
-            ));
         }
         if record.inputs != self.inputs_text() {
             return Err(format!(
@@ -303,7 +304,12 @@ mod tests {
         let physical = quad.clone().with_profile("physical");
         assert_eq!(
             physical.content_key(),
-            format!("{}-physical", quad.scene_sha256())
+            format!("{}-physical", physical.scene_sha256())
+        );
+        assert_ne!(
+            physical.content_key(),
+            key,
+            "another profile is another golden"
         );
         let textured = quad.clone().with_input("textures/earth.png", b"one");
         let retextured = quad.clone().with_input("textures/earth.png", b"two");
