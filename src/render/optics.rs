@@ -17,12 +17,16 @@ pub fn reflect(v: DVec3, n: DVec3) -> DVec3 {
 /// Schlick's approximation of the reflectance at an interface: `r0 + (1 - r0) (1 - cos)^5`,
 /// `r0 = ((1 - x) / (1 + x))^2`. The course and the book feed it the refraction ratio rather
 /// than the index of refraction, which gives the same `r0` (it is symmetric under `x -> 1/x`).
-/// The fifth power is libm's `pow`.
+/// The fifth power is three IEEE multiplications, `(m^2)^2 m` (the same bits on every platform,
+/// within 2 ulp of `pow`, and many times cheaper than a call to `pow` on the path of every
+/// ray that meets glass).
 #[inline]
 pub fn schlick(cosine: f64, x: f64) -> f64 {
     let r0 = (1.0 - x) / (1.0 + x);
     let r0 = r0 * r0;
-    r0 + (1.0 - r0) * libm::pow(1.0 - cosine, 5.0)
+    let m = 1.0 - cosine;
+    let m2 = m * m;
+    r0 + (1.0 - r0) * (m2 * m2 * m)
 }
 
 /// The refracted direction of the unit direction `v` through the interface with unit normal `n`

@@ -232,6 +232,33 @@ mod tests {
     use crate::render::job::film_bits_with;
     use crate::render::packet::WIDTH;
 
+    /// The book's final scene (about 490 spheres) renders through the hierarchy to the very film
+    /// the linear scan gives, variance included.
+    #[test]
+    fn the_final_scene_renders_the_same_through_the_hierarchy() {
+        let d = crate::scene::rtiow_final_scene(1);
+        assert!(d.objects.len() > 400, "{}", d.objects.len());
+        let world = d.scene();
+        assert!(world.has_hierarchy());
+        let linear = world.clone().without_hierarchy();
+        let camera = d.camera(Some(48));
+        let options = RenderOptions {
+            samples_per_pixel: 2,
+            seed: 3,
+            variance: true,
+            ..Default::default()
+        };
+        let bits = |film: Film| -> Vec<u64> {
+            film.mean
+                .iter()
+                .chain(film.variance.as_deref().unwrap_or(&[]))
+                .flat_map(|c| c.to_array().map(f64::to_bits))
+                .collect()
+        };
+        let fast = bits(render(&world, &camera, &options).unwrap());
+        assert_eq!(fast, bits(render(&linear, &camera, &options).unwrap()));
+    }
+
     /// The course's jittered sampling takes whole passes over its strata: week 9's 30 spp is 25
     /// samples (the course's), 4096 asked is 163 passes of 25, fewer than 25 is one pass; each
     /// sample weighs `25 / 30`. Week 10's 200 spp is 196 samples of weight `196 / 200`.
@@ -250,7 +277,7 @@ mod tests {
         assert_eq!(samples_taken(&world, 30).0, 25);
         assert_eq!(samples_taken(&world, 4096).0, 4075);
         assert_eq!(samples_taken(&world, 3).0, 25);
-        let uniform = crate::scene::builtin("week09-blinn").unwrap().scene();
+        let uniform = crate::scene::builtin("week08-blinn").unwrap().scene();
         assert_eq!(samples_taken(&uniform, 30), (30, None));
     }
 

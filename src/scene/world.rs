@@ -155,6 +155,13 @@ impl World {
         }
     }
 
+    /// A copy without the hierarchy (the linear scan), for tests that compare the two.
+    #[cfg(test)]
+    pub(crate) fn without_hierarchy(mut self) -> Self {
+        self.bvh = None;
+        self
+    }
+
     /// A copy with the hierarchy switched on (when the scene's boxes are finite) whatever the
     /// number of objects, for tests that compare it with the scan.
     #[cfg(test)]

@@ -890,7 +890,7 @@ fn bad_new_keys_are_one_line_and_exit_2() {
     assert_render_refused(
         &[],
         &["render", "week07-earth", "--textures", "."],
-        "no basketball.png or basketball.jpg",
+        "no basketball.jpg or basketball.png",
     );
     assert_render_refused(
         &[("scene.toml", &good)],

@@ -145,7 +145,7 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     },
     BuiltinScene {
         name: "week07-procedural-texture",
-        summary: "renderProceduralTexture: checkers, a solid colour and the earth picture, depth 5, 400x225, 20 spp",
+        summary: "renderProceduralTexture: checkers, the earth picture and a solid colour, depth 5, 400x225, 20 spp",
         week: Some(7),
         profiles: BOTH,
         build: Build::Textured(weeks::week07_procedural_texture),
@@ -173,7 +173,7 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     },
     BuiltinScene {
         name: "week09-blinn",
-        summary: "renderBlinn: Blinn spheres under the sky, cosine-sampled bounces, depth 5, 320x180, 30 spp",
+        summary: "renderBlinn: Blinn spheres under the sky, cosine-sampled bounces, jittered, depth 5, 320x180, 30 spp",
         week: Some(9),
         profiles: COURSE,
         build: Build::Fixed(weeks::week09_blinn),
@@ -376,7 +376,7 @@ mod tests {
         let e = builtin_with_textures("week07-earth", &source)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("basketball.png or basketball.jpg"), "{e}");
+        assert!(e.contains("basketball.jpg or basketball.png"), "{e}");
         // Without a folder the generated pictures stand in, and no file is read.
         assert!(builtin("week07-earth").unwrap().external_files().is_empty());
     }

@@ -98,14 +98,15 @@ pub(super) fn checker(name: &str, scale: f64, even: [f64; 3], odd: [f64; 3]) -> 
 
 /// The stems the course's texture files go by, for each picture a built-in scene uses.
 const COURSE_FILES: &[(&str, &[&str])] = &[
-    ("earth", &["earthmap", "earth"]),
+    ("earth", &["earthmap"]),
     ("basketball", &["basketball"]),
     ("soccer", &["soccer"]),
     ("pepsi", &["pepsi"]),
 ];
 
-/// The extensions looked for, in order.
-const EXTENSIONS: &[&str] = &["png", "jpg", "jpeg", "PNG", "JPG", "JPEG"];
+/// The extensions looked for, in order: week 7's scenes read JPEGs (`earthmap.jpg`; week 8's
+/// `earthmap.png` is the fallback).
+const EXTENSIONS: &[&str] = &["jpg", "jpeg", "png", "JPG", "JPEG", "PNG"];
 
 /// The image texture `name` showing the course's picture `picture` (one of the generated
 /// pictures' names): generated, or the course's file found in the folder of `source` (the first
@@ -150,7 +151,7 @@ pub(super) fn picture(
                 dir.display(),
                 stems
                     .iter()
-                    .map(|s| format!("{s}.png or {s}.jpg"))
+                    .map(|s| format!("{s}.jpg or {s}.png"))
                     .collect::<Vec<_>>()
                     .join(", ")
             ),

@@ -4,9 +4,10 @@
 //! Where the course's code does not settle a value, the choice is named in the scene's
 //! function: week 5's `renderPointLightShadow` (from a deleted solution) takes
 //! `renderPointLight`'s sample count and depth; week 7's materials are the solution's, the
-//! checkers' scalar colours read as greys; weeks 9 and 10 keep week 8's checker ground, and week
-//! 9 its field of view and depth; week 9's `renderBlinn` samples uniformly (its output is
-//! `week09_nojittered.png`).
+//! checkers' scalar colours read as greys, the earth in the centre; weeks 9 and 10 keep week 8's
+//! checker ground, and week 9 its field of view and depth; week 9's `renderBlinn` uses
+//! `render_jittered` (although its output is `week09_nojittered.png`). These are also the
+//! choices of the Python fixtures of the weeks (`tests/fixtures/python/weeks/`).
 
 use super::parts::{
     TextureSource, brdf, camera, checker, dielectric, lambertian, light, mirror, moving_sphere,
@@ -160,7 +161,7 @@ fn week07(textures: Vec<crate::scene::TextureEntry>, spheres: [&str; 3]) -> Scen
 }
 
 /// `renderProceduralTexture`: the solution's textures, `Checker(0.12, (.2, .3, .1), .9)` on the
-/// left, `Solid(.8, .2, .5)` in the centre, the earth picture on the right.
+/// left, the earth picture in the centre, `Solid(.8, .2, .5)` on the right.
 pub(super) fn week07_procedural_texture(
     source: &TextureSource,
 ) -> Result<SceneDescription, SceneError> {
@@ -171,22 +172,22 @@ pub(super) fn week07_procedural_texture(
             solid("solid", [0.8, 0.2, 0.5]),
             picture(name, "earth", "earth", source)?,
         ],
-        ["checker", "solid", "earth"],
+        ["checker", "earth", "solid"],
     ))
 }
 
-/// `renderEarth`: the basketball, soccer and earth pictures on the spheres, and
+/// `renderEarth`: the basketball, earth and soccer pictures on the spheres (left to right), and
 /// `Quad((1, 0, -1), (1, 2, -1), (1, 0, 1))` with the pepsi picture.
 pub(super) fn week07_earth(source: &TextureSource) -> Result<SceneDescription, SceneError> {
     let name = "week07-earth";
     let mut d = week07(
         vec![
             picture(name, "basketball", "basketball", source)?,
-            picture(name, "soccer", "soccer", source)?,
             picture(name, "earth", "earth", source)?,
+            picture(name, "soccer", "soccer", source)?,
             picture(name, "pepsi", "pepsi", source)?,
         ],
-        ["basketball", "soccer", "earth"],
+        ["basketball", "earth", "soccer"],
     );
     d.objects.push(quad(
         [1.0, 0.0, -1.0],
@@ -272,7 +273,9 @@ fn week09_spheres(ks: [f64; 3], alphas: [f64; 3]) -> [(MaterialKind, [f64; 3], f
 }
 
 /// `renderBlinn` of week 9: cosine-sampled diffuse scattering, the sky, no light, spp 30, focus
-/// 5, uniform pixel sampling.
+/// 5, `render_jittered` with week 9's frozen step `1 / int(sqrt(10)) = 1/3` (25 samples over
+/// 30; the output's name, `week09_nojittered.png`, says otherwise, but the week's subject is the
+/// jitter).
 pub(super) fn week09_blinn() -> SceneDescription {
     brdf_scene(
         30,
@@ -280,6 +283,8 @@ pub(super) fn week09_blinn() -> SceneDescription {
         week09_spheres([0.2, 0.6, 0.2], [0.08, 8.0, 300.0]),
         RenderSettings {
             diffuse_sampling: DiffuseSampling::Cosine,
+            sampling: PixelSampling::CourseJittered,
+            jitter_step: Some(1.0 / 3.0),
             ..RenderSettings::default()
         },
     )
