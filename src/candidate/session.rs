@@ -531,6 +531,8 @@ impl Session {
         };
         let proc = self.proc.as_ref().expect("a running candidate");
         proc.send(line.into_bytes());
+        // What it wrote of a last line it never ended (said when it dies).
+        let mut partial: Option<String> = None;
         loop {
             let proc = self.proc.as_mut().expect("a running candidate");
             let left = deadline.saturating_duration_since(Instant::now());
@@ -570,12 +572,17 @@ impl Session {
                     return CallOutcome::Failed(oversize_message(&head, MAX_LINE_BYTES));
                 }
                 Ok(Line::Parsed(_)) => {}
+                Ok(Line::Partial(head)) => partial = Some(head),
                 Ok(Line::Eof) | Err(RecvTimeoutError::Disconnected) => {
                     let mut proc = self.proc.take().expect("a running candidate");
                     let status = proc.exit_status();
                     let _ = proc.kill();
+                    let wrote = partial
+                        .take()
+                        .map(|head| format!(", after writing {head} without its newline"))
+                        .unwrap_or_default();
                     return CallOutcome::Failed(format!(
-                        "the candidate died on this request: {}",
+                        "the candidate died on this request: {}{wrote}",
                         self.describe_end(status)
                     ));
                 }

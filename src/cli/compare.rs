@@ -36,10 +36,12 @@ pub struct Args {
     /// Print the JSON report on stdout instead of the summary.
     #[arg(long)]
     json: bool,
-    /// Write the signed z heatmap (failing regions outlined) to this PNG.
+    /// Write the signed z heatmap (a map per channel, failing regions outlined) to this PNG
+    /// (inside the --report folder: named heat*.png).
     #[arg(long, value_name = "OUT.png")]
     heatmap: Option<PathBuf>,
-    /// Write a report folder: report.json, heatmap.png, crops of the worst regions, index.html.
+    /// Write a report folder: report.json, the candidate, golden and difference images,
+    /// heatmap.png, crops of the worst regions, index.html.
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
 }
@@ -80,8 +82,13 @@ fn summary(c: &Comparison, candidate: &Path, pictures: bool, spp_note: Option<&s
             .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}"))
     ));
     for r in c.regions.iter().take(5) {
+        let change = r
+            .change
+            .as_deref()
+            .map(|c| format!(" ({c})"))
+            .unwrap_or_default();
         s.push_str(&format!(
-            "  failing region x {} y {} {}x{}: {} scale, channel {}, adjusted p {:.2e}, z {:+.1}\n",
+            "  failing region x {} y {} {}x{}{change}: {} scale, channel {}, adjusted p {:.2e}, z {:+.1}\n",
             r.x, r.y, r.width, r.height, r.scale, r.channel, r.adjusted_p, r.z
         ));
     }

@@ -35,8 +35,8 @@ fn median(v: &mut [f64]) -> Option<f64> {
 }
 
 /// The scale per channel that takes the golden to the candidate, from the pixels whose golden
-/// is flat (per-sample standard deviation below 0.02) and neither dark nor near the film's clamp
-/// (mean in [0.02, 0.9], candidate below 0.95). For 8-bit codes it is the scale that the most
+/// is flat (per-sample standard deviation below 0.02), not dark (mean at least 0.02) and whose
+/// candidate is not near the film's clamp (below 0.95: a brighter image clamps there). For 8-bit codes it is the scale that the most
 /// of those pixels' code intervals allow (each pixel's interval `[lo, hi]` allows the scales
 /// `[lo / mu, hi / mu]`; the middle of the scales allowed by the most pixels), so the codes'
 /// rounding does not bias it; for linear values, the median ratio. `None` with fewer than 100
@@ -64,7 +64,7 @@ pub(crate) fn channel_scales(
             .zip(&golden.mean)
             .zip(&golden.variance)
             .filter(|((iv, mu), s2)| {
-                (0.02..=0.9).contains(&mu[c]) && s2[c] < 4e-4 && iv[c].1 < 0.95
+                (0.02..=1.0).contains(&mu[c]) && s2[c] < 4e-4 && iv[c].1 < 0.95
             })
             .map(|((iv, mu), _)| (iv[c].0 / mu[c], iv[c].1 / mu[c]))
             .collect();

@@ -1,6 +1,6 @@
 //! What the failing regions show: each one's change per channel in words, and their order.
 //!
-//! The statistic finds the regions ([`super::verdict`]); this module ranks them by what a reader
+//! The statistic finds the regions (the verdict); this module ranks them by what a reader
 //! learns from them, not by where they are: first the region with the most evidence (its area
 //! times the strength of its differences, `|z|` capped at [`Z_CAP`] per pixel, so a large region
 //! beats a small one whose `z` saturates), then, for the regions listed, each next one the one
@@ -10,7 +10,6 @@
 //! blue down: a different colour, not a brighter one".
 
 use super::Region;
-use super::verdict::REGIONS_LISTED;
 
 /// `|z|` at which a pixel's evidence stops growing.
 const Z_CAP: f64 = 50.0;
@@ -85,7 +84,7 @@ pub fn channel_change(changes: [ChannelChange; 3]) -> String {
     );
     if !both.is_empty() {
         return format!(
-            "{} both higher and lower than the golden in places: the shapes differ (moved, flipped, resized or missing)",
+            "{} higher in some pixels and lower in others: an edge or a shape moved, or more noise than the claimed samples give",
             names(&both)
         );
     }
@@ -127,9 +126,15 @@ fn evidence(r: &Region, z: &[[f32; 3]], width: usize) -> f64 {
         .sum()
 }
 
-/// The regions with their change in words, ranked (see the module docs). `z` is the signed `z`
-/// per pixel and channel of a `width`-wide image.
-pub fn rank(regions: Vec<Region>, z: &[[f32; 3]], width: usize, height: usize) -> Vec<Region> {
+/// The regions with their change in words, ranked (see the module docs); the first `listed` are
+/// chosen for distinct places. `z` is the signed `z` per pixel and channel of a `width`-wide
+/// image.
+pub fn rank(
+    regions: Vec<Region>,
+    z: &[[f32; 3]],
+    (width, height): (usize, usize),
+    listed: usize,
+) -> Vec<Region> {
     let mut scored: Vec<(f64, Region)> = regions
         .into_iter()
         .map(|mut r| {
@@ -155,7 +160,7 @@ pub fn rank(regions: Vec<Region>, z: &[[f32; 3]], width: usize, height: usize) -
     let mut out: Vec<Region> = Vec::with_capacity(scored.len());
     let mut nearest = vec![f64::INFINITY; scored.len()];
     let mut taken = vec![false; scored.len()];
-    for _ in 0..REGIONS_LISTED.min(scored.len()) {
+    for _ in 0..listed.min(scored.len()) {
         let pick = (0..scored.len())
             .filter(|&k| !taken[k])
             .max_by(|&a, &b| {
@@ -209,7 +214,7 @@ mod tests {
         assert_eq!(channel_change([Down; 3]), "darker in every channel");
         assert_eq!(channel_change([Up; 3]), "brighter in every channel");
         assert!(channel_change([Same, Same, Up]).starts_with("blue up, the rest unchanged"));
-        assert!(channel_change([Both, Same, Up]).contains("the shapes differ"));
+        assert!(channel_change([Both, Same, Up]).contains("an edge or a shape moved"));
         assert!(channel_change([Same; 3]).starts_with("no channel stands out"));
         assert_eq!(names(&[0, 1, 2]), "red, green and blue");
     }
@@ -238,7 +243,7 @@ mod tests {
         let mut regions: Vec<Region> = (0..6).map(|k| region(8 * k, 0, 8, 8)).collect();
         regions.push(region(184, 184, 8, 8));
         regions.push(region(100, 100, 16, 16));
-        let ranked = rank(regions, &z, w, h);
+        let ranked = rank(regions, &z, (w, h), 50);
         assert_eq!(
             (ranked[0].x, ranked[0].width),
             (100, 16),

@@ -726,7 +726,8 @@ impl Evaluation {
     ) -> Comparison {
         let (width, height) = candidate.size();
         let regions_total = self.regions.len();
-        let ranked = super::regions::rank(self.regions, &self.z_map, width, height);
+        let ranked =
+            super::regions::rank(self.regions, &self.z_map, (width, height), REGIONS_LISTED);
         let listed = ranked.iter().take(REGIONS_LISTED).cloned().collect();
         Comparison {
             verdict: if self.passed {

@@ -329,12 +329,6 @@ pub fn scene_file_batches(work: &Path) -> (f64, f64) {
         include_str!("../../examples/rubrics/triangles-scene.toml"),
     )
     .expect("write the example scene");
-    // The uploaded images are judged: this measures the golden's cost, not the renders'.
-    let text = text.replace(
-        "kind = \"image\"\n",
-        "kind = \"image\"\nsource = \"upload\"\n",
-    );
-    std::fs::write(&rubric_path, &text).expect("write the example rubric");
     let file_rubric = Rubric::from_file(&rubric_path).expect("the example rubric is valid");
     let builtin_rubric = Rubric::from_toml(
         &text.replace(

@@ -99,9 +99,11 @@ impl Trace for World {
 /// The course's `render_jittered` (weeks 9 and 10) takes `m^2` samples, `m = floor(sqrt(spp))`
 /// of the scene's `samples_per_pixel`, and divides their sum by that `spp` (course departure:
 /// 25 samples over 30 in week 9, 196 over 200 in week 10). Asked for `n` samples, the reference
-/// takes the largest multiple of `m^2` not above `n` (at least `m^2`), so every stratum gets the
-/// same number, and multiplies each by `m^2 / spp`: at `n = m^2` that is the course's pixel,
-/// and at any `n` an estimate of its expectation.
+/// takes whole passes over the strata, so every stratum gets the same number: one pass (the
+/// course's pixel) for `n` up to the scene's `spp` (more passes only where `m = 1`), and above it
+/// the smallest multiple of `m^2` at least `n`, so that a golden asked for 4096 samples holds at
+/// least 4096. Each sample is multiplied by `m^2 / spp`, so the mean at any `n` estimates the
+/// course's pixel's expectation.
 pub fn samples_taken(world: &World, spp: u32) -> (u32, Option<CourseJitter>) {
     let settings = &world.settings;
     match (world.profile, settings.sampling, settings.jitter_step) {
@@ -109,7 +111,12 @@ pub fn samples_taken(world: &World, spp: u32) -> (u32, Option<CourseJitter>) {
             let scene_spp = world.samples_per_pixel.max(1);
             let grid = ((scene_spp as f64).sqrt() as u32).max(1);
             let cells = grid * grid;
-            let taken = (spp / cells).max(1).saturating_mul(cells);
+            let passes = if spp <= scene_spp {
+                (spp / cells).max(1)
+            } else {
+                spp.div_ceil(cells)
+            };
+            let taken = passes.saturating_mul(cells);
             let scale = cells as f64 / scene_spp as f64;
             (taken, Some(CourseJitter { grid, step, scale }))
         }
@@ -260,8 +267,8 @@ mod tests {
     }
 
     /// The course's jittered sampling takes whole passes over its strata: week 9's 30 spp is 25
-    /// samples (the course's), 4096 asked is 163 passes of 25, fewer than 25 is one pass; each
-    /// sample weighs `25 / 30`. Week 10's 200 spp is 196 samples of weight `196 / 200`.
+    /// samples (the course's), 4096 asked is 164 passes of 25 (at least what was asked), fewer
+    /// than 25 is one pass; each sample weighs `25 / 30`. Week 10's 200 spp is 196 samples of weight `196 / 200`.
     #[test]
     fn course_jitter_takes_whole_passes() {
         let mut d = crate::scene::builtin("week10-moving").unwrap();
@@ -275,7 +282,8 @@ mod tests {
         d.image.samples_per_pixel = 30;
         let world = d.scene();
         assert_eq!(samples_taken(&world, 30).0, 25);
-        assert_eq!(samples_taken(&world, 4096).0, 4075);
+        assert_eq!(samples_taken(&world, 4096).0, 4100);
+        assert_eq!(samples_taken(&world, 31).0, 50);
         assert_eq!(samples_taken(&world, 3).0, 25);
         let uniform = crate::scene::builtin("week08-blinn").unwrap().scene();
         assert_eq!(samples_taken(&uniform, 30), (30, None));

@@ -129,6 +129,8 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("compare", "--heatmap", false, false),
     ("compare", "--report", false, false),
     ("grade", "--batch", false, false),
+    ("grade", "--shard", false, false),
+    ("grade", "--merge", false, false),
     ("grade", "--rubric", false, false),
     ("grade", "--out", false, false),
     ("grade", "--format", false, false),

@@ -31,8 +31,8 @@ fn golden() -> &'static Golden {
     })
 }
 
-/// `d` rendered at [`SPP`] with [`SEED`], every linear value times `scale`, as course codes.
-fn render_codes(d: &SceneDescription, scale: f64) -> Rgb8Image {
+/// `d` rendered at [`SPP`] with [`SEED`]: the linear means.
+fn render_means(d: &SceneDescription) -> Vec<[f64; 3]> {
     let film = render(
         &d.scene(),
         &d.camera(None),
@@ -43,13 +43,17 @@ fn render_codes(d: &SceneDescription, scale: f64) -> Rgb8Image {
         },
     )
     .unwrap();
+    film.mean.iter().map(|m| m.to_array()).collect()
+}
+
+/// Linear means times `scale` as a course PNG's codes, `w` wide.
+fn codes(means: &[[f64; 3]], scale: f64, w: usize) -> Rgb8Image {
     Rgb8Image {
-        width: film.width,
-        height: film.height,
-        data: film
-            .mean
+        width: w,
+        height: means.len() / w,
+        data: means
             .iter()
-            .flat_map(|m| m.to_array().map(|x| encode_course_png(scale * x)))
+            .flat_map(|m| m.map(|x| encode_course_png(scale * x)))
             .collect(),
     }
 }
@@ -64,30 +68,16 @@ pub struct Case {
     pub changed: Vec<bool>,
 }
 
-/// Pixels whose codes differ between two images.
-fn differing(a: &Rgb8Image, b: &Rgb8Image) -> Vec<bool> {
-    a.data
-        .chunks_exact(3)
-        .zip(b.data.chunks_exact(3))
-        .map(|(p, q)| p != q)
-        .collect()
-}
-
-/// The golden's course codes.
-fn golden_codes(g: &Golden) -> Vec<[u8; 3]> {
-    g.mean.iter().map(|m| m.map(encode_course_png)).collect()
-}
-
-/// The four cases. Colour and field of view: the pixels whose codes differ from an honest render
-/// with the same seed (the same rays; only those that meet the recoloured quad or see the scene
-/// differently change). Flip and darker: the pixels whose golden codes the change alters (the
-/// golden flipped, the golden times 0.9).
+/// The four cases and the pixels each changed, exactly: those whose mean (linear, before the
+/// codes) the change alters. Colour and field of view: renders with the same seed (the same
+/// rays; only those that meet the recoloured quad, or see the scene from another angle, change).
+/// Flip and darker: the golden's means flipped, or times 0.9.
 pub fn cases() -> &'static [Case] {
     static CASES: OnceLock<Vec<Case>> = OnceLock::new();
     CASES.get_or_init(|| {
         let d = rtoracle::scene::builtin(SCENE).unwrap();
-        let honest = render_codes(&d, 1.0);
-        let (w, h) = (honest.width, honest.height);
+        let honest = render_means(&d);
+        let (w, h) = (golden().width, golden().height);
         let mut recoloured = d.clone();
         let blue = recoloured
             .materials
@@ -95,45 +85,37 @@ pub fn cases() -> &'static [Case] {
             .find(|m| m.name == "right_blue")
             .unwrap();
         blue.albedo = [1.0, 0.2, 0.2];
-        let colour = render_codes(&recoloured, 1.0);
+        let colour = render_means(&recoloured);
         let mut narrow = d.clone();
         assert_eq!(narrow.camera.vfov, 90.0);
         narrow.camera.vfov = 80.0;
-        let fov = render_codes(&narrow, 1.0);
-        let mut flipped = honest.clone();
-        for j in 0..h {
-            let row = &honest.data[3 * w * (h - 1 - j)..3 * w * (h - j)];
-            flipped.data[3 * w * j..3 * w * (j + 1)].copy_from_slice(row);
-        }
-        let g = golden_codes(golden());
-        let flip_changed = (0..w * h)
-            .map(|k| g[k] != g[(h - 1 - k / w) * w + k % w])
-            .collect();
-        let dark_changed = golden()
-            .mean
-            .iter()
-            .map(|m| m.map(|x| encode_course_png(0.9 * x)) != m.map(encode_course_png))
-            .collect();
+        let fov = render_means(&narrow);
+        let flip = |k: usize| (h - 1 - k / w) * w + k % w;
+        let flipped: Vec<[f64; 3]> = (0..w * h).map(|k| honest[flip(k)]).collect();
+        let g = &golden().mean;
+        let differ = |a: &[[f64; 3]], b: &[[f64; 3]]| -> Vec<bool> {
+            a.iter().zip(b).map(|(p, q)| p != q).collect()
+        };
         vec![
             Case {
                 name: "colour",
-                changed: differing(&honest, &colour),
-                image: colour,
+                image: codes(&colour, 1.0, w),
+                changed: differ(&honest, &colour),
             },
             Case {
                 name: "flip",
-                changed: flip_changed,
-                image: flipped,
+                image: codes(&flipped, 1.0, w),
+                changed: (0..w * h).map(|k| g[k] != g[flip(k)]).collect(),
             },
             Case {
                 name: "darker",
-                changed: dark_changed,
-                image: render_codes(&d, 0.9),
+                image: codes(&honest, 0.9, w),
+                changed: g.iter().map(|m| m.iter().any(|&x| x != 0.0)).collect(),
             },
             Case {
                 name: "fov80",
-                changed: differing(&honest, &fov),
-                image: fov,
+                image: codes(&fov, 1.0, w),
+                changed: differ(&honest, &fov),
             },
         ]
     })
@@ -485,7 +467,7 @@ fn screenshot(chromium: &Path, profile: &Path, page: &Path) {
         page,
         &[
             &format!("--screenshot={}", shot.display()),
-            "--window-size=1100,860",
+            "--window-size=1100,1100",
         ],
     );
     let img = rtoracle::image_io::read_png(&shot).unwrap();

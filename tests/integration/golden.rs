@@ -348,9 +348,20 @@ fn goldens_have_the_documented_channels_and_attributes() {
         );
         assert!(g.attribute("rtoracle.camera").is_some());
         assert!(g.attribute(ATTR_VERSION).is_some());
-        // Means are colours of the scene (albedos and sky are in [0, 1]); variances of samples in
-        // [0, 1] are at most 1/4 * N/(N-1).
+        // Under week 4's integrator means are colours of the scene (albedos and sky are in
+        // [0, 1]) and variances of samples in [0, 1] are at most 1/4 * N/(N-1); the later weeks'
+        // light adds up (render_weeks.rs checks their goldens).
         let v = g.variance.as_ref().unwrap();
+        if !["week04-sphere", "week04-quad", "triangles", "edge-cases"].contains(&scene) {
+            assert!(
+                g.mean
+                    .iter()
+                    .chain(v)
+                    .flatten()
+                    .all(|x| x.is_finite() && *x >= 0.0)
+            );
+            continue;
+        }
         assert!(g.mean.iter().flatten().all(|x| (0.0..=1.0).contains(x)));
         assert!(
             v.iter()

@@ -17,6 +17,7 @@ mod oracle_props;
 mod protocol;
 mod readme;
 mod render;
+mod render_weeks;
 mod renders;
 mod reports;
 mod sandbox;

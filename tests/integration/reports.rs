@@ -224,10 +224,7 @@ fn forged_messages_and_names_stay_text_in_feedback_and_results_json() {
             );
         }
         let all = outputs.join("\n");
-        assert!(
-            all.contains("&lt;img src=x onerror=alert(1)&gt;"),
-            "{all}"
-        );
+        assert!(all.contains("&lt;img src=x onerror=alert(1)&gt;"), "{all}");
 
         let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
         assert!(!junit.contains("<img") && !junit.contains('\x1b'));
@@ -315,9 +312,25 @@ fn a_fifo_or_a_symlink_where_an_image_should_be_scores_0_without_blocking() {
         std::fs::remove_file(sub.join("week04_quad.png")).unwrap();
         std::os::unix::fs::symlink(&real, sub.join("week04_quad.png")).unwrap();
     });
+    // The uploads are what is judged here (`source = "upload"`): with the grader's renders they
+    // are still read with the same care, but earn nothing either way.
+    std::fs::write(
+        dir.path().join("upload.toml"),
+        rtoracle::grade::rubric::week04_uploads_toml(),
+    )
+    .unwrap();
     let (code, stdout, stderr) = run_with_timeout(
         dir.path(),
-        &["grade", "sub", "--out", "out", "--format", "json,markdown"],
+        &[
+            "grade",
+            "sub",
+            "--rubric",
+            "upload.toml",
+            "--out",
+            "out",
+            "--format",
+            "json,markdown",
+        ],
         Duration::from_secs(120),
     );
     assert_eq!(code, Some(0), "{stderr}");

@@ -161,7 +161,9 @@ fn three_shards_merged_equal_the_batch_graded_whole() {
         "batch.json",
     );
     refused(
-        &["grade", "--batch", "subs", "--shard", "4/3", "--out", "refused"],
+        &[
+            "grade", "--batch", "subs", "--shard", "4/3", "--out", "refused",
+        ],
         "4/3",
     );
 }
