@@ -509,7 +509,7 @@ pub struct Hello {
 }
 
 /// The keys a hello answer may have.
-pub const HELLO_KEYS: [&str; 4] = ["name", "protocol", "shapes", "error"];
+pub const HELLO_KEYS: [&str; 5] = ["name", "protocol", "shapes", "ops", "error"];
 
 /// The keys of `map` that are not [`HELLO_KEYS`], in order, each capped; at most 8.
 fn unknown_hello_keys(map: &serde_json::Map<String, serde_json::Value>) -> Vec<String> {

@@ -11,6 +11,7 @@ use crate::candidate::check::{
     FailureKind as CheckKind, Verdict, decide_winding, judge_exact_wound, judge_wound,
 };
 use crate::candidate::python;
+use crate::candidate::render::{RenderJob, RenderOutcome, render_scene};
 use crate::candidate::report::python_repro;
 use crate::candidate::{
     CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
@@ -150,7 +151,7 @@ impl CodeChecker for CourseCodeChecker {
         submission: &Path,
         jobs: &[crate::grade::inputs::RenderJob],
     ) -> Vec<crate::grade::inputs::RenderOutcome> {
-        super::render::course_render(self, submission, jobs)
+        course_render(self, submission, jobs)
     }
 
     fn vectors_sha256(&self) -> String {
@@ -365,6 +366,74 @@ impl CourseCodeChecker {
         out.failures.extend(ambiguous_failures);
     }
 }
+
+/// Renders each job with the course adapter in one sandboxed session on `submission` (started
+/// once, restarted after a time-out or a death); a session that cannot start gives every job
+/// the reason.
+fn course_render(
+    checker: &CourseCodeChecker,
+    submission: &Path,
+    jobs: &[RenderJob],
+) -> Vec<RenderOutcome> {
+    let mut session = match start(checker, submission, jobs) {
+        Ok(s) => s,
+        Err(why) => {
+            return jobs
+                .iter()
+                .map(|_| RenderOutcome::Declined(why.clone()))
+                .collect();
+        }
+    };
+    let submission_dir = std::path::absolute(submission).unwrap_or_else(|_| submission.into());
+    let sandbox_dir = session.sandbox_dir().to_path_buf();
+    let dirs = [sandbox_dir.as_path(), submission_dir.as_path()];
+    jobs.iter()
+        .map(|job| match render_scene(&mut session, job) {
+            RenderOutcome::Raised(mut e) => {
+                for text in [&mut e.message, &mut e.traceback] {
+                    *text = strip_dirs(text, &dirs);
+                }
+                RenderOutcome::Raised(e)
+            }
+            other => other,
+        })
+        .collect()
+}
+
+/// Starts the render session. One interpreter renders every job, so its CPU limit is the
+/// code checks' plus every job's wall time: a render that keeps within its `render_seconds` is
+/// never stopped by the CPU limit meant for the code checks.
+fn start(
+    checker: &CourseCodeChecker,
+    submission: &Path,
+    jobs: &[RenderJob],
+) -> Result<Session, String> {
+    let python = python::choose(
+        checker.python.as_deref(),
+        &checker.python_requires,
+        &checker.policy,
+    )
+    .map_err(|e| e.to_string())?;
+    let options = RunOptions {
+        timeout: checker.case_timeout,
+        hello_timeout: checker.import_timeout,
+        limits: {
+            let mut limits = checker.policy.clone();
+            let render_seconds: u64 = jobs.iter().map(|j| j.time_limit.as_secs() + 1).sum();
+            limits.cpu_seconds = limits.cpu_seconds.saturating_add(render_seconds);
+            limits
+        },
+        budget: None,
+        ..RunOptions::default()
+    };
+    CandidateCommand::python_course_with(submission, Some(&python), true)
+        .and_then(|command| Session::start(command, options))
+        .map_err(|e| match e {
+            HarnessError::Python(e) => format!("cannot run the Python interpreter: {e}"),
+            e => e.to_string(),
+        })
+}
+
 
 #[cfg(test)]
 mod tests {

@@ -86,7 +86,7 @@ pub trait ImageChecker: Sync {
 
     /// Judges the grader's render of `scene` from the submission's code (linear RGB at
     /// `render.spp` samples per pixel). The default judges it as an uploaded PNG of the course's
-    /// encoding ([`judge_as_png`](super::render::judge_as_png)), which is enough for checkers
+    /// encoding ([`judge_as_png`]), which is enough for checkers
     /// that read only files (and for fakes).
     fn check_render(
         &self,
@@ -94,7 +94,7 @@ pub trait ImageChecker: Sync {
         scene: &SceneSource,
         heatmap_out: &Path,
     ) -> ImageOutcome {
-        super::render::judge_as_png(render, |png| self.check_scene(png, scene, heatmap_out))
+        judge_as_png(render, |png| self.check_scene(png, scene, heatmap_out))
     }
 }
 
@@ -215,4 +215,56 @@ impl ImageOutcome {
             heatmap: None,
         }
     }
+}
+
+/// The render as the 8-bit image of the course's encoding (what the course's code would have
+/// written as a PNG).
+pub(crate) fn encoded(image: &RenderedImage) -> crate::image_io::Rgb8Image {
+    let data = image
+        .data
+        .iter()
+        .flat_map(|p| p.map(|x| crate::compare::Encoding::Course.encode(f64::from(x))))
+        .collect();
+    crate::image_io::Rgb8Image {
+        width: image.width,
+        height: image.height,
+        data,
+    }
+}
+
+/// How a render group's result reads when the checker has no render to judge: the render
+/// converted to the course's 8-bit encoding, written as a PNG into a private folder, and judged
+/// as an uploaded image of that encoding would be. [`ImageChecker::check_render`]'s default.
+pub fn judge_as_png(
+    image: &RenderedImage,
+    check_png: impl FnOnce(&Path) -> ImageOutcome,
+) -> ImageOutcome {
+    // Made and registered in one step (removed on Ctrl-C), as an upload's staging folder is.
+    let made = crate::interrupt::create_temporary(
+        || {
+            tempfile::Builder::new()
+                .prefix(".rtoracle-render-")
+                .tempdir()
+        },
+        |t| t.path(),
+    );
+    let (dir, _cleanup) = match made {
+        Ok(made) => made,
+        Err(e) => {
+            return ImageOutcome::unusable(format!(
+                "the render could not be staged ({})",
+                e.kind()
+            ));
+        }
+    };
+    let path = dir.path().join("render.png");
+    let png = encoded(image);
+    if let Err(e) = crate::image_io::write_png(&path, &png) {
+        return ImageOutcome::unusable(format!("the render could not be staged ({e})"));
+    }
+    let mut outcome = check_png(&path);
+    if let ImageVerdict::Unusable(why) = &mut outcome.verdict {
+        *why = why.replace(&path.display().to_string(), "the render");
+    }
+    outcome
 }

@@ -20,12 +20,10 @@ use std::time::Duration;
 
 use serde_json::{Value, json};
 
-use super::CourseCodeChecker;
-use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict};
+use super::inputs::{ImageChecker, ImageOutcome};
 use super::result::CheckResult;
 use super::rubric::{Group, SceneSource};
-use crate::candidate::render::{RenderJob, RenderOutcome, RenderedImage, render_scene};
-use crate::candidate::{CandidateCommand, HarnessError, RunOptions, Session, python};
+use crate::candidate::render::{RenderJob, RenderOutcome, RenderedImage};
 use crate::scene::SceneDescription;
 
 /// The scene description an image group renders: the built-in's or the rubric's scene file.
@@ -34,71 +32,6 @@ pub(crate) fn scene_description(scene: &SceneSource) -> Result<SceneDescription,
         SceneSource::Builtin(name) => crate::scene::builtin(name).map_err(|e| e.to_string()),
         SceneSource::File(f) => Ok(f.description.clone()),
     }
-}
-
-/// Renders each job with the course adapter in one sandboxed session on `submission` (started
-/// once, restarted after a time-out or a death); a session that cannot start gives every job
-/// the reason.
-pub(crate) fn course_render(
-    checker: &CourseCodeChecker,
-    submission: &Path,
-    jobs: &[RenderJob],
-) -> Vec<RenderOutcome> {
-    let mut session = match start(checker, submission) {
-        Ok(s) => s,
-        Err(why) => {
-            return jobs
-                .iter()
-                .map(|_| RenderOutcome::Declined(why.clone()))
-                .collect();
-        }
-    };
-    let submission_dir = std::path::absolute(submission).unwrap_or_else(|_| submission.into());
-    let dirs = [session.sandbox_dir().to_path_buf(), submission_dir];
-    jobs.iter()
-        .map(|job| match render_scene(&mut session, job) {
-            RenderOutcome::Raised(mut e) => {
-                for text in [&mut e.message, &mut e.traceback] {
-                    *text = strip_dirs(text, &dirs);
-                }
-                RenderOutcome::Raised(e)
-            }
-            other => other,
-        })
-        .collect()
-}
-
-/// Names files as the student knows them (without the sandbox's or the grader's folders).
-fn strip_dirs(text: &str, dirs: &[std::path::PathBuf]) -> String {
-    let mut text = text.to_string();
-    for d in dirs {
-        for prefix in [format!("{}/./", d.display()), format!("{}/", d.display())] {
-            text = text.replace(&prefix, "");
-        }
-    }
-    text
-}
-
-fn start(checker: &CourseCodeChecker, submission: &Path) -> Result<Session, String> {
-    let python = python::choose(
-        checker.python.as_deref(),
-        &checker.python_requires,
-        &checker.policy,
-    )
-    .map_err(|e| e.to_string())?;
-    let options = RunOptions {
-        timeout: checker.case_timeout,
-        hello_timeout: checker.import_timeout,
-        limits: checker.policy.clone(),
-        budget: None,
-        ..RunOptions::default()
-    };
-    CandidateCommand::python_course_with(submission, Some(&python), true)
-        .and_then(|command| Session::start(command, options))
-        .map_err(|e| match e {
-            HarnessError::Python(e) => format!("cannot run the Python interpreter: {e}"),
-            e => e.to_string(),
-        })
 }
 
 /// The render jobs of the rubric's render groups, in `groups`' order: `Err` for a group whose
@@ -231,7 +164,7 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
     let upload = &image.metrics["upload"];
     let said = match upload["verdict"]["verdict"].as_str() {
         Some("pass") => format!(
-            " Your uploaded {file} matches it too (uploads earn no points: the grader renders your code)."
+            " Your uploaded {file} matches the reference (uploads earn no points: the grader renders your code)."
         ),
         Some("fail") => format!(
             " Your uploaded {file} differs from the reference (uploads earn no points: the grader renders your code)."
@@ -251,54 +184,3 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
     check.message = message;
 }
 
-/// The render as the 8-bit image of the course's encoding (what the course's code would have
-/// written as a PNG).
-pub(crate) fn encoded(image: &RenderedImage) -> crate::image_io::Rgb8Image {
-    let data = image
-        .data
-        .iter()
-        .flat_map(|p| p.map(|x| crate::compare::Encoding::Course.encode(f64::from(x))))
-        .collect();
-    crate::image_io::Rgb8Image {
-        width: image.width,
-        height: image.height,
-        data,
-    }
-}
-
-/// How a render group's result reads when the checker has no render to judge: the render
-/// converted to the course's 8-bit encoding, written as a PNG into a private folder, and judged
-/// as an uploaded image of that encoding would be. [`ImageChecker::check_render`]'s default.
-pub fn judge_as_png(
-    image: &RenderedImage,
-    check_png: impl FnOnce(&Path) -> ImageOutcome,
-) -> ImageOutcome {
-    // Made and registered in one step (removed on Ctrl-C), as an upload's staging folder is.
-    let made = crate::interrupt::create_temporary(
-        || {
-            tempfile::Builder::new()
-                .prefix(".rtoracle-render-")
-                .tempdir()
-        },
-        |t| t.path(),
-    );
-    let (dir, _cleanup) = match made {
-        Ok(made) => made,
-        Err(e) => {
-            return ImageOutcome::unusable(format!(
-                "the render could not be staged ({})",
-                e.kind()
-            ));
-        }
-    };
-    let path = dir.path().join("render.png");
-    let png = encoded(image);
-    if let Err(e) = crate::image_io::write_png(&path, &png) {
-        return ImageOutcome::unusable(format!("the render could not be staged ({e})"));
-    }
-    let mut outcome = check_png(&path);
-    if let ImageVerdict::Unusable(why) = &mut outcome.verdict {
-        *why = why.replace(&path.display().to_string(), "the render");
-    }
-    outcome
-}

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::copies::{CopyFinding, Fingerprint, recognise};
+use crate::candidate::render::RenderOutcome;
 use super::inputs::{
     CodeChecker, CodeOutcome, FailureKind, ImageChecker, ImageOutcome, ImageVerdict,
 };
@@ -105,6 +106,38 @@ impl StagedImage {
     }
 }
 
+/// The check of a render group: the grader's render of the submission's code judged against
+/// the golden, the upload's judgement (`upload`) reported beside it.
+///
+/// What the submission's code returned may itself be a copy: pixels read from the course's
+/// published image or from the reference's render (scored 0, said so). Renders are not
+/// compared with each other: one seed and the same formulas give honest submissions the same
+/// noise.
+fn render_check(
+    g: &Group,
+    upload: ImageOutcome,
+    render: RenderOutcome,
+    images: &dyn ImageChecker,
+    out_dir: &Path,
+) -> super::result::CheckResult {
+    let copy = match &render {
+        RenderOutcome::Rendered(image) => {
+            let scene = g.scene_source().expect("validated");
+            let fp = Fingerprint::of(&super::inputs::encoded(image));
+            recognise(&fp, &scene).filter(CopyFinding::zeroes)
+        }
+        _ => None,
+    };
+    let heatmap = out_dir.join(heatmap_name(g));
+    let judged = super::render::judge(g, render, upload, images, &heatmap);
+    let mut check = image_check(g, judged, copy.clone(), out_dir);
+    match &copy {
+        Some(c) => check.message = c.render_sentence(),
+        None => super::render::explain(&mut check, g),
+    }
+    check
+}
+
 /// Grades the submission in folder `submission`: runs the code groups through `code` and the
 /// image groups through `images` (heatmaps go into `out_dir`, which must exist), and scores them
 /// with `rubric`. Whatever the student's code does, a report comes back; the only errors are a
@@ -162,30 +195,13 @@ pub fn grade(
     for g in &rubric.groups {
         match g.kind {
             GroupKind::Code => checks.extend(code_check(g, &outcome)),
-            GroupKind::Image if g.renders() => {
-                let staged = image_outcomes.next().expect("one per image group");
-                let render = renders.next().expect("one per render group");
-                // What the submission's code returned may itself be a copy: pixels read from
-                // the course's published image or from the reference's render. Renders are
-                // not compared with each other: one seed and the same formulas give the same
-                // noise to honest submissions.
-                let copy = match &render {
-                    crate::candidate::render::RenderOutcome::Rendered(image) => {
-                        let scene = g.scene_source().expect("validated");
-                        let fp = Fingerprint::of(&super::render::encoded(image));
-                        recognise(&fp, &scene).filter(CopyFinding::zeroes)
-                    }
-                    _ => None,
-                };
-                let heatmap = out_dir.join(heatmap_name(g));
-                let judged = super::render::judge(g, render, staged.outcome, images, &heatmap);
-                let mut check = image_check(g, judged, copy.clone(), out_dir);
-                match &copy {
-                    Some(c) => check.message = c.render_sentence(),
-                    None => super::render::explain(&mut check, g),
-                }
-                checks.push(check);
-            }
+            GroupKind::Image if g.renders() => checks.push(render_check(
+                g,
+                image_outcomes.next().expect("one per image group").outcome,
+                renders.next().expect("one per render group"),
+                images,
+                out_dir,
+            )),
             GroupKind::Image => {
                 let staged = image_outcomes.next().expect("one per image group");
                 // A recognised copy is not compared with classmates' images (it scores 0).
@@ -196,16 +212,6 @@ pub fn grade(
             }
         }
     }
-    let goldens_sha256 = image_groups
-        .iter()
-        .filter_map(|g| g.scene_source())
-        .map(|s| (s.label().to_string(), images.scene_golden_sha256(&s)))
-        .collect();
-    let scenes_sha256 = image_groups
-        .iter()
-        .filter_map(|g| g.scene_file.as_ref())
-        .map(|f| (f.label.clone(), f.sha256.clone()))
-        .collect();
     let score = round2(checks.iter().map(|c| c.score).sum());
     let submission_name = submission
         .canonicalize()
@@ -234,7 +240,36 @@ pub fn grade(
                 .map(|f| (f.id.clone(), f.shape))
                 .collect(),
         },
-        reproducibility: Reproducibility {
+        reproducibility: reproducibility(submission, rubric, code, images, &image_groups),
+    })
+    .map(|mut r| {
+        r.execution_time = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
+        r
+    })
+}
+
+
+/// What the report says the grade was made from: tool, rubric, vectors, goldens, scene files
+/// and the submission's files, each by its SHA-256, and the checkers.
+fn reproducibility(
+    submission: &Path,
+    rubric: &Rubric,
+    code: &dyn CodeChecker,
+    images: &dyn ImageChecker,
+    image_groups: &[&Group],
+) -> Reproducibility {
+    let shapes = rubric.code_shapes();
+    let goldens_sha256 = image_groups
+        .iter()
+        .filter_map(|g| g.scene_source())
+        .map(|s| (s.label().to_string(), images.scene_golden_sha256(&s)))
+        .collect();
+    let scenes_sha256 = image_groups
+        .iter()
+        .filter_map(|g| g.scene_file.as_ref())
+        .map(|f| (f.label.clone(), f.sha256.clone()))
+        .collect();
+    Reproducibility {
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
             rubric_sha256: rubric.sha256.clone(),
             vectors_sha256: if shapes.is_empty() {
@@ -247,12 +282,7 @@ pub fn grade(
             submission_sha256: super::intake::submission_hashes(submission),
             code_checker: code.describe(),
             image_checker: images.describe(),
-        },
-    })
-    .map(|mut r| {
-        r.execution_time = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
-        r
-    })
+        }
 }
 
 #[cfg(test)]

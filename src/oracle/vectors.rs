@@ -213,7 +213,18 @@ pub struct Expect {
     /// ([`super::watertight`]): a ray through an edge or vertex this shape shares with the
     /// group's other shapes must hit at least one of them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub watertight: Option<super::watertight::Watertight>,
+    pub watertight: Option<Watertight>,
+}
+
+/// The rule of a watertight group, carried by each of its members.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Watertight {
+    /// The group's id (`watertight-quads-0003`): the members are the cases that carry it.
+    pub group: String,
+    /// `hit`: the ray must hit at least one member (at the right `t`); `ambiguous`: a ray in
+    /// the plane of the group, not scored.
+    pub class: Class,
 }
 
 /// One test vector.

@@ -24,23 +24,11 @@
 //! them is hit exactly (the generator checks it). Rays that lie in the plane (tangent to the
 //! group) make groups of class `ambiguous`: reported, never scored.
 
-use serde::{Deserialize, Serialize};
-
 use super::classify::classify_tagged_with;
 use super::generate::{CAMERA, Stream, add, pow2, scale, sub};
 use super::profile::Judging;
+pub use super::vectors::Watertight;
 use super::vectors::{Case, Class, RaySpec, ShapeSpec};
-
-/// The rule of a watertight group, carried by each of its members.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Watertight {
-    /// The group's id (`watertight-quads-0003`): the members are the cases that carry it.
-    pub group: String,
-    /// `hit`: the ray must hit at least one member (at the right `t`); `ambiguous`: a ray in
-    /// the plane of the group, not scored.
-    pub class: Class,
-}
 
 /// The kinds of group, with how many groups of each the suite holds (the last
 /// [`TANGENT_GROUPS`] of each have a ray in the plane).

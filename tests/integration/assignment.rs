@@ -595,11 +595,12 @@ fn own_scene(width: usize, aspect_ratio: f64, spp: u32, albedo: [f64; 3]) -> Str
     )
 }
 
-/// The image group of `scene` (a file beside the rubric).
+/// The image group of `scene` (a file beside the rubric), judging the uploaded image (these
+/// tests are of the judging of uploads; `renders.rs` tests the grader's renders).
 fn image_group(id: &str, scene: &str, points: u32) -> String {
     format!(
         "[[group]]\nid = \"image.{id}\"\nname = \"{id}\"\nkind = \"image\"\nscene = \"{scene}\"\n\
-         points = {points}\n\n"
+         source = \"upload\"\npoints = {points}\n\n"
     )
 }
 

@@ -82,6 +82,8 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("render", "--profile", false, false),
     ("render", "--textures", false, false),
     ("scenes", "--dump", false, false),
+    ("scenes", "--profile", false, false),
+    ("scenes", "--textures", false, false),
     ("golden", "--dir", false, false),
     ("golden", "--spp", true, false),
     ("golden", "--scenes", false, false),

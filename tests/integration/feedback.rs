@@ -50,8 +50,18 @@ points = 30
 
 /// Grades `sub` (in `dir`) into `dir/out` with `extra` arguments; returns feedback.md and
 /// results.json.
+/// Grades `sub` in `dir` (with the uploads' variant of the built-in rubric unless `extra` names
+/// a rubric: these tests are of the feedback's words, not of the grader's renders).
 fn grade(dir: &Path, sub: &str, extra: &[&str]) -> (String, Value) {
     let mut args = vec!["grade", sub, "--out", "out"];
+    if !extra.contains(&"--rubric") {
+        std::fs::write(
+            dir.join("uploads.toml"),
+            rtoracle::grade::rubric::week04_uploads_toml(),
+        )
+        .unwrap();
+        args.extend(["--rubric", "uploads.toml"]);
+    }
     args.extend(extra);
     let out = run_in(dir, &args);
     assert_eq!(

@@ -353,7 +353,8 @@ fn report_json_holds_checks_repros_metrics_pictures_and_hashes() {
     assert_eq!(rep["tool_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(
         rep["rubric_sha256"],
-        sha256_hex(rtoracle::grade::rubric::WEEK04_RUBRIC.as_bytes())
+        // The batch graded with the uploads' variant of the built-in rubric.
+        sha256_hex(rtoracle::grade::rubric::week04_uploads_toml().as_bytes())
     );
     assert_eq!(rep["vectors_sha256"].as_str().unwrap().len(), 64);
     assert_eq!(
@@ -806,7 +807,10 @@ fn re_encode(src: &Path, dest: &Path) {
 }
 
 struct GamingBatch {
+    /// Graded with the built-in rubric (the grader renders each submission's code).
     out: PathBuf,
+    /// Graded with its uploads' variant (`source = "upload"`).
+    uploads: PathBuf,
     output: Output,
     /// Whether the course's published images were there (the skeleton's submission).
     skeleton: bool,
@@ -856,8 +860,32 @@ fn gaming_batch() -> &'static GamingBatch {
             None => false,
         };
         let output = run_in(&root, &["grade", "--batch", "subs", "--out", "out"]);
+        // The same batch with the uploads judged, as a rubric with `source = "upload"` does:
+        // where the copy checks of uploads decide the points.
+        std::fs::write(
+            root.join("uploads.toml"),
+            rtoracle::grade::rubric::week04_uploads_toml(),
+        )
+        .unwrap();
+        let uploads_output = run_in(
+            &root,
+            &[
+                "grade",
+                "--batch",
+                "subs",
+                "--rubric",
+                "uploads.toml",
+                "--out",
+                "uploads",
+            ],
+        );
+        assert!(
+            uploads_output.status.code().is_some_and(|c| c <= 1),
+            "{uploads_output:?}"
+        );
         GamingBatch {
             out: root.join("out"),
+            uploads: root.join("uploads"),
             output,
             skeleton,
         }
@@ -920,6 +948,9 @@ fn the_instructors_solution_and_honest_work_score_100_and_the_skeleton_at_most_5
     if b.skeleton {
         let report = read_json(&b.out.join("skeleton/report.json"));
         assert!(report["score"].as_f64().unwrap() <= 5.0, "{report}");
+        // With its uploads judged, the published images are recognised as the course's.
+        let report = read_json(&b.uploads.join("skeleton/report.json"));
+        assert!(report["score"].as_f64().unwrap() <= 5.0, "{report}");
         for (id, file) in [
             ("image.week04-sphere", "week04_sphere.png"),
             ("image.week04-quad", "week04_quad.png"),
@@ -943,7 +974,7 @@ fn the_instructors_solution_and_honest_work_score_100_and_the_skeleton_at_most_5
 fn a_copied_image_flags_both_submissions_and_the_reference_render_scores_0() {
     let b = gaming_batch();
     let shared = |name: &str| -> Vec<String> {
-        let report = read_json(&b.out.join(name).join("report.json"));
+        let report = read_json(&b.uploads.join(name).join("report.json"));
         let mut with = Vec::new();
         for c in report["checks"].as_array().unwrap() {
             for f in c["image"]["copies"].as_array().into_iter().flatten() {
@@ -965,7 +996,7 @@ fn a_copied_image_flags_both_submissions_and_the_reference_render_scores_0() {
         assert!(shared(name).is_empty(), "{name}: {:?}", shared(name));
     }
     assert!(shared("instructor-solution").is_empty());
-    let feedback = std::fs::read_to_string(b.out.join("copier/feedback.md")).unwrap();
+    let feedback = std::fs::read_to_string(b.uploads.join("copier/feedback.md")).unwrap();
     assert!(
         feedback.contains("shares its Monte Carlo noise with another submission"),
         "{feedback}"
@@ -974,13 +1005,13 @@ fn a_copied_image_flags_both_submissions_and_the_reference_render_scores_0() {
         !feedback.contains("honest-numpy"),
         "a student's feedback names no classmate"
     );
-    let summary = std::fs::read_to_string(b.out.join("summary.md")).unwrap();
+    let summary = std::fs::read_to_string(b.uploads.join("summary.md")).unwrap();
     assert!(
         summary.contains(r"| `image.week04-sphere` | copier and honest\-numpy |"),
         "{summary}"
     );
     // The reference tracer's own render scores 0 and says so; the rest of the grade stands.
-    let report = read_json(&b.out.join("pip-render/report.json"));
+    let report = read_json(&b.uploads.join("pip-render/report.json"));
     let c = check(&report, "image.week04-sphere");
     assert_eq!(c["score"].as_f64(), Some(0.0));
     assert!(

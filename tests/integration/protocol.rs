@@ -314,7 +314,12 @@ fn fuzz_by_time_runs_for_the_time_and_shows_every_kind() {
     // The search runs the 2 s, shrinking a tenth more (0.2 s); the rest is start-up.
     assert!(took < Duration::from_secs(2 + 6), "{took:?}");
     // More than one round of 1000: the time bounded the run.
-    let run: usize = text.split_whitespace().next().unwrap().parse().unwrap();
+    let run: usize = text
+        .lines()
+        .find(|l| l.contains("random definite cases run"))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|w| w.parse().ok())
+        .unwrap_or_else(|| panic!("no count of cases run: {text}"));
     assert!(run > 1000, "{text}");
     assert!(text.contains("[missed hit]") && text.contains("(sphere)") && text.contains("(quad)"));
     // An adapter's report speaks of requests, not of the course's Python.

@@ -740,7 +740,7 @@ fn render_names_the_profile_and_the_samples_taken() {
     assert!(
         String::from_utf8(out.stderr)
             .unwrap()
-            .contains("30 spp, seed")
+            .contains("30 spp: 25 jittered samples a pixel, seed")
     );
     let out = run_in(
         dir.path(),

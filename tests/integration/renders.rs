@@ -226,7 +226,7 @@ fn source_upload_judges_the_uploaded_image_and_render_ignores_it_for_points() {
             assert_eq!(m["upload"]["verdict"]["verdict"], "pass", "{c}");
             let message = c["message"].as_str().unwrap();
             assert!(
-                message.contains("Your uploaded week04_sphere.png matches it too"),
+                message.contains("Your uploaded week04_sphere.png matches the reference"),
                 "{message}"
             );
         }

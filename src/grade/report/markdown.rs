@@ -85,7 +85,7 @@ fn write_lost(md: &mut String, report: &GradeReport, shown: &mut Shown) {
             if img.heatmap.is_some() {
                 let _ = writeln!(
                     md,
-                    "\nIn the heatmap of {} below, red marks pixels brighter than the reference allows, blue darker ones, and green boxes outline the regions that fail.",
+                    "\nIn the heatmap of {} below (one map per colour channel: red, green, blue), orange marks pixels higher than the reference allows, purple lower ones, and green boxes outline the regions that fail.",
                     img.file
                 );
             }
@@ -117,7 +117,7 @@ fn write_passed_and_heatmaps(md: &mut String, report: &GradeReport) {
     if heatmaps.is_empty() {
         return;
     }
-    md.push_str("\n## Heatmaps\n\nYour images against the reference, as signed z-scores: white where they agree up to sampling noise, red where yours is brighter, blue where darker");
+    md.push_str("\n## Heatmaps\n\nYour images against the reference, as signed z-scores, one map per colour channel (red, green, blue): white where they agree up to sampling noise, orange where yours is higher, purple where lower");
     let image_lost = visible().any(|c| c.image.is_some() && c.status == CheckStatus::Failed);
     md.push_str(if image_lost {
         "; green boxes outline the regions that fail.\n"
