@@ -99,8 +99,8 @@ pub struct Session {
     junk_left: usize,
     /// What the session noticed about the candidate's use of the protocol ([`Session::notes`]).
     notes: Vec<String>,
-    /// Stdout lines read from the running process since its hello.
-    lines_seen: usize,
+    /// Stdout lines read after a hello, over every process of the session (restarts included).
+    lines_seen_ever: usize,
 }
 
 /// The usual reason a candidate's lines never arrive.
@@ -138,7 +138,7 @@ impl Session {
             detail_left: RUN_DETAIL_BYTES,
             junk_left: RUN_JUNK_BYTES,
             notes: Vec::new(),
-            lines_seen: 0,
+            lines_seen_ever: 0,
         };
         match session.launch()? {
             Ok(hello) => {
@@ -295,7 +295,6 @@ impl Session {
                         });
                     }
                     self.proc = Some(proc);
-                    self.lines_seen = 0;
                     if let Some(error) = &mut hello.error {
                         self.localise(error);
                     }
@@ -684,7 +683,7 @@ impl Session {
             };
             let parsed = match next {
                 Ok(Line::Parsed(parsed)) => {
-                    self.lines_seen += 1;
+                    self.lines_seen_ever += 1;
                     parsed
                 }
                 Ok(Line::Oversize(head)) => {
@@ -773,7 +772,9 @@ impl Session {
             self.sync = true;
             return None;
         }
-        if self.lines_seen == 0 && !self.notes.iter().any(|n| n.contains(FLUSH_HINT)) {
+        // Only a candidate that never answered anything: one that answers some cases and hangs
+        // on others flushes, and its restarted processes have seen nothing yet.
+        if self.lines_seen_ever == 0 && !self.notes.iter().any(|n| n.contains(FLUSH_HINT)) {
             self.notes.push(format!(
                 "no line came from the candidate after its hello while it was sent requests \
                  to answer one at a time; {FLUSH_HINT}"

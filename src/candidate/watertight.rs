@@ -1,8 +1,9 @@
 //! Judging the watertight groups of a run ([`crate::oracle::watertight`]): a group of class
 //! `hit` holds when the candidate hit at least one of its members at the member's exact `t`,
 //! and cracks when every member was answered and none was so hit (an open edge). A group with
-//! a member not answered (a time-out, a death, a protocol error, a shape not implemented) is
-//! not judged: the member's own failure, if any, is reported by the vector's verdict.
+//! a member not answered (a time-out, a death, a protocol error, a shape not implemented) or
+//! answered with an error (the code raised) is not judged: the member's own failure, if any,
+//! is reported by the vector's verdict.
 
 use super::outcome::Outcome;
 use crate::oracle::vectors::{Case, Class};
@@ -12,7 +13,7 @@ use crate::oracle::vectors::{Case, Class};
 pub enum GroupResult {
     /// At least one member was hit at its exact `t`.
     Held,
-    /// Every member was answered, none hit: the ray went through a crack.
+    /// Every member was answered without an error, none hit: the ray went through a crack.
     Cracked,
     /// Not judged: a member was not answered, or the group is `ambiguous`.
     Unjudged,
@@ -68,10 +69,9 @@ pub fn judge_groups(cases: &[Case], outcomes: &[Outcome]) -> Vec<Group> {
             .members
             .iter()
             .any(|&i| hit_right(&cases[i], &outcomes[i]));
-        let all_answered = group
-            .members
-            .iter()
-            .all(|&i| matches!(outcomes[i], Outcome::Answered { .. }));
+        let all_answered = group.members.iter().all(
+            |&i| matches!(&outcomes[i], Outcome::Answered { answer, .. } if answer.error.is_none()),
+        );
         group.result = match (class, held, all_answered) {
             (Class::Hit, true, _) => GroupResult::Held,
             (Class::Hit, false, true) => GroupResult::Cracked,

@@ -154,7 +154,9 @@ pub fn grade_batch_shard(
         .collect();
     let subs: Vec<PathBuf> = all
         .into_iter()
-        .filter(|s| shard.is_none_or(|sh| sh.holds(&folder_name(s.file_name().unwrap_or_default()))))
+        .filter(|s| {
+            shard.is_none_or(|sh| sh.holds(&folder_name(s.file_name().unwrap_or_default())))
+        })
         .collect();
     let bar = if std::io::stderr().is_terminal() {
         let bar =

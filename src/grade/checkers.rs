@@ -434,7 +434,6 @@ fn start(
         })
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

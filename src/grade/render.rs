@@ -183,4 +183,3 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
     message.push_str(&said);
     check.message = message;
 }
-

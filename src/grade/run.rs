@@ -6,13 +6,13 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::copies::{CopyFinding, Fingerprint, recognise};
-use crate::candidate::render::RenderOutcome;
 use super::inputs::{
     CodeChecker, CodeOutcome, FailureKind, ImageChecker, ImageOutcome, ImageVerdict,
 };
 use super::result::{CodeRun, GradeError, GradeReport, Reproducibility, round2};
 use super::rubric::{Group, GroupKind, Rubric, SceneSource};
 use super::score::{code_check, heatmap_name, image_check};
+use crate::candidate::render::RenderOutcome;
 
 /// The size the image of `scene` must have, when `scene` is a built-in scene.
 pub(crate) fn expected_size(scene: &SceneSource) -> Option<(usize, usize)> {
@@ -248,7 +248,6 @@ pub fn grade(
     })
 }
 
-
 /// What the report says the grade was made from: tool, rubric, vectors, goldens, scene files
 /// and the submission's files, each by its SHA-256, and the checkers.
 fn reproducibility(
@@ -270,19 +269,19 @@ fn reproducibility(
         .map(|f| (f.label.clone(), f.sha256.clone()))
         .collect();
     Reproducibility {
-            tool_version: env!("CARGO_PKG_VERSION").to_string(),
-            rubric_sha256: rubric.sha256.clone(),
-            vectors_sha256: if shapes.is_empty() {
-                String::new()
-            } else {
-                code.vectors_sha256()
-            },
-            goldens_sha256,
-            scenes_sha256,
-            submission_sha256: super::intake::submission_hashes(submission),
-            code_checker: code.describe(),
-            image_checker: images.describe(),
-        }
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        rubric_sha256: rubric.sha256.clone(),
+        vectors_sha256: if shapes.is_empty() {
+            String::new()
+        } else {
+            code.vectors_sha256()
+        },
+        goldens_sha256,
+        scenes_sha256,
+        submission_sha256: super::intake::submission_hashes(submission),
+        code_checker: code.describe(),
+        image_checker: images.describe(),
+    }
 }
 
 #[cfg(test)]

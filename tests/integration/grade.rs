@@ -655,8 +655,17 @@ fn the_autograder_package_grades_a_submission_like_gradescope_would() {
         .filter(|t| t["max_score"].as_f64().unwrap() > 0.0)
         .collect();
     assert_eq!(tests.len(), 4);
-    assert_eq!(tests[0]["status"], "failed");
-    assert!(tests[1..].iter().all(|t| t["status"] == "passed"));
+    // The far root first fails the sphere vectors, and the grader's render of the sphere scene
+    // from the same code shows it; the quads and their scene pass.
+    let statuses: Vec<&str> = tests
+        .iter()
+        .map(|t| t["status"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        statuses,
+        ["failed", "passed", "failed", "passed"],
+        "{tests:#?}"
+    );
     // Graded with the secret seed, which needs no warning, by the recorded interpreter.
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(!stderr.contains("public seed"), "{stderr}");
@@ -1007,7 +1016,7 @@ fn a_copied_image_flags_both_submissions_and_the_reference_render_scores_0() {
     );
     let summary = std::fs::read_to_string(b.uploads.join("summary.md")).unwrap();
     assert!(
-        summary.contains(r"| `image.week04-sphere` | copier and honest\-numpy |"),
+        summary.contains("| `image.week04-sphere` | copier and honest-numpy |"),
         "{summary}"
     );
     // The reference tracer's own render scores 0 and says so; the rest of the grade stands.
@@ -1023,7 +1032,7 @@ fn a_copied_image_flags_both_submissions_and_the_reference_render_scores_0() {
     );
     assert_eq!(report["score"].as_f64(), Some(80.0));
     assert!(
-        summary.contains(r"pip\-render: week04\_sphere\.png is the reference tracer's own render"),
+        summary.contains("pip-render: week04_sphere.png is the reference tracer's own render"),
         "{summary}"
     );
 }
