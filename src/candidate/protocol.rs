@@ -825,9 +825,13 @@ mod tests {
             "{w:?}"
         );
         assert!(w[1].contains("\"x-build\"") && !w[1].contains("did you mean"));
-        assert!(w[1].contains("name, protocol, shapes, error"));
+        assert!(w[1].contains("name, protocol, shapes, ops, error"));
         let ok = Hello::parse(r#"{"name":"c","protocol":1,"shapes":["sphere"]}"#).unwrap();
         assert!(ok.warnings().is_empty());
+        // The function and render requests' list is a key of its own, not a typo.
+        let ops =
+            Hello::parse(r#"{"name":"c","protocol":1,"ops":["intersect","render"]}"#).unwrap();
+        assert!(ops.warnings().is_empty(), "{:?}", ops.warnings());
         for (typo, meant) in [("nme", "name"), ("protocl", "protocol"), ("Error", "error")] {
             assert_eq!(likely_hello_key(typo), Some(meant), "{typo}");
         }
