@@ -339,7 +339,11 @@ fn goldens_have_the_documented_channels_and_attributes() {
         );
         assert!(g.variance.is_some(), "{scene}");
         assert_eq!(g.attribute(ATTR_SCENE), Some(scene));
-        assert_eq!(g.attribute(ATTR_SPP), Some("4096"));
+        // 4096 samples, or under the course's jittered sampling (weeks 9 and 10) the whole
+        // passes over its strata that hold at least 4096: less than one more pass of week 10's
+        // 196 strata.
+        let spp: u32 = g.attribute(ATTR_SPP).unwrap().parse().unwrap();
+        assert!((4096..4096 + 196).contains(&spp), "{scene}: {spp}");
         assert_eq!(g.attribute(ATTR_SEED), Some("0"));
         assert_eq!(
             g.attribute("rtoracle.sampling")
@@ -535,7 +539,11 @@ fn openexr_reads_the_goldens() {
             assert_eq!(attrs[k.as_str()], v.as_str(), "{scene} {k}");
         }
         assert_eq!(attrs["rtoracle.scene"], scene);
-        assert_eq!(attrs["rtoracle.spp"], "4096");
+        assert_eq!(
+            attrs["rtoracle.spp"].as_str(),
+            ours.attribute("rtoracle.spp"),
+            "{scene}"
+        );
         assert_eq!(attrs["rtoracle.seed"], "0");
         assert_eq!(
             attrs["rtoracle.sceneSha256"], r["dump_sha256"],
