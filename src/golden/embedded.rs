@@ -70,10 +70,7 @@ const EMBEDDED: &[(&str, &[u8])] = &[
         "week09-blinn",
         include_bytes!("../../golden/week09-blinn.exr"),
     ),
-    (
-        "week10-dof",
-        include_bytes!("../../golden/week10-dof.exr"),
-    ),
+    ("week10-dof", include_bytes!("../../golden/week10-dof.exr")),
     (
         "week10-moving",
         include_bytes!("../../golden/week10-moving.exr"),
