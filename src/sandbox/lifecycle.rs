@@ -242,6 +242,14 @@ impl Sandbox {
             .and_then(watchdog::Watchdog::violation)
     }
 
+    /// Measures what the code wrote and holds once, now ([`watchdog::Watchdog::measure_now`]):
+    /// for the end of a run, which may come between two of the watchdog's ticks.
+    pub fn measure_now(&self) {
+        if let Some(w) = &self.watchdog {
+            w.measure_now();
+        }
+    }
+
     /// What ends the code's processes (for a restart or the end of a session).
     pub fn reaper(&self) -> Reaper {
         self.reaper.clone()

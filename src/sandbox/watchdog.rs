@@ -43,11 +43,20 @@ fn cgroup_ran_out(cgroup: Option<&std::path::Path>) -> bool {
 pub const TICK: Duration = Duration::from_millis(100);
 
 /// Measures a sandbox's writing while it lives (see the module's promises).
-#[derive(Debug)]
 pub struct Watchdog {
     stop: Arc<AtomicBool>,
     violation: Arc<Mutex<Option<String>>>,
     thread: Option<std::thread::JoinHandle<()>>,
+    /// One measurement (what each tick runs), for [`Watchdog::measure_now`].
+    measure: Arc<dyn Fn() + Send + Sync>,
+}
+
+impl std::fmt::Debug for Watchdog {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Watchdog")
+            .field("violation", &self.violation())
+            .finish_non_exhaustive()
+    }
 }
 
 impl Watchdog {
@@ -61,8 +70,47 @@ impl Watchdog {
         };
         let stop = Arc::new(AtomicBool::new(false));
         let violation = Arc::new(Mutex::new(None));
+        let measure: Arc<dyn Fn() + Send + Sync> = {
+            let violation = violation.clone();
+            Arc::new(move || {
+                let mut usage = usage_of_tree(&dir);
+                if let Some(uid) = uid {
+                    let shared = owned_usage(uid);
+                    usage.bytes = usage.bytes.saturating_add(shared.bytes);
+                    usage.entries = usage.entries.saturating_add(shared.entries);
+                    usage.deepest = usage.deepest.max(shared.deepest);
+                }
+                let procs = process_usage(&members);
+                usage.bytes = usage
+                    .bytes
+                    .saturating_add(procs.unlinked_bytes)
+                    .saturating_add(procs.tmpfs_bytes);
+                let memory = if procs.memory > limits.memory_bytes {
+                    procs.proportional()
+                } else {
+                    procs.memory
+                };
+                let memory = if cgroup_ran_out(cgroup.as_deref()) {
+                    // The kernel's bound was reached between two ticks.
+                    memory.max(limits.memory_bytes.saturating_add(1))
+                } else {
+                    memory
+                };
+                let why = judge(usage, limits.disk_bytes)
+                    .or_else(|| judge_memory(memory, limits.memory_bytes));
+                if let Some(why) = why {
+                    // Recorded before the kill, so the session that sees the code die
+                    // finds why.
+                    violation
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .get_or_insert(why);
+                    reaper.reap();
+                }
+            })
+        };
         let thread = {
-            let (stop, violation) = (stop.clone(), violation.clone());
+            let (stop, measure) = (stop.clone(), measure.clone());
             std::thread::Builder::new()
                 .name("sandbox-watchdog".into())
                 .spawn(move || {
@@ -71,40 +119,7 @@ impl Watchdog {
                         if stop.load(Ordering::Relaxed) {
                             break;
                         }
-                        let mut usage = usage_of_tree(&dir);
-                        if let Some(uid) = uid {
-                            let shared = owned_usage(uid);
-                            usage.bytes = usage.bytes.saturating_add(shared.bytes);
-                            usage.entries = usage.entries.saturating_add(shared.entries);
-                            usage.deepest = usage.deepest.max(shared.deepest);
-                        }
-                        let procs = process_usage(&members);
-                        usage.bytes = usage
-                            .bytes
-                            .saturating_add(procs.unlinked_bytes)
-                            .saturating_add(procs.tmpfs_bytes);
-                        let memory = if procs.memory > limits.memory_bytes {
-                            procs.proportional()
-                        } else {
-                            procs.memory
-                        };
-                        let memory = if cgroup_ran_out(cgroup.as_deref()) {
-                            // The kernel's bound was reached between two ticks.
-                            memory.max(limits.memory_bytes.saturating_add(1))
-                        } else {
-                            memory
-                        };
-                        let why = judge(usage, limits.disk_bytes)
-                            .or_else(|| judge_memory(memory, limits.memory_bytes));
-                        if let Some(why) = why {
-                            // Recorded before the kill, so the session that sees the code die
-                            // finds why.
-                            violation
-                                .lock()
-                                .unwrap_or_else(|e| e.into_inner())
-                                .get_or_insert(why);
-                            reaper.reap();
-                        }
+                        measure();
                     }
                 })
                 .ok()
@@ -113,7 +128,14 @@ impl Watchdog {
             stop,
             violation,
             thread,
+            measure,
         }
+    }
+
+    /// Measures once, now, in the caller's thread: a run that ends between two ticks (code
+    /// that fills its `/tmp` and then fails fast) is still judged on what it left.
+    pub fn measure_now(&self) {
+        (self.measure)();
     }
 
     /// Why the code was stopped, if it was.

@@ -935,6 +935,10 @@ for _p in [{theirs:?}, {planted:?}, "/tmp/{marker}", "/var/tmp/{marker}", "scrat
     assert!(!classmate.path().join("planted.py").exists());
 }
 
+/// Held by each test that measures the host's shared memory, so that no two of them run at
+/// once: one's 1 GiB segment would be the other's growth.
+static SHMEM_MEASURED: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// The host's shared memory (tmpfs files, System V segments, memfds) in KiB: `Shmem` of
 /// `/proc/meminfo`.
 fn host_shmem_kib() -> u64 {
@@ -983,6 +987,7 @@ const SHMEM_NOISE_KIB: u64 = 48 << 10;
 /// host's shared memory never grows by anything near the fill, and nothing is left.
 #[test]
 fn a_1_gib_tmpfs_fill_is_stopped_at_the_limit_in_every_mode_and_leaves_nothing() {
+    let _measuring = SHMEM_MEASURED.lock().unwrap_or_else(|e| e.into_inner());
     if !root("a_1_gib_tmpfs_fill_is_stopped_at_the_limit_in_every_mode_and_leaves_nothing") {
         return;
     }
@@ -1047,6 +1052,7 @@ _s.stderr.write("FILLED %d MiB\n" % (_done >> 20))
 /// exit, is stopped at the 1 GiB limit in every mode, and nothing is left.
 #[test]
 fn a_gib_of_system_v_shared_memory_is_stopped_at_the_limit_in_every_mode() {
+    let _measuring = SHMEM_MEASURED.lock().unwrap_or_else(|e| e.into_inner());
     if !root("a_gib_of_system_v_shared_memory_is_stopped_at_the_limit_in_every_mode") {
         return;
     }
