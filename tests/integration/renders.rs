@@ -169,6 +169,27 @@ fn a_render_that_raises_hangs_returns_nan_or_the_wrong_size_scores_0_with_the_re
     }
 }
 
+/// A camera whose `init_camera` takes no lens arguments (an earlier week's, or a student's own)
+/// is built all the same: the render passes and earns its points.
+#[test]
+fn a_camera_whose_init_takes_no_lens_is_rendered_all_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    week4_submission(&dir.path().join("sub"), Some("no_lens"));
+    std::fs::write(dir.path().join("r.toml"), sphere_rubric(60.0)).unwrap();
+    let out = run_in(
+        dir.path(),
+        &["grade", "sub", "--rubric", "r.toml", "--out", "out"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = read_json(&dir.path().join("out/report.json"));
+    let c = check(&report, "image.week04-sphere");
+    assert_eq!(c["score"], 20.0, "{c}");
+}
+
 /// `source = "upload"` keeps the old behaviour: the uploaded image is judged and earns the
 /// points, nothing is rendered; under `render` the same upload earns nothing of its own (a
 /// submission whose render fails gets 0 whatever it uploads).
