@@ -2,7 +2,8 @@
 //!
 //! - The fixtures (`tests/fixtures/submissions/*/`, the course modules of
 //!   `tests/fixtures/python/common`, the triangle assignment's and the `check` fixtures'
-//!   variants of `tests/fixtures/python/variants`) are embedded in the library for
+//!   variants of `tests/fixtures/python/variants`, the week-8 solution of
+//!   `tests/fixtures/python/weeks/week08/solution`) are embedded in the library for
 //!   `rtoracle bench grade` and `rtoracle bench candidate`, so an installed binary runs them
 //!   without a checkout: `$OUT_DIR/fixtures.rs` lists them as `include_bytes!` of paths relative
 //!   to the crate's own folder (`concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/...")`),
@@ -14,11 +15,13 @@
 //!   returns early would show as passed, its "skipped" line swallowed by libtest).
 
 /// The folders under `tests/fixtures/` whose `.py` and `.toml` files are embedded.
-const EMBEDDED: [&str; 4] = [
+const EMBEDDED: [&str; 5] = [
     "submissions",
     "python/common",
     "python/triangle_assignment",
     "python/variants",
+    // The week-8 solution, which `rtoracle bench grade` grades with the week08 rubric.
+    "python/weeks/week08/solution",
 ];
 
 fn main() {

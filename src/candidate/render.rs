@@ -128,6 +128,39 @@ pub fn tiles(width: usize, height: usize) -> Vec<[usize; 4]> {
     out
 }
 
+/// The scene as sent: each image texture carries its picture as `png_hex`, the hex of a PNG
+/// of the 8-bit RGB the reference reads (a generated picture, or the file decoded: a JPEG is
+/// sent as the reference decodes it), so the candidate reads exactly the golden's texels and
+/// needs no file of the grader's. A picture file that cannot be read is why the scene is not
+/// sent (a relative file is read from the current folder).
+pub fn with_pictures(scene: &SceneDescription, mut value: Value) -> Result<Value, String> {
+    let Some(textures) = value.get_mut("textures").and_then(Value::as_array_mut) else {
+        return Ok(value);
+    };
+    for (entry, t) in scene.textures.iter().zip(textures.iter_mut()) {
+        if entry.kind != crate::scene::TextureKind::Image {
+            continue;
+        }
+        let picture = match (&entry.generated, &entry.file) {
+            (Some(name), _) => crate::scene::generated_picture(name)
+                .ok_or_else(|| format!("no generated picture {name:?}"))?,
+            (None, Some(file)) => crate::scene::read_picture(std::path::Path::new(file))
+                .map_err(|why| format!("the picture {file} of texture {:?}: {why}", entry.name))?,
+            (None, None) => continue,
+        };
+        let png = crate::image_io::encode_png(&crate::image_io::Rgb8Image {
+            width: picture.width,
+            height: picture.height,
+            data: picture.data,
+        })?;
+        let hex: String = png.iter().map(|b| format!("{b:02x}")).collect();
+        if let Some(obj) = t.as_object_mut() {
+            obj.insert("png_hex".into(), Value::String(hex));
+        }
+    }
+    Ok(value)
+}
+
 /// The request for one tile, without its id (the session adds it).
 pub fn render_request(job: &RenderJob, scene: &Value, tile: [usize; 4]) -> Value {
     json!({
@@ -238,6 +271,10 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
     let scene = match serde_json::to_value(job.scene) {
         Ok(v) => v,
         Err(e) => return RenderOutcome::Invalid(format!("the scene cannot be sent: {e}")),
+    };
+    let scene = match with_pictures(job.scene, scene) {
+        Ok(v) => v,
+        Err(why) => return RenderOutcome::Declined(why),
     };
     let start = Instant::now();
     let deadline = start + job.time_limit;

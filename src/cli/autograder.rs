@@ -4,16 +4,17 @@ use std::process::ExitCode;
 use anyhow::Context;
 use rtoracle::grade::{Rubric, autograder, pack};
 
-/// `rtoracle autograder --out autograder.zip [--rubric FILE.toml] [--binary PATH]`
+/// `rtoracle autograder --out autograder.zip [--rubric NAME|FILE.toml] [--binary PATH]`
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The package to write.
     #[arg(long, value_name = "ZIP", default_value = "autograder.zip")]
     out: PathBuf,
-    /// The rubric to grade with (default: the built-in week-4 rubric). Its scene files and
+    /// The rubric to grade with: a built-in one by name (week04 ... week10) or a TOML file
+    /// (default: the built-in week04). A file's scene files and
     /// their goldens are packed too (missing goldens are rendered now), so Gradescope never
     /// renders.
-    #[arg(long, value_name = "FILE.toml")]
+    #[arg(long, value_name = "NAME|FILE.toml")]
     rubric: Option<PathBuf>,
     /// The rtoracle binary to pack (default: this one). It must be an x86_64 Linux executable,
     /// as Gradescope's machines are.
@@ -46,13 +47,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (packed, rubric_seed, runs_code) = match &args.rubric {
         Some(path) => {
             // Validate it now, so a bad rubric fails here and not on Gradescope.
-            let rubric = Rubric::from_file(path)?;
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("{}: cannot read the rubric", path.display()))?;
-            let runs_code = rubric
-                .groups
-                .iter()
-                .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
+            let (rubric, text) = Rubric::named(path)?;
+            let runs_code = rubric.week.is_some()
+                || rubric
+                    .groups
+                    .iter()
+                    .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
             (pack::pack_rubric(&rubric, &text)?, rubric.seed, runs_code)
         }
         None => (

@@ -2,12 +2,14 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use rtoracle::escape::terminal_line;
+use rtoracle::golden::embedded::SPP_VARIANTS;
 use rtoracle::golden::{
     GOLDEN_SEED, GOLDEN_SPP, GoldenScene, Tolerance, cache_dir, compare_goldens, golden_file_name,
     golden_of, golden_spp, render_golden_bytes,
 };
 use rtoracle::image_io::{decode_exr, write_atomically};
-use rtoracle::scene::{builtin, builtin_names};
+use rtoracle::scene::builtin_names;
 
 /// `rtoracle golden [--check] [--dir DIR] [--spp N] [--scenes a,b]`, or
 /// `rtoracle golden FILE.toml -o FILE.exr [--spp N]` for a scene file.
@@ -37,24 +39,50 @@ pub struct Args {
     scenes: Vec<String>,
 }
 
+/// The committed goldens: each built-in scene's (`NAME`), then those of
+/// [`SPP_VARIANTS`] (`NAME.sppN`), as (its name for `--scenes`, the scene at its samples).
+fn committed() -> Vec<(String, GoldenScene)> {
+    let mut out: Vec<(String, GoldenScene)> = builtin_names()
+        .into_iter()
+        .map(|n| {
+            (
+                n.to_string(),
+                GoldenScene::builtin(n).expect("a built-in scene"),
+            )
+        })
+        .collect();
+    for (name, spp) in SPP_VARIANTS {
+        let scene = GoldenScene::builtin_at_spp(name, *spp).expect("a built-in scene");
+        out.push((format!("{name}.spp{spp}"), scene));
+    }
+    out
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let (Some(file), Some(out)) = (&args.scene_file, &args.out) {
         return write_scene_file(file, out, args.spp);
     }
     let spp = args.spp.unwrap_or(GOLDEN_SPP);
-    let scenes: Vec<String> = if args.scenes.is_empty() {
-        builtin_names().into_iter().map(String::from).collect()
+    let all = committed();
+    let scenes: Vec<(String, GoldenScene)> = if args.scenes.is_empty() {
+        all
     } else {
-        args.scenes.clone()
-    };
-    for scene in &scenes {
-        if builtin(scene).is_err() {
-            anyhow::bail!(
-                "--scenes {scene}: no such built-in scene (the built-in scenes: {})",
-                builtin_names().join(", ")
-            );
+        let mut chosen = Vec::new();
+        for name in &args.scenes {
+            match all.iter().find(|(n, _)| n == name) {
+                Some(found) => chosen.push(found.clone()),
+                None => anyhow::bail!(
+                    "--scenes {}: no such built-in scene (the committed goldens: {})",
+                    terminal_line(name),
+                    all.iter()
+                        .map(|(n, _)| n.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            }
         }
-    }
+        chosen
+    };
     if args.check {
         if !args.dir.is_dir() {
             let what = if args.dir.exists() {
@@ -105,14 +133,14 @@ fn write_scene_file(file: &Path, out: &Path, spp: Option<u32>) -> anyhow::Result
     Ok(ExitCode::SUCCESS)
 }
 
-fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
+fn write(dir: &Path, scenes: &[(String, GoldenScene)], spp: u32) -> anyhow::Result<ExitCode> {
     // The folder is created with the first golden, and removed again on Ctrl-C if this run
     // created it, so an interrupted run leaves no empty or half-filled new folder.
     let mut created: Option<rtoracle::interrupt::CleanupGuard> = None;
-    for scene in scenes {
-        let path = dir.join(golden_file_name(scene));
+    for (name, scene) in scenes {
+        let path = dir.join(golden_file_name(name));
         let start = Instant::now();
-        let bytes = render_golden_bytes(&GoldenScene::builtin(scene)?, spp, true)?;
+        let bytes = render_golden_bytes(scene, spp, true)?;
         if created.is_none() && !dir.is_dir() {
             // Made and registered in one step, so a signal's cleanups cannot miss it.
             let made = || std::fs::create_dir(dir).map(|()| dir.to_path_buf());
@@ -134,19 +162,19 @@ fn write(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn check(dir: &Path, scenes: &[String], spp: u32) -> anyhow::Result<ExitCode> {
+fn check(dir: &Path, scenes: &[(String, GoldenScene)], spp: u32) -> anyhow::Result<ExitCode> {
     // Read every file before the long renders, so an unreadable one fails at once.
     let mut committed = Vec::with_capacity(scenes.len());
-    for scene in scenes {
-        let path = dir.join(golden_file_name(scene));
+    for (name, _) in scenes {
+        let path = dir.join(golden_file_name(name));
         let bytes = std::fs::read(&path)
             .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
         let image = decode_exr(&bytes, &path)?;
         committed.push((path, bytes, image));
     }
     let mut all_equal = true;
-    for (scene, (path, bytes, on_disk)) in scenes.iter().zip(committed) {
-        let fresh = render_golden_bytes(&GoldenScene::builtin(scene)?, spp, true)?;
+    for ((_, scene), (path, bytes, on_disk)) in scenes.iter().zip(committed) {
+        let fresh = render_golden_bytes(scene, spp, true)?;
         if fresh == bytes {
             outln!("{}: identical bytes", path.display())?;
             continue;

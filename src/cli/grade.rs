@@ -27,8 +27,9 @@ pub struct Args {
     /// without --shard writes them.
     #[arg(long, value_name = "OUT", num_args = 1.., conflicts_with_all = ["submission", "batch"])]
     merge: Vec<PathBuf>,
-    /// The rubric (TOML); default: the built-in week-4 rubric (see --print-rubric).
-    #[arg(long, value_name = "FILE.toml")]
+    /// The rubric: a built-in one by name (week04 ... week10) or a TOML file; default: the
+    /// built-in week04 (see --print-rubric).
+    #[arg(long, value_name = "NAME|FILE.toml")]
     rubric: Option<PathBuf>,
     /// The report folder (created).
     #[arg(long, value_name = "DIR", default_value = "grade-report")]
@@ -50,24 +51,36 @@ pub struct Args {
     /// /usr/local/bin/python3, python3 on PATH, ... that has them.
     #[arg(long, value_name = "PATH")]
     python: Option<PathBuf>,
-    /// Print the rubric in use (the built-in one unless --rubric) and exit.
-    #[arg(long)]
-    print_rubric: bool,
+    /// Print a rubric and exit: the built-in one named (week04 ... week10), else the one in use
+    /// (--rubric's, or the built-in week04).
+    #[arg(long, value_name = "NAME", num_args = 0..=1, default_missing_value = "")]
+    print_rubric: Option<String>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if !args.merge.is_empty() {
         return run_merge(&args);
     }
-    let rubric = match &args.rubric {
-        Some(path) => Rubric::from_file(path)?,
-        None => Rubric::week04(),
+    if let Some(name) = args.print_rubric.as_deref().filter(|n| !n.is_empty()) {
+        let Some(text) = rtoracle::grade::week_rubrics::builtin_rubric_toml(name) else {
+            anyhow::bail!(
+                "--print-rubric {}: not a built-in rubric (known: {})",
+                terminal_line(name),
+                rtoracle::grade::week_rubrics::BUILTIN_RUBRICS.join(", ")
+            );
+        };
+        out!("{text}")?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (rubric, text) = match &args.rubric {
+        Some(path) => Rubric::named(path)?,
+        None => (
+            Rubric::week04(),
+            rtoracle::grade::rubric::WEEK04_RUBRIC.to_string(),
+        ),
     };
-    if args.print_rubric {
-        match &args.rubric {
-            Some(path) => out!("{}", std::fs::read_to_string(path)?)?,
-            None => out!("{}", rtoracle::grade::rubric::WEEK04_RUBRIC)?,
-        }
+    if args.print_rubric.is_some() {
+        out!("{text}")?;
         return Ok(ExitCode::SUCCESS);
     }
     let formats = Format::parse_list(&args.format)?;
@@ -182,10 +195,11 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         Some(path) => Some((path.display().to_string(), read_vectors(path)?)),
         None => None,
     };
-    let runs_code = rubric
-        .groups
-        .iter()
-        .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
+    let runs_code = rubric.week.is_some()
+        || rubric
+            .groups
+            .iter()
+            .any(|g| g.kind == rtoracle::grade::GroupKind::Code || g.renders());
     let policy = rubric.sandbox_policy();
     let python = if runs_code {
         let python = rtoracle::candidate::python::choose(
@@ -206,6 +220,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         policy,
         python,
         python_requires: rubric.python_requires.clone(),
+        week: rubric.week.and_then(rtoracle::functions::Week::new),
         ..Default::default()
     })
 }
@@ -262,26 +277,34 @@ fn print_batch(entries: &[batch::BatchEntry], args: &Args) -> anyhow::Result<()>
 
 /// A submission's checks and total on stdout, and where the reports are on stderr.
 fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::Result<()> {
+    use rtoracle::grade::round2;
     // Unscored checks are listed only when some ambiguous vector differs (no `0 / 0` rows).
-    for c in report
+    let shown: Vec<&rtoracle::grade::CheckResult> = report
         .checks
         .iter()
         .filter(|c| c.status != rtoracle::grade::CheckStatus::Skipped || !c.failures.is_empty())
-    {
+        .collect();
+    let width = shown
+        .iter()
+        .map(|c| terminal_line(&c.id).chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(24);
+    for c in shown {
         if c.status == rtoracle::grade::CheckStatus::Skipped {
-            outln!("{:<24} {:>15} not scored", terminal_line(&c.id), "")?;
+            outln!("{:<width$} {:>15} not scored", terminal_line(&c.id), "")?;
             continue;
         }
         outln!(
-            "{:<24} {:>6} / {:<6} {}",
+            "{:<width$} {:>6} / {:<6} {}",
             terminal_line(&c.id),
-            c.score,
-            c.max_score,
+            round2(c.score),
+            round2(c.max_score),
             c.status.name()
         )?;
     }
     outln!(
-        "{:<24} {:>6} / {:<6}",
+        "{:<width$} {:>6} / {:<6}",
         "total",
         report.score,
         report.max_score
@@ -300,7 +323,8 @@ fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::R
 fn private_inputs(args: &Args, rubric: &Rubric) -> Vec<PathBuf> {
     let mut paths: Vec<PathBuf> = [
         args.batch.clone(),
-        args.rubric.clone(),
+        // A built-in rubric's name is no file.
+        args.rubric.clone().filter(|p| p.is_file()),
         args.vectors.clone(),
     ]
     .into_iter()

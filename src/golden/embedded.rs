@@ -85,6 +85,53 @@ const EMBEDDED: &[(&str, &[u8])] = &[
     ),
 ];
 
+/// The built-in scenes whose image depends on the samples per pixel (the course's jittered
+/// sampling) with the counts the built-in rubrics render them at (`week_rubrics`): their
+/// goldens at those counts are committed and compiled in too, as
+/// `golden/<scene>.spp<N>.exr`, so grading them renders no golden.
+pub const SPP_VARIANTS: &[(&str, u32)] =
+    &[("week09-blinn", 5), ("week10-dof", 5), ("week10-moving", 5)];
+
+/// The compiled-in goldens of [`SPP_VARIANTS`], in its order.
+const EMBEDDED_VARIANTS: &[(&str, &str, &[u8])] = &[
+    (
+        "week09-blinn",
+        "week09-blinn.spp5.exr",
+        include_bytes!("../../golden/week09-blinn.spp5.exr"),
+    ),
+    (
+        "week10-dof",
+        "week10-dof.spp5.exr",
+        include_bytes!("../../golden/week10-dof.spp5.exr"),
+    ),
+    (
+        "week10-moving",
+        "week10-moving.spp5.exr",
+        include_bytes!("../../golden/week10-moving.spp5.exr"),
+    ),
+];
+
+/// The file name of the committed golden of `scene` at `spp` samples per pixel in
+/// [`SPP_VARIANTS`]: `<scene>.spp<N>.exr`.
+pub fn variant_file_name(scene: &str, spp: u32) -> String {
+    format!("{scene}.spp{spp}.exr")
+}
+
+/// Every compiled-in golden of the built-in `scene`, as (file name, bytes): its own first, then
+/// those of its [`SPP_VARIANTS`].
+pub fn embedded_goldens(scene: &str) -> impl Iterator<Item = (String, &'static [u8])> + '_ {
+    EMBEDDED
+        .iter()
+        .filter(move |(name, _)| *name == scene)
+        .map(|(name, bytes)| (golden_file_name(name), *bytes))
+        .chain(
+            EMBEDDED_VARIANTS
+                .iter()
+                .filter(move |(name, _, _)| *name == scene)
+                .map(|(_, file, bytes)| (file.to_string(), *bytes)),
+        )
+}
+
 /// The names of the scenes whose golden is compiled in, in table order.
 pub fn embedded_scenes() -> Vec<&'static str> {
     EMBEDDED.iter().map(|(name, _)| *name).collect()

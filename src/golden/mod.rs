@@ -44,7 +44,9 @@ pub use format::{
     ATTR_SCENE_TOML, ATTR_SEED, ATTR_SPP, ATTR_VARIANCE, ATTR_VERSION, CAMERA_CONVENTION,
     DEFAULT_PROFILE, GoldenRecord, SAMPLING, VARIANCE_MEANING, golden_file_name,
 };
-pub use source::{GoldenInput, GoldenScene, files_read, golden_fits, scene_sha256, sha256_hex};
+pub use source::{
+    GoldenInput, GoldenScene, at_spp, files_read, golden_fits, scene_sha256, sha256_hex,
+};
 
 use crate::image_io::{ExrImage, ImageError, decode_exr};
 use crate::render::{Film, PixelJitter, RenderError, RenderOptions, render};
@@ -286,18 +288,19 @@ fn embedded_of(scene: &GoldenScene, spp: u32) -> Option<FoundGolden> {
     if !scene.builtin {
         return None;
     }
-    let bytes = embedded_golden(&scene.name)?;
-    let source = PathBuf::from(embedded::embedded_label(&scene.name));
-    let image = scene.fits(bytes, &source).ok()?;
-    let record = GoldenRecord::of(&image);
-    if record.spp? < spp || record.seed != Some(GOLDEN_SEED) {
-        return None;
-    }
-    Some(FoundGolden {
-        bytes: bytes.to_vec(),
-        image,
-        source,
-        origin: GoldenOrigin::Embedded,
+    embedded::embedded_goldens(&scene.name).find_map(|(file, bytes)| {
+        let source = PathBuf::from(format!("(embedded) golden/{file}"));
+        let image = scene.fits(bytes, &source).ok()?;
+        let record = GoldenRecord::of(&image);
+        if record.spp? < spp || record.seed != Some(GOLDEN_SEED) {
+            return None;
+        }
+        Some(FoundGolden {
+            bytes: bytes.to_vec(),
+            image,
+            source,
+            origin: GoldenOrigin::Embedded,
+        })
     })
 }
 

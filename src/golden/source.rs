@@ -55,6 +55,17 @@ pub fn files_read(description: &SceneDescription) -> Vec<PathBuf> {
         .collect()
 }
 
+/// `description` with `spp` samples per pixel when its image depends on them (the course's
+/// jittered sampling) and they differ from its own; `None` when it does not change.
+pub fn at_spp(description: &SceneDescription, spp: u32) -> Option<SceneDescription> {
+    let jittered = description.render.sampling == crate::scene::PixelSampling::CourseJittered;
+    (jittered && description.image.samples_per_pixel != spp).then(|| {
+        let mut d = description.clone();
+        d.image.samples_per_pixel = spp;
+        d
+    })
+}
+
 /// One file a scene reads, by content.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct GoldenInput {
@@ -87,6 +98,18 @@ impl GoldenScene {
         let description = builtin(name)?;
         let mut scene = Self::from_description(name, description, None)?;
         scene.builtin = true;
+        Ok(scene)
+    }
+
+    /// The built-in scene `name` as a candidate of `spp` samples per pixel renders it: the
+    /// scene itself, except that a scene of the course's jittered sampling (weeks 9 and 10,
+    /// whose strata, and whose division of their sum, come from the scene's
+    /// `samples_per_pixel`) has `spp` as its `samples_per_pixel`, since its image depends on it.
+    pub fn builtin_at_spp(name: &str, spp: u32) -> Result<Self, GoldenError> {
+        let mut scene = Self::builtin(name)?;
+        if let Some(d) = at_spp(&scene.description, spp) {
+            scene.description = d;
+        }
         Ok(scene)
     }
 

@@ -220,6 +220,7 @@ pub fn run() -> String {
         secs(t.elapsed())
     });
     let (builtin, scene_file) = pool.install(|| scene_file_batches(work.path()));
+    let week08 = week08_one(work.path());
     let mut report = String::new();
     report.push_str(&format!(
         "grade benchmark (2 threads unless said; fixtures: {})",
@@ -256,6 +257,19 @@ pub fn run() -> String {
         batch_time / 30.0
     ));
     report.push('\n');
+    report.push_str(&format!(
+        "  one week-8 submission, week08 rubric    {:8.3} s  = {:6.1} x baseline  (the course-shaped solution, 1 thread; target <= 180 s; {:.0} / 100)",
+        week08.rendered.total,
+        week08.rendered.total / baseline,
+        week08.score
+    ));
+    report.push('\n');
+    for (id, spp, seconds) in &week08.rendered.groups {
+        report.push_str(&format!(
+            "    {id:<36}{seconds:8.3} s  to render at {spp} spp"
+        ));
+        report.push('\n');
+    }
     report.push_str(&format!(
         "  batch of 10, built-in scene 'triangles'  {:8.3} s  (embedded golden; median of 3 runs)",
         builtin
@@ -298,7 +312,62 @@ fn rendered_one(submission: &Path, work: &Path) -> Rendered {
         .expect("grading works");
         (secs(t.elapsed()), report)
     });
-    let groups = report
+    Rendered {
+        total,
+        groups: render_times(&report),
+    }
+}
+
+/// What grading the week-8 solution took.
+struct WeekGrade {
+    rendered: Rendered,
+    score: f64,
+}
+
+/// Grades the course-shaped week-8 solution (embedded) with the built-in week08 rubric, its
+/// functions and its two scenes rendered from its code, on one thread: the week the course's
+/// heaviest scenes per sample are in.
+fn week08_one(work: &Path) -> WeekGrade {
+    let submission = work.join("week08");
+    std::fs::create_dir_all(&submission).expect("a folder");
+    for (name, bytes) in crate::candidate::fixtures::python_files_in("python/weeks/week08/solution")
+    {
+        std::fs::write(submission.join(name), bytes).expect("the fixture is written");
+    }
+    let rubric = Rubric::builtin("week08").expect("built in");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a pool");
+    let (total, report) = pool.install(|| {
+        let t = Instant::now();
+        let report = grade_to_dir(
+            &submission,
+            &rubric,
+            &CourseCodeChecker {
+                week: rubric.week.and_then(crate::functions::Week::new),
+                time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
+                ..CourseCodeChecker::default()
+            },
+            &CompareImageChecker::default(),
+            &work.join("week08-report"),
+            &Format::ALL,
+        )
+        .expect("grading works");
+        (secs(t.elapsed()), report)
+    });
+    WeekGrade {
+        rendered: Rendered {
+            total,
+            groups: render_times(&report),
+        },
+        score: report.score,
+    }
+}
+
+/// Each rendered group's id, spp and seconds, from a report.
+fn render_times(report: &super::GradeReport) -> Vec<(String, u64, f64)> {
+    report
         .checks
         .iter()
         .filter_map(|c| {
@@ -309,8 +378,7 @@ fn rendered_one(submission: &Path, work: &Path) -> Rendered {
                 render["seconds"].as_f64().unwrap_or(f64::NAN),
             ))
         })
-        .collect();
-    Rendered { total, groups }
+        .collect()
 }
 
 /// Grades 10 honest triangle submissions twice, with the triangle rubric of `examples/rubrics`

@@ -77,6 +77,45 @@ impl CompareImageChecker {
         Ok((golden, sha))
     }
 
+    /// The golden a render of `scene` at `spp` samples per pixel is judged against: the scene's
+    /// own, except for a scene whose image depends on its samples per pixel (the course's
+    /// jittered sampling, [`crate::golden::at_spp`]), whose golden is that of the scene at
+    /// `spp` (embedded for the built-in rubrics' counts, else rendered once into the cache).
+    fn render_golden(
+        &self,
+        scene: &SceneSource,
+        spp: u32,
+    ) -> Result<(Arc<Golden>, String), CompareError> {
+        let derived = match scene {
+            SceneSource::Builtin(name) => crate::scene::builtin(name)
+                .ok()
+                .and_then(|d| crate::golden::at_spp(&d, spp))
+                .map(|_| (format!("builtin:{name}@{spp}"), None)),
+            SceneSource::File(f) if f.golden.is_none() => {
+                crate::golden::at_spp(&f.description, spp)
+                    .map(|d| (format!("file:{}@{spp}", f.sha256), Some((f, d))))
+            }
+            SceneSource::File(_) => None,
+        };
+        let Some((key, file)) = derived else {
+            return self.golden(scene);
+        };
+        let mut cache = self.goldens.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((g, h)) = cache.get(&key) {
+            return Ok((Arc::clone(g), h.clone()));
+        }
+        let golden_scene = match (scene, file) {
+            (SceneSource::Builtin(name), _) => GoldenScene::builtin_at_spp(name, spp),
+            (_, Some((f, d))) => GoldenScene::from_description(&f.label, d, f.path.parent()),
+            _ => unreachable!("a derived golden is of a built-in scene or a scene file"),
+        }
+        .map_err(|e| CompareError::Golden(e.to_string()))?;
+        let (golden, sha) = self.found(&golden_scene, spp)?;
+        let golden = Arc::new(golden);
+        cache.insert(key, (Arc::clone(&golden), sha.clone()));
+        Ok((golden, sha))
+    }
+
     /// The candidate's samples per pixel for `scene`: a scene file's own, else the options'.
     fn candidate_spp(&self, scene: &SceneSource) -> u32 {
         match scene {
@@ -131,7 +170,7 @@ impl CompareImageChecker {
         name: &str,
         heatmap_out: &Path,
     ) -> ImageOutcome {
-        let golden = match self.golden(scene) {
+        let golden = match self.render_golden(scene, spp) {
             Ok((g, _)) => g,
             Err(e) => {
                 return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
@@ -242,6 +281,12 @@ impl ImageChecker for CompareImageChecker {
 
     fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
         self.golden(scene).map(|(_, h)| h).unwrap_or_default()
+    }
+
+    fn render_golden_sha256(&self, scene: &SceneSource, spp: u32) -> String {
+        self.render_golden(scene, spp)
+            .map(|(_, h)| h)
+            .unwrap_or_default()
     }
 
     fn check(&self, candidate_png: &Path, scene: &str, heatmap_out: &Path) -> ImageOutcome {

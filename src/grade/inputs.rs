@@ -40,9 +40,39 @@ pub trait CodeChecker: Sync {
             .map(|_| RenderOutcome::Declined(format!("{} does not render", self.describe())))
             .collect()
     }
+
+    /// Runs week `week`'s function checks ([`crate::functions`]) on the submission. Never
+    /// panics: whatever the code does is in the outcome. The default runs none (a checker that
+    /// cannot send function requests), and says so in `fatal`.
+    fn check_functions(
+        &self,
+        submission: &Path,
+        week: crate::functions::Week,
+        options: crate::functions::FunctionOptions,
+    ) -> FunctionsOutcome {
+        let _ = (submission, week, options);
+        FunctionsOutcome {
+            fatal: Some(format!("{} does not run function checks", self.describe())),
+            ..FunctionsOutcome::default()
+        }
+    }
 }
 
 pub use crate::candidate::render::{RenderJob, RenderOutcome, RenderedImage};
+
+/// What running a week's function checks on a submission found.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct FunctionsOutcome {
+    /// The function checks, judged (`None` when nothing could be run: see `fatal`).
+    pub report: Option<crate::functions::WeekReport>,
+    /// Set when nothing could be run: the import failed (the message shows the exception), the
+    /// interpreter is missing, the checker does not run function checks.
+    pub fatal: Option<String>,
+    /// The last lines the code wrote to stderr (truncated), file names as the student knows them.
+    pub stderr_tail: String,
+    /// Functions not run because the code time budget ran out.
+    pub out_of_time: usize,
+}
 
 /// Compares one image of a submission with the reference of a scene.
 pub trait ImageChecker: Sync {
@@ -82,6 +112,14 @@ pub trait ImageChecker: Sync {
     /// [`golden_sha256`](Self::golden_sha256) with the scene's label.
     fn scene_golden_sha256(&self, scene: &SceneSource) -> String {
         self.golden_sha256(scene.label())
+    }
+
+    /// The SHA-256 (hex) of the golden a render of `scene` at `spp` samples per pixel is judged
+    /// against (for a scene of the course's jittered sampling, that of the scene at `spp`); the
+    /// default is [`scene_golden_sha256`](Self::scene_golden_sha256)'s.
+    fn render_golden_sha256(&self, scene: &SceneSource, spp: u32) -> String {
+        let _ = spp;
+        self.scene_golden_sha256(scene)
     }
 
     /// Judges the grader's render of `scene` from the submission's code (linear RGB at

@@ -35,6 +35,7 @@ pub mod copies;
 pub mod credit;
 #[cfg(test)]
 pub(crate) mod fakes;
+mod functions_score;
 pub mod image_checker;
 pub mod inputs;
 pub mod intake;
@@ -46,13 +47,15 @@ mod result;
 pub mod rubric;
 mod run;
 mod score;
+pub mod week_rubrics;
 mod write;
 
 pub use checkers::CourseCodeChecker;
+pub use functions_score::{UNSCORED_ID, function_checks};
 pub use image_checker::CompareImageChecker;
 pub use inputs::{
-    CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageChecker, ImageOutcome,
-    ImageVerdict, SceneFile, SceneSource,
+    CodeChecker, CodeOutcome, FailureKind, FailureSummary, FunctionsOutcome, GroupCounts,
+    ImageChecker, ImageOutcome, ImageVerdict, SceneFile, SceneSource,
 };
 pub use report::{Format, write_reports};
 pub use result::{

@@ -42,6 +42,8 @@ pub(crate) fn jobs_of(groups: &[&Group]) -> Vec<Result<(SceneDescription, u32, D
         .map(|g| {
             let scene = g.scene_source().ok_or("the group has no scene")?;
             let d = scene_description(&scene)?;
+            // A scene of the course's jittered sampling is sent as it is at the render's spp.
+            let d = crate::golden::at_spp(&d, g.render_spp()).unwrap_or(d);
             Ok((
                 d,
                 g.render_spp(),

@@ -98,6 +98,10 @@ pub struct CheckResult {
     /// The comparison, for image checks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub image: Option<ImageResult>,
+    /// For function checks that did not pass (and the unscored check's first failure): the
+    /// function's result, with its smallest failing case and its reproduction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub function: Option<crate::functions::FunctionResult>,
 }
 
 /// What was checked and with what, so a grade can be reproduced.
@@ -135,6 +139,12 @@ pub struct CodeRun {
     pub diagnosis: Vec<crate::candidate::diagnose::Diagnosis>,
     /// The winding of the submission's triangles, when it has any that hit.
     pub triangle_winding: Option<crate::candidate::check::Winding>,
+    /// Why the week's function checks could not run at all, when they could not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub functions_fatal: Option<String>,
+    /// The last lines the code wrote to stderr during the function checks (truncated).
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub functions_stderr_tail: String,
     /// Every definite vector it failed (not only the few each check shows), for a batch's
     /// summary; not written into report.json.
     #[serde(skip)]

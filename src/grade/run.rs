@@ -164,13 +164,25 @@ pub fn grade(
         .copied()
         .filter(|g| g.renders())
         .collect();
-    let (outcome, (image_outcomes, renders)) = rayon::join(
+    let week = rubric.week.and_then(crate::functions::Week::new);
+    let function_options = crate::functions::FunctionOptions {
+        seed: rubric.seed,
+        alpha: rubric
+            .alpha
+            .unwrap_or(crate::functions::stats::DEFAULT_ALPHA),
+    };
+    let ((outcome, functions), (image_outcomes, renders)) = rayon::join(
         || {
-            if shapes.is_empty() {
-                CodeOutcome::default()
-            } else {
-                code.check(submission, &shapes)
-            }
+            rayon::join(
+                || {
+                    if shapes.is_empty() {
+                        CodeOutcome::default()
+                    } else {
+                        code.check(submission, &shapes)
+                    }
+                },
+                || week.map(|w| code.check_functions(submission, w, function_options)),
+            )
         },
         || {
             rayon::join(
@@ -192,9 +204,18 @@ pub fn grade(
     let mut renders = renders.into_iter();
     let mut checks = Vec::new();
     let mut fingerprints = Vec::new();
+    let mut function_checks = functions
+        .as_ref()
+        .map(|f| super::functions_score::function_checks(rubric, f))
+        .unwrap_or_default();
     for g in &rubric.groups {
         match g.kind {
             GroupKind::Code => checks.extend(code_check(g, &outcome)),
+            GroupKind::Functions => {
+                let (mine, rest) = function_checks.into_iter().partition(|c| c.group == g.id);
+                checks.extend::<Vec<_>>(mine);
+                function_checks = rest;
+            }
             GroupKind::Image if g.renders() => checks.push(render_check(
                 g,
                 image_outcomes.next().expect("one per image group").outcome,
@@ -212,6 +233,8 @@ pub fn grade(
             }
         }
     }
+    // The unscored check of the functions that carry no points comes last.
+    checks.extend(function_checks);
     let score = round2(checks.iter().map(|c| c.score).sum());
     let submission_name = submission
         .canonicalize()
@@ -233,6 +256,11 @@ pub fn grade(
             sandbox: outcome.sandbox.clone(),
             diagnosis: outcome.diagnosis.clone(),
             triangle_winding: outcome.triangle_winding,
+            functions_fatal: functions.as_ref().and_then(|f| f.fatal.clone()),
+            functions_stderr_tail: functions
+                .as_ref()
+                .map(|f| f.stderr_tail.clone())
+                .unwrap_or_default(),
             failed_vectors: outcome
                 .failures
                 .iter()
@@ -260,8 +288,15 @@ fn reproducibility(
     let shapes = rubric.code_shapes();
     let goldens_sha256 = image_groups
         .iter()
-        .filter_map(|g| g.scene_source())
-        .map(|s| (s.label().to_string(), images.scene_golden_sha256(&s)))
+        .filter_map(|g| g.scene_source().map(|s| (g, s)))
+        .map(|(g, s)| {
+            let sha = if g.renders() {
+                images.render_golden_sha256(&s, g.render_spp())
+            } else {
+                images.scene_golden_sha256(&s)
+            };
+            (s.label().to_string(), sha)
+        })
         .collect();
     let scenes_sha256 = image_groups
         .iter()

@@ -96,6 +96,7 @@ pub(crate) fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResul
         credit: earned,
         failures,
         image: None,
+        function: None,
     }];
     if counts.ambiguous > 0 && !group.score_ambiguous && outcome.fatal.is_none() {
         checks.push(ambiguous_check(group, outcome, &counts));
@@ -205,6 +206,7 @@ fn ambiguous_check(group: &Group, outcome: &CodeOutcome, counts: &GroupCounts) -
             .cloned()
             .collect(),
         image: None,
+        function: None,
     }
 }
 
@@ -289,6 +291,7 @@ pub(crate) fn image_check(
         counts: None,
         credit: None,
         failures: vec![],
+        function: None,
         image: Some(ImageResult {
             file,
             scene,

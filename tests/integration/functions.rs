@@ -12,6 +12,7 @@ use rtoracle::functions::score::score;
 use rtoracle::functions::{
     FunctionOptions, FunctionRunner, Reply, SessionRunner, Status, Week, WeekReport, run_week,
 };
+use rtoracle::grade::{CheckResult, FunctionsOutcome, Rubric, UNSCORED_ID, function_checks};
 use serde_json::json;
 
 fn python() -> Option<&'static Path> {
@@ -179,6 +180,28 @@ fn week_is_judged_fairly(week: u8) {
         "the solution of {base}:\n{text}"
     );
     assert_eq!(score(&solution).score, 100.0, "{base}");
+    // The same reports scored by the week's built-in rubric, as `grade` scores them.
+    let rubric = Rubric::builtin(&base).unwrap();
+    let graded = |report: &WeekReport| {
+        function_checks(
+            &rubric,
+            &FunctionsOutcome {
+                report: Some(report.clone()),
+                ..FunctionsOutcome::default()
+            },
+        )
+    };
+    let points = |checks: &[CheckResult]| -> (f64, f64) {
+        (
+            checks.iter().map(|c| c.score).sum(),
+            checks.iter().map(|c| c.max_score).sum(),
+        )
+    };
+    let (got, max) = points(&graded(&solution));
+    assert!(
+        (got - max).abs() < 1e-9 && (max - 70.0).abs() < 1e-9,
+        "{base}: the solution's functions score {got} of {max} in the rubric"
+    );
     let skeleton = week_report(&format!("{base}/skeleton"), None, week).unwrap();
     let text = rtoracle::functions::report::to_text(&skeleton, 0);
     for f in skeleton.of_the_week().filter(|f| !f.given) {
@@ -193,6 +216,11 @@ fn week_is_judged_fairly(week: u8) {
     assert!(
         skeleton_score <= 5.0,
         "{base}'s skeleton scores {skeleton_score}"
+    );
+    let (got, _) = points(&graded(&skeleton));
+    assert!(
+        got <= 3.5,
+        "{base}'s skeleton's functions score {got} in the rubric"
     );
     let mut missed = Vec::new();
     for (name, kind) in catalogue(week) {
@@ -228,6 +256,26 @@ fn week_is_judged_fairly(week: u8) {
         });
         if kind == "mistake" && named && !lost_in_its_group && !regression {
             missed.push(format!("{name} loses no points: {scored:?}"));
+        }
+        // In the rubric: a check of a functions group that loses points says the mistake's
+        // name; a regression is named by the unscored check.
+        let checks = graded(&report);
+        let in_rubric = checks.iter().any(|c| {
+            let says = c.message.contains(&format!(" {name} ("));
+            if regression {
+                c.id == UNSCORED_ID && c.message.contains(&name)
+            } else {
+                c.score < c.max_score && says
+            }
+        });
+        if kind == "mistake" && named && !in_rubric {
+            missed.push(format!(
+                "{name} is not named by a check that loses points in the {base} rubric: {:#?}",
+                checks
+                    .iter()
+                    .map(|c| (&c.id, c.score, c.max_score, &c.message))
+                    .collect::<Vec<_>>()
+            ));
         }
         if !named {
             missed.push(format!(

@@ -12,6 +12,7 @@ mod feedback;
 mod functions;
 mod golden;
 mod grade;
+mod grade_weeks;
 mod oracle;
 mod oracle_props;
 mod protocol;

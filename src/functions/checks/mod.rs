@@ -140,6 +140,37 @@ pub fn week_checks(of: Week, seed: u64) -> Vec<FunctionCheck> {
     chosen
 }
 
+/// The ids of the functions a week-`of` submission is checked on ([`week_checks`]'s), in its
+/// order.
+pub fn function_ids(of: Week) -> Vec<&'static str> {
+    week_checks(of, 0).iter().map(|c| c.id).collect()
+}
+
+/// The names of the catalogue's alternatives among a week-`of` submission's checks: versions the
+/// course itself has or documents ([`Standing::Alternative`]) and physical departures
+/// ([`Standing::Physical`]), which a rubric may accept as passing.
+pub fn alternatives(of: Week) -> Vec<&'static str> {
+    let mut out: Vec<&'static str> = Vec::new();
+    for c in week_checks(of, 0) {
+        let named: Vec<(&'static str, Standing)> = match &c.body {
+            Body::Cases { variants, .. } => variants.iter().map(|v| (v.name, v.standing)).collect(),
+            Body::Samples { check, .. } => check
+                .mistakes
+                .iter()
+                .map(|h| (h.name, h.standing))
+                .collect(),
+        };
+        for (name, standing) in named {
+            if matches!(standing, Standing::Alternative | Standing::Physical)
+                && !out.contains(&name)
+            {
+                out.push(name);
+            }
+        }
+    }
+    out
+}
+
 /// A small deterministic stream for the random cases of a check: the reference's sampler,
 /// seeded by the run's seed and the check's id.
 pub(crate) fn stream(seed: u64, id: &str) -> crate::render::PixelSampler {

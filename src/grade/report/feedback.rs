@@ -192,6 +192,9 @@ pub(crate) fn check_body(
     shown: &mut Shown,
     section: &str,
 ) -> String {
+    if let Some(f) = &c.function {
+        return function_body(c, f, quote);
+    }
     let mut md = String::new();
     let smallest = smallest_failure(&c.failures);
     let sentence = smallest.map(smallest_case_sentence);
@@ -258,6 +261,60 @@ fn ambiguous_counts(c: &CheckResult, checks: &[CheckResult]) -> Option<(usize, u
         .filter(|o| o.group == c.group)
         .find_map(|o| o.counts.as_ref())
         .map(|n| (n.ambiguous - n.ambiguous_passed, n.ambiguous))
+}
+
+/// A function check's message (the harness's words, escaped as text all the same) and the
+/// function's smallest failing case: its input, what the submission answered or raised (in a
+/// block `quote` writes: it is the submission's text), the reproduction, and the notes.
+fn function_body(
+    c: &CheckResult,
+    f: &crate::functions::FunctionResult,
+    quote: fn(&str) -> String,
+) -> String {
+    let mut md = markdown_inline(&c.message);
+    md.push('\n');
+    if let Some(failure) = &f.failure {
+        let _ = write!(
+            md,
+            "\nThe smallest failing case of `{}`, `{}` ({}), gave:\n\n{}",
+            f.id.replace('`', "'"),
+            failure.case.replace('`', "'"),
+            markdown_inline(&failure.input),
+            quote(&failure.problem)
+        );
+        md.push_str(&format!(
+            "\nTo run it yourself, save this as `repro.py` in your submission folder and run \
+             `python3 repro.py`:\n\n{}",
+            markdown_block(&failure.repro, "python")
+        ));
+    }
+    if let Some(stats) = &f.statistics {
+        let fit = &stats.fit;
+        let mut said = format!("\nThe statistical check judged {} samples", stats.samples);
+        if fit.invariant_failures > 0 {
+            let _ = write!(
+                said,
+                "; {} broke the course's invariant",
+                fit.invariant_failures
+            );
+            if let Some((i, why)) = &fit.first_failure {
+                let _ = write!(said, " (the first, sample {i}: {})", markdown_inline(why));
+            }
+        }
+        if let Some(t) = &fit.test {
+            let _ = write!(
+                said,
+                "; {} test: statistic {:.1}, p = {:.2e}, rejected below a false-alarm rate of {:.0e}",
+                t.test, t.statistic, t.p_value, t.alpha
+            );
+        }
+        md.push_str(&said);
+        md.push_str(".\n");
+    }
+    for note in f.notes.iter().take(3) {
+        let _ = writeln!(md, "\nNote: {}", markdown_inline(note));
+    }
+    md
 }
 
 /// The short note on a group's ambiguous vectors (an unscored check with some that differ):

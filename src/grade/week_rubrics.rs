@@ -1,0 +1,266 @@
+//! The built-in rubrics of the course's weeks 4 to 10 (`grade --rubric week06`,
+//! `--print-rubric week06`, `autograder --rubric week06`), as TOML text a course can print,
+//! edit and give back as a file.
+//!
+//! Week 4's is [`WEEK04_RUBRIC`](super::rubric::WEEK04_RUBRIC). From week 5 on, a week's rubric
+//! holds, out of 100 points:
+//! - **70 points of functions**: the week's function groups ([`crate::functions::score`]'s,
+//!   their points scaled by 0.7), each group's points shared equally by its functions; the
+//!   functions the week's skeleton gives and the earlier weeks' (week 4's intersections
+//!   included) are checked and reported but carry no points;
+//! - **30 points of images**: each of the week's `main.py` scenes rendered by the grader from the
+//!   submission's own code, at a few samples per pixel ([`week_render_spp`]) so that a Python
+//!   submission renders all of a week's scenes in about a minute of one core, judged against the
+//!   golden of that scene at that sample count (a scene whose render the week's skeleton passes
+//!   is judged and shown without points: [`unscored_image`]);
+//! - the week-4 intersection groups at 0 points (`sphere`, `quad`): a regression shows in the
+//!   feedback without costing points.
+//!
+//! Week 5 checks the course's current direct term (`E min(1, 1/d)`); a rubric with
+//! `accept = ["older_direct_term_one_over_d"]` also passes the earlier version's functions.
+
+use std::fmt::Write as _;
+
+use crate::functions::Week;
+use crate::functions::score::week_groups;
+
+/// The names of the built-in rubrics.
+pub const BUILTIN_RUBRICS: &[&str] = &[
+    "week04", "week05", "week06", "week07", "week08", "week09", "week10",
+];
+
+/// The points of a week's functions (the rest are its images').
+pub const FUNCTION_POINTS: f64 = 70.0;
+
+/// The points of a week's images.
+pub const IMAGE_POINTS: f64 = 30.0;
+
+/// The wall time each of a week's renders may take, in seconds: about four times what the
+/// slowest scene of the week takes in the course's Python at [`week_render_spp`] on one core.
+pub const WEEK_RENDER_SECONDS: f64 = 120.0;
+
+/// The samples per pixel of the grader's renders of week `week`'s scenes: 2 for weeks 5 to 7
+/// (400-pixel-wide scenes of 24 to 44 us a sample: 4 to 10 s each), 4 for week 8 (320 x 180,
+/// about 50 us a sample: about 12 s each), and 5 for the jittered scenes of weeks 9 and 10:
+/// `render_jittered` takes `floor(sqrt(5))^2 = 4` samples and their sum is divided by 5, as the
+/// course's film does (a count that is not a square keeps that departure visible in the
+/// golden; at 4 it would vanish). The goldens of those scenes at 5 are compiled in
+/// ([`crate::golden::embedded::SPP_VARIANTS`]).
+pub fn week_render_spp(week: Week) -> u32 {
+    match week.number() {
+        ..=7 => 2,
+        8 => 4,
+        _ => 5,
+    }
+}
+
+/// The week's scenes with the file name the course's `main.py` writes each to.
+pub fn week_scenes(week: Week) -> &'static [(&'static str, &'static str)] {
+    match week.number() {
+        5 => &[
+            ("week05-quad", "week05_quad.png"),
+            ("week05-quad-light", "week05_quad_light1.png"),
+            ("week05-point-light", "week05_point_light.png"),
+            ("week05-point-light-shadow", "week05_point_light_shadow.png"),
+        ],
+        6 => &[
+            ("week06-mirror-point-light", "week06_point_light.png"),
+            ("week06-mirrors", "week06_glass_sky.png"),
+            ("week06-dielectric", "week06_dielec_sky.png"),
+        ],
+        7 => &[
+            ("week07-procedural-texture", "week07_texture_sky.png"),
+            ("week07-earth", "week07_texture_earth_sky.png"),
+        ],
+        8 => &[
+            ("week08-phong", "week08_brdf_Phong.png"),
+            ("week08-blinn", "week08_brdf_Blinn.png"),
+        ],
+        9 => &[("week09-blinn", "week09_nojittered.png")],
+        _ => &[
+            ("week10-dof", "week10_jitter_DoF.png"),
+            ("week10-moving", "week10_moving_nojitter.png"),
+        ],
+    }
+}
+
+/// Why a week's scene is rendered and judged but carries no points in the built-in rubric, when
+/// it does not: an image that the week's skeleton passes measures nothing of the student's.
+///
+/// `week10-dof`: the week-10 skeleton's jittered rays have no lens, and at the grader's samples
+/// its render matches the golden (measured at 5 and at 10 spp: the 2-degree lens blurs edges by
+/// about 2 pixels, within the noise of a few samples). The lens is scored by its function check
+/// (35 points) instead.
+pub fn unscored_image(scene: &str) -> Option<&'static str> {
+    (scene == "week10-dof").then_some(
+        "at the grader's samples the render of the week-10 skeleton, whose jittered rays have no lens, passes this image; the lens is scored by its function check",
+    )
+}
+
+/// The TOML text of the built-in rubric `name` (`week04` ... `week10`), or `None`.
+pub fn builtin_rubric_toml(name: &str) -> Option<String> {
+    if name == "week04" {
+        return Some(super::rubric::WEEK04_RUBRIC.to_string());
+    }
+    let n: u8 = name.strip_prefix("week")?.parse().ok()?;
+    if name.len() != 6 {
+        return None;
+    }
+    Week::new(n).map(week_rubric_toml)
+}
+
+/// Writes a number as TOML does not mind (`24.5`, `10`).
+fn points(x: f64) -> String {
+    let r = (x * 100.0).round() / 100.0;
+    if r.fract() == 0.0 {
+        format!("{r:.0}")
+    } else {
+        format!("{r}")
+    }
+}
+
+/// The built-in rubric of `week` ([module docs](self)).
+fn week_rubric_toml(week: Week) -> String {
+    let n = week.number();
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "# The built-in week-{n} rubric: 100 points, {} for the week's functions and {} for its scenes' images.",
+        points(FUNCTION_POINTS),
+        points(IMAGE_POINTS)
+    );
+    t.push_str(
+        "# The functions the week's skeleton gives and the earlier weeks' (week 4's intersections\n\
+         # included) are checked and reported without points.\n",
+    );
+    let _ = writeln!(t, "name = \"week{n:02}\"");
+    let _ = writeln!(t, "week = {n}");
+    t.push_str("seed = 0\n");
+    t.push_str("alpha = 1e-4 # false-alarm rate of each statistical check of a sampler\n");
+    if n == 5 {
+        t.push_str(
+            "# The direct term checked is the course's current one, E min(1, 1/d) times the albedo.\n\
+             # For the earlier one (E / d, not times the albedo), add:\n\
+             # accept = [\"older_direct_term_one_over_d\"]\n",
+        );
+    }
+    t.push_str(
+        "code_time_budget_seconds = 120 # wall time for all of a submission's code checks\n",
+    );
+    for g in week_groups(week) {
+        let list: Vec<String> = g.functions.iter().map(|f| format!("{f:?}")).collect();
+        let _ = write!(
+            t,
+            "\n[[group]]\nid = \"{}\"\nname = \"{}\"\nkind = \"functions\"\nfunctions = [{}]\npoints = {}\nvisibility = \"visible\"\n",
+            g.id,
+            g.name,
+            list.join(", "),
+            points(g.points * FUNCTION_POINTS / 100.0)
+        );
+    }
+    let scenes = week_scenes(week);
+    let scored = scenes
+        .iter()
+        .filter(|(scene, _)| unscored_image(scene).is_none())
+        .count();
+    let each = IMAGE_POINTS / scored.max(1) as f64;
+    let spp = week_render_spp(week);
+    for (scene, file) in scenes {
+        let why = unscored_image(scene);
+        if let Some(why) = why {
+            let _ = write!(t, "\n# No points: {why}.");
+        }
+        let _ = write!(
+            t,
+            "\n[[group]]\nid = \"image.{scene}\"\nname = \"{scene} rendered from your code ({file})\"\nkind = \"image\"\nfile = \"{file}\"\nscene = \"{scene}\"\nsource = \"render\" # rendered by the grader from the submission's code\nspp = {spp}\nrender_seconds = {}\npoints = {}\nvisibility = \"visible\"\n",
+            points(WEEK_RENDER_SECONDS),
+            points(if why.is_some() { 0.0 } else { each })
+        );
+    }
+    for (shape, name) in [
+        ("sphere", "Sphere intersection (week 4; no points)"),
+        (
+            "quad",
+            "Quad constructor and intersection (week 4; no points)",
+        ),
+    ] {
+        let _ = write!(
+            t,
+            "\n[[group]]\nid = \"{shape}\"\nname = \"{name}\"\nkind = \"code\"\nshape = \"{shape}\"\npoints = 0\nvisibility = \"visible\"\n"
+        );
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grade::rubric::{GroupKind, Rubric};
+
+    /// Every built-in rubric parses, adds up to 100, and from week 5 on scores every one of the
+    /// week's own functions once, renders every scene of the week, and keeps the week-4
+    /// intersections at no points.
+    #[test]
+    fn every_built_in_rubric_is_valid_and_adds_up_to_100() {
+        for name in BUILTIN_RUBRICS {
+            let text = builtin_rubric_toml(name).unwrap();
+            let r = Rubric::from_toml(&text, "built-in").unwrap();
+            assert_eq!(r.name, *name);
+            assert!(
+                (r.max_score() - 100.0).abs() < 1e-9,
+                "{name}: {}",
+                r.max_score()
+            );
+            let Some(week) = r.week.and_then(Week::new) else {
+                assert_eq!(*name, "week04");
+                continue;
+            };
+            let scored: Vec<&str> = r
+                .groups
+                .iter()
+                .filter(|g| g.kind == GroupKind::Functions)
+                .flat_map(|g| g.functions.iter().flatten().map(String::as_str))
+                .collect();
+            let mut own: Vec<&str> = week_groups(week)
+                .iter()
+                .flat_map(|g| g.functions.iter().copied())
+                .collect();
+            own.sort();
+            let mut got = scored.clone();
+            got.sort();
+            assert_eq!(got, own, "{name}");
+            let images: Vec<&str> = r
+                .groups
+                .iter()
+                .filter(|g| g.kind == GroupKind::Image)
+                .map(|g| g.scene.as_deref().unwrap())
+                .collect();
+            let expected: Vec<&str> = crate::scene::BUILTIN_SCENES
+                .iter()
+                .filter(|s| s.week == Some(u32::from(week.number())))
+                .map(|s| s.name)
+                .collect();
+            assert_eq!(
+                images, expected,
+                "{name}: every scene of the week, in order"
+            );
+            for g in r.groups.iter().filter(|g| g.kind == GroupKind::Code) {
+                assert_eq!(g.points, 0.0, "{name} {}", g.id);
+            }
+            // A render whose golden depends on its samples per pixel has that golden compiled in.
+            for g in r.groups.iter().filter(|g| g.renders()) {
+                let scene = crate::scene::builtin(g.scene.as_deref().unwrap()).unwrap();
+                if crate::golden::at_spp(&scene, g.render_spp()).is_some() {
+                    let wanted = (g.scene.as_deref().unwrap(), g.render_spp());
+                    assert!(
+                        crate::golden::embedded::SPP_VARIANTS.contains(&wanted),
+                        "{name}: {wanted:?} has no committed golden"
+                    );
+                }
+            }
+        }
+        assert!(builtin_rubric_toml("week11").is_none());
+        assert!(builtin_rubric_toml("week5").is_none());
+        assert!(builtin_rubric_toml("week004").is_none());
+    }
+}
