@@ -220,7 +220,6 @@ pub fn run() -> String {
         secs(t.elapsed())
     });
     let (builtin, scene_file) = pool.install(|| scene_file_batches(work.path()));
-    let week08 = week08_one(work.path());
     let mut report = String::new();
     report.push_str(&format!(
         "grade benchmark (2 threads unless said; fixtures: {})",
@@ -257,19 +256,7 @@ pub fn run() -> String {
         batch_time / 30.0
     ));
     report.push('\n');
-    report.push_str(&format!(
-        "  one week-8 submission, week08 rubric    {:8.3} s  = {:6.1} x baseline  (the course-shaped solution, 1 thread; target <= 180 s; {:.0} / 100)",
-        week08.rendered.total,
-        week08.rendered.total / baseline,
-        week08.score
-    ));
-    report.push('\n');
-    for (id, spp, seconds) in &week08.rendered.groups {
-        report.push_str(&format!(
-            "    {id:<36}{seconds:8.3} s  to render at {spp} spp"
-        ));
-        report.push('\n');
-    }
+    report.push_str(&week08_one(work.path()).lines(baseline));
     report.push_str(&format!(
         "  batch of 10, built-in scene 'triangles'  {:8.3} s  (embedded golden; median of 3 runs)",
         builtin
@@ -322,6 +309,24 @@ fn rendered_one(submission: &Path, work: &Path) -> Rendered {
 struct WeekGrade {
     rendered: Rendered,
     score: f64,
+}
+
+impl WeekGrade {
+    /// Its lines of the benchmark's output.
+    fn lines(&self, baseline: f64) -> String {
+        let mut out = format!(
+            "  one week-8 submission, week08 rubric    {:8.3} s  = {:6.1} x baseline  (the course-shaped solution, 1 thread; target <= 180 s; {:.0} / 100)\n",
+            self.rendered.total,
+            self.rendered.total / baseline,
+            self.score
+        );
+        for (id, spp, seconds) in &self.rendered.groups {
+            out.push_str(&format!(
+                "    {id:<36}{seconds:8.3} s  to render at {spp} spp\n"
+            ));
+        }
+        out
+    }
 }
 
 /// Grades the course-shaped week-8 solution (embedded) with the built-in week08 rubric, its

@@ -455,38 +455,6 @@ impl Rubric {
             .expect("the upload variant is valid")
     }
 
-    /// The built-in rubric `name` (`week04` ... `week10`,
-    /// [`BUILTIN_RUBRICS`](super::week_rubrics::BUILTIN_RUBRICS)), or `None`.
-    pub fn builtin(name: &str) -> Option<Rubric> {
-        let text = super::week_rubrics::builtin_rubric_toml(name)?;
-        Some(Rubric::from_toml(&text, "built-in").expect("the built-in rubrics are valid"))
-    }
-
-    /// The rubric `--rubric` names: a built-in one by its name (`week06`), else a file (a file
-    /// called like a built-in rubric is given as `./week06`). With the TOML text it was read from.
-    pub fn named(arg: &Path) -> Result<(Rubric, String), RubricError> {
-        if let Some(name) = arg.to_str() {
-            if let Some(text) = super::week_rubrics::builtin_rubric_toml(name) {
-                let rubric = Rubric::from_toml(&text, "built-in")?;
-                return Ok((rubric, text));
-            }
-        }
-        let text = std::fs::read_to_string(arg).map_err(|e| RubricError::Read {
-            path: arg.display().to_string(),
-            message: if e.kind() == std::io::ErrorKind::NotFound {
-                format!(
-                    "no such file (and not a built-in rubric: {})",
-                    super::week_rubrics::BUILTIN_RUBRICS.join(", ")
-                )
-            } else {
-                e.to_string()
-            },
-        })?;
-        let base = arg.parent().unwrap_or(Path::new(""));
-        let rubric = Rubric::from_toml_in(&text, &arg.display().to_string(), base)?;
-        Ok((rubric, text))
-    }
-
     /// Reads a rubric file.
     pub fn from_file(path: &Path) -> Result<Rubric, RubricError> {
         let text = std::fs::read_to_string(path).map_err(|e| RubricError::Read {
@@ -622,7 +590,7 @@ impl Rubric {
         Ok(())
     }
 
-    fn invalid(&self, message: String) -> RubricError {
+    pub(super) fn invalid(&self, message: String) -> RubricError {
         RubricError::Invalid {
             path: self.source.clone(),
             message,
@@ -680,110 +648,6 @@ impl Rubric {
         }
         self.validate_week()?;
         self.validate_image_files()
-    }
-
-    /// The week, `alpha` and `accept`, and that no function is scored by two groups.
-    fn validate_week(&self) -> Result<(), RubricError> {
-        let week = match self.week {
-            None => {
-                if self.alpha.is_some() || !self.accept.is_empty() {
-                    return Err(self.invalid(
-                        "alpha and accept are for a rubric with a week (week = 5 to 10)".into(),
-                    ));
-                }
-                return Ok(());
-            }
-            Some(n) => crate::functions::Week::new(n).ok_or_else(|| {
-                self.invalid(format!(
-                    "week = {n}: function checks exist for weeks 5 to 10 (leave week out for week 4)"
-                ))
-            })?,
-        };
-        if let Some(a) = self.alpha {
-            if !(a.is_finite() && a > 0.0 && a < 0.5) {
-                return Err(self.invalid(format!(
-                    "alpha = {a}: it must be more than 0 and less than 0.5"
-                )));
-            }
-        }
-        let known = crate::functions::checks::alternatives(week);
-        for name in &self.accept {
-            if !known.contains(&name.as_str()) {
-                return Err(self.invalid(format!(
-                    "accept: {name:?} is not one of {week}'s alternatives (known: {})",
-                    if known.is_empty() {
-                        "none".to_string()
-                    } else {
-                        known.join(", ")
-                    }
-                )));
-            }
-        }
-        let mut seen: Vec<(&str, &str)> = Vec::new();
-        for g in self
-            .groups
-            .iter()
-            .filter(|g| g.kind == GroupKind::Functions)
-        {
-            for f in g.functions.iter().flatten() {
-                if let Some((_, first)) = seen.iter().find(|(s, _)| s == f) {
-                    return Err(self.invalid(format!(
-                        "function {f:?} is in groups {first:?} and {:?}; a function is scored by one group",
-                        g.id
-                    )));
-                }
-                seen.push((f.as_str(), g.id.as_str()));
-            }
-        }
-        Ok(())
-    }
-
-    fn validate_functions_group(&self, g: &Group) -> Result<(), RubricError> {
-        if !g.id.starts_with("functions.") {
-            return Err(self.invalid(format!(
-                "functions group id {:?} must start with \"functions.\"",
-                g.id
-            )));
-        }
-        let Some(week) = self.week.and_then(crate::functions::Week::new) else {
-            return Err(self.invalid(format!(
-                "functions group {:?} needs the rubric's week (week = 5 to 10)",
-                g.id
-            )));
-        };
-        let names = g.functions.as_deref().unwrap_or_default();
-        if names.is_empty() {
-            return Err(self.invalid(format!(
-                "functions group {:?} needs functions = [...] (the ids of the functions it scores)",
-                g.id
-            )));
-        }
-        let known = crate::functions::checks::function_ids(week);
-        for f in names {
-            if !known.contains(&f.as_str()) {
-                return Err(self.invalid(format!(
-                    "functions group {:?}: {f:?} is not a function {week} checks (known: {})",
-                    g.id,
-                    known.join(", ")
-                )));
-            }
-        }
-        if g.shape.is_some()
-            || g.file.is_some()
-            || g.scene.is_some()
-            || g.golden.is_some()
-            || g.source.is_some()
-            || g.spp.is_some()
-            || g.render_seconds.is_some()
-            || g.score_ambiguous
-            || g.all_or_nothing
-        {
-            return Err(self.invalid(format!(
-                "functions group {:?} takes no shape, file, scene, golden, source, spp, render_seconds, score_ambiguous or all_or_nothing",
-                g.id
-            )));
-        }
-        Ok(())
     }
 
     fn validate_code_group(&self, g: &Group) -> Result<(), RubricError> {

@@ -138,6 +138,33 @@ fn render_check(
     check
 }
 
+/// The code checks of `submission`: the intersection vectors of the rubric's shapes and, with a
+/// week, that week's function checks, at the same time.
+fn run_code(
+    submission: &Path,
+    rubric: &Rubric,
+    code: &dyn CodeChecker,
+) -> (CodeOutcome, Option<super::inputs::FunctionsOutcome>) {
+    let shapes = rubric.code_shapes();
+    let week = rubric.week.and_then(crate::functions::Week::new);
+    let function_options = crate::functions::FunctionOptions {
+        seed: rubric.seed,
+        alpha: rubric
+            .alpha
+            .unwrap_or(crate::functions::stats::DEFAULT_ALPHA),
+    };
+    rayon::join(
+        || {
+            if shapes.is_empty() {
+                CodeOutcome::default()
+            } else {
+                code.check(submission, &shapes)
+            }
+        },
+        || week.map(|w| code.check_functions(submission, w, function_options)),
+    )
+}
+
 /// Grades the submission in folder `submission`: runs the code groups through `code` and the
 /// image groups through `images` (heatmaps go into `out_dir`, which must exist), and scores them
 /// with `rubric`. Whatever the student's code does, a report comes back; the only errors are a
@@ -153,7 +180,6 @@ pub fn grade(
     if !submission.is_dir() {
         return Err(GradeError::NoSubmission(submission.to_path_buf()));
     }
-    let shapes = rubric.code_shapes();
     let image_groups: Vec<&Group> = rubric
         .groups
         .iter()
@@ -164,26 +190,8 @@ pub fn grade(
         .copied()
         .filter(|g| g.renders())
         .collect();
-    let week = rubric.week.and_then(crate::functions::Week::new);
-    let function_options = crate::functions::FunctionOptions {
-        seed: rubric.seed,
-        alpha: rubric
-            .alpha
-            .unwrap_or(crate::functions::stats::DEFAULT_ALPHA),
-    };
     let ((outcome, functions), (image_outcomes, renders)) = rayon::join(
-        || {
-            rayon::join(
-                || {
-                    if shapes.is_empty() {
-                        CodeOutcome::default()
-                    } else {
-                        code.check(submission, &shapes)
-                    }
-                },
-                || week.map(|w| code.check_functions(submission, w, function_options)),
-            )
-        },
+        || run_code(submission, rubric, code),
         || {
             rayon::join(
                 || {

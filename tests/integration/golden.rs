@@ -307,6 +307,19 @@ fn embedded_goldens_are_the_files() {
         .collect();
     files.sort();
     let mut embedded: Vec<String> = embedded_scenes().into_iter().map(String::from).collect();
+    // With the goldens of the jittered scenes at the built-in rubrics' samples per pixel.
+    for (scene, spp) in rtoracle::golden::embedded::SPP_VARIANTS {
+        embedded.push(format!("{scene}.spp{spp}"));
+        let file = std::fs::read(golden_dir().join(format!("{scene}.spp{spp}.exr"))).unwrap();
+        assert!(
+            rtoracle::golden::embedded::embedded_goldens(scene).any(|(_, b)| b == file.as_slice()),
+            "{scene} at {spp} spp: the embedded golden is stale; rebuild"
+        );
+        let fits = GoldenScene::builtin_at_spp(scene, *spp)
+            .unwrap()
+            .fits(&file, Path::new(scene));
+        assert!(fits.is_ok(), "{scene}.spp{spp}: {}", fits.unwrap_err());
+    }
     embedded.sort();
     assert_eq!(
         files, embedded,
