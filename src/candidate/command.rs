@@ -44,6 +44,13 @@ pub const COURSE_FUNCTIONS_DRIVER: &str = include_str!("../functions/course_func
 /// The driver's name in the sandbox folder (the adapter's `FUNCTIONS_FILE`).
 const FUNCTIONS_NAME: &str = "rtoracle_course_functions.py";
 
+/// The course adapter's driver of the submission's own `main.py` (render requests naming a
+/// `program`), written beside the adapter.
+pub const COURSE_PROGRAM_DRIVER: &str = include_str!("python_course_program.py");
+
+/// The program driver's name in the sandbox folder (the adapter's `PROGRAM_FILE`).
+const PROGRAM_NAME: &str = "rtoracle_course_program.py";
+
 /// The program a candidate runs, and how its failures are treated.
 #[derive(Clone, Debug)]
 pub struct CandidateCommand {
@@ -186,7 +193,11 @@ impl CandidateCommand {
         for entry in entries.flatten() {
             let raw = entry.file_name();
             let name = raw.to_string_lossy().to_string();
-            if !name.ends_with(".py") || name == ADAPTER_NAME || name == FUNCTIONS_NAME {
+            if !name.ends_with(".py")
+                || name == ADAPTER_NAME
+                || name == FUNCTIONS_NAME
+                || name == PROGRAM_NAME
+            {
                 continue;
             }
             candidates.push((name, entry));
@@ -255,6 +266,9 @@ impl CandidateCommand {
                 .map_err(io)?;
             sandbox
                 .add_file(FUNCTIONS_NAME, COURSE_FUNCTIONS_DRIVER.as_bytes())
+                .map_err(io)?;
+            sandbox
+                .add_file(PROGRAM_NAME, COURSE_PROGRAM_DRIVER.as_bytes())
                 .map_err(io)?;
         } else {
             let found = if self.program.components().count() > 1 {

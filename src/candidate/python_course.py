@@ -24,7 +24,10 @@ A "render" request (docs/PROTOCOL.md, "Render requests") renders one tile of a s
 submission's own classes: RT_scene.Scene, RT_object.Sphere / Quad / Triangle, RT_material's
 materials, RT_camera.Camera and RT_integrator.Integrator, looping over the pixels here (so the
 course's RT_renderer and its progress bar are never imported). The answer is the tile's mean
-linear RGB, or {"declined": why} for a scene the submission's classes cannot build.
+linear RGB, or {"declined": why} for a scene the submission's classes cannot build. A render
+request naming a "program" (a main.py render function) is answered by a third file written
+beside this one (PROGRAM_FILE): the function is run unmodified and the answer is the 8-bit film
+it saves, as "film" codes.
 """
 
 import importlib.util
@@ -69,6 +72,8 @@ REQUIRES = ["numpy", "PIL"]
 SUBMISSION = "."
 # rtoracle's driver of the course's functions, written beside this file.
 FUNCTIONS_FILE = "rtoracle_course_functions.py"
+# rtoracle's driver of the submission's own main.py (render requests naming a "program").
+PROGRAM_FILE = "rtoracle_course_program.py"
 
 
 def load_functions():
@@ -424,8 +429,12 @@ class Renderer:
         self.make_triangle = make_triangle
         self.key = None
         self.built = None
+        self.program = None
+        self.program_module = None
 
     def answer(self, req):
+        if req.get("program") is not None:
+            return self.answer_program(req)
         key = json.dumps([req["scene"], req["spp"]], sort_keys=True)
         if key != self.key:
             self.key, self.built = None, None
@@ -435,6 +444,22 @@ class Renderer:
                 return json.dumps({"declined": str(d)})
             self.key = key
         return render_tile(self.built, req)
+
+    def answer_program(self, req):
+        """A tile of the image the submission's own main.py function makes (PROGRAM_FILE)."""
+        if self.program is None:
+            path = os.path.join(os.path.dirname(os.path.abspath(__file__)), PROGRAM_FILE)
+            if not os.path.isfile(path):
+                return json.dumps({"declined": "the adapter cannot run the submission's program"})
+            spec = importlib.util.spec_from_file_location("rtoracle_course_program", path)
+            self.program_module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(self.program_module)
+            self.program = self.program_module.ProgramRenderer()
+        key = json.dumps([req["program"], req["scene"], req["spp"], req.get("seed", 0)], sort_keys=True)
+        try:
+            return self.program.answer(req, key)
+        except self.program_module.Declined as d:
+            return json.dumps({"declined": str(d)})
 
 
 class _Channel:
@@ -571,7 +596,7 @@ def main():
     make_triangle = triangle_maker(Triangle, Vec3)
     if make_triangle is not None:
         hello["shapes"].append("triangle")
-    hello.setdefault("ops", ["intersect"]).append("render")
+    hello.setdefault("ops", ["intersect"]).extend(["render", "render_program"])
     renderer = Renderer(Vec3, make_triangle)
     out.write(json.dumps(hello) + "\n")
     threading.Thread(target=chan.watchdog, daemon=True).start()

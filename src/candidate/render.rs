@@ -39,6 +39,30 @@ pub struct RenderJob<'a> {
     pub seed: u64,
     /// Wall time the whole render may take, from the first tile's request.
     pub time_limit: Duration,
+    /// The candidate's own program that renders this scene (a course `main.py` render
+    /// function, `renderMoving`), asked for when its hello lists `"render_program"`: the answer
+    /// is then the 8-bit film the program saves. When the program cannot render it (declined,
+    /// raised, the wrong size), the scene is rendered from its description, and the image says
+    /// why ([`MadeBy::DescriptionInstead`]).
+    pub program: Option<&'a str>,
+}
+
+/// How a render was made.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum MadeBy {
+    /// The candidate built the scene's description with its own code and sent linear means.
+    #[default]
+    Description,
+    /// The candidate's own program (named) rendered the scene through its own film.
+    Program(String),
+    /// The job named a program that could not render the scene (why); the description was
+    /// rendered instead.
+    DescriptionInstead {
+        /// The program asked for.
+        program: String,
+        /// Why it did not render (its decline, its exception, a wrong answer), one line.
+        why: String,
+    },
 }
 
 /// A render that came back whole.
@@ -52,8 +76,14 @@ pub struct RenderedImage {
     pub spp: u32,
     /// Wall time it took, in seconds.
     pub seconds: f64,
-    /// Mean linear RGB per pixel, row-major, top row first.
+    /// Mean linear RGB per pixel, row-major, top row first (for a program's film, its codes
+    /// decoded as the course's gamma-2 film, for display only: the film is what is judged).
     pub data: Vec<[f32; 3]>,
+    /// The 8-bit film the candidate's program saved (3 codes per pixel, row-major, top row
+    /// first), when [`made_by`](Self::made_by) is a program: what is judged.
+    pub film: Option<Vec<u8>>,
+    /// How it was made.
+    pub made_by: MadeBy,
 }
 
 /// How a render ended.
@@ -163,13 +193,17 @@ pub fn with_pictures(scene: &SceneDescription, mut value: Value) -> Result<Value
 
 /// The request for one tile, without its id (the session adds it).
 pub fn render_request(job: &RenderJob, scene: &Value, tile: [usize; 4]) -> Value {
-    json!({
+    let mut request = json!({
         "op": "render",
         "scene": scene,
         "spp": job.spp,
         "seed": job.seed,
         "tile": tile,
-    })
+    });
+    if let Some(program) = job.program {
+        request["program"] = json!(program);
+    }
+    request
 }
 
 /// A number of an answer: a JSON number, or `"nan"`, `"inf"`, `"-inf"` as strings.
@@ -195,31 +229,8 @@ pub fn read_tile(
     (width, height): (usize, usize),
     data: &mut [[f32; 3]],
 ) -> Result<(), String> {
+    read_header(result, tile, (width, height))?;
     let [x0, y0, x1, y1] = tile;
-    let echoed: Option<Vec<u64>> = result
-        .get("tile")
-        .and_then(Value::as_array)
-        .map(|a| a.iter().filter_map(Value::as_u64).collect());
-    if echoed.as_deref() != Some(&[x0 as u64, y0 as u64, x1 as u64, y1 as u64][..]) {
-        return Err(format!(
-            "the answer for the tile x {x0}..{x1}, y {y0}..{y1} names another tile ({})",
-            result.get("tile").map_or("none".into(), |t| {
-                crate::escape::truncate(&t.to_string(), 80)
-            })
-        ));
-    }
-    if let Some(size) = result.get("size") {
-        let made: Option<Vec<u64>> = size
-            .as_array()
-            .map(|a| a.iter().filter_map(Value::as_u64).collect());
-        let want = [width as u64, height as u64];
-        if made.as_deref() != Some(&want[..]) {
-            return Err(format!(
-                "the candidate's camera makes an image of size {} but the scene is {width}x{height}",
-                crate::escape::truncate(&size.to_string(), 40)
-            ));
-        }
-    }
     let Some(rgb) = result.get("rgb").and_then(Value::as_array) else {
         return Err(format!(
             "the answer for the tile x {x0}..{x1}, y {y0}..{y1} has no \"rgb\" list"
@@ -258,14 +269,129 @@ pub fn read_tile(
     Ok(())
 }
 
+/// Reads one tile of a program's answer (`"film"`: 8-bit codes, 3 per pixel) into `film` (the
+/// whole image's codes) and, decoded as the course's gamma-2 film (the middle of each code,
+/// squared), into `data`; `Err` says what is wrong, naming the first bad pixel.
+pub fn read_film_tile(
+    result: &Value,
+    tile: [usize; 4],
+    (width, height): (usize, usize),
+    data: &mut [[f32; 3]],
+    film: &mut [u8],
+) -> Result<(), String> {
+    read_header(result, tile, (width, height))?;
+    let [x0, y0, x1, y1] = tile;
+    let Some(codes) = result.get("film").and_then(Value::as_array) else {
+        return Err(format!(
+            "the answer for the tile x {x0}..{x1}, y {y0}..{y1} has no \"film\" list"
+        ));
+    };
+    let pixels = (x1 - x0) * (y1 - y0);
+    if codes.len() != 3 * pixels {
+        return Err(format!(
+            "the tile x {x0}..{x1}, y {y0}..{y1} has {} codes, not 3 x {pixels}",
+            codes.len()
+        ));
+    }
+    for (k, triple) in codes.chunks(3).enumerate() {
+        let (x, y) = (x0 + k % (x1 - x0), y0 + k / (x1 - x0));
+        let at = y * width + x;
+        for (c, v) in triple.iter().enumerate() {
+            let Some(code) = v.as_u64().and_then(|n| u8::try_from(n).ok()) else {
+                return Err(format!(
+                    "pixel ({x}, {y}) is not an 8-bit code: {}",
+                    crate::escape::truncate(&v.to_string(), 40)
+                ));
+            };
+            film[3 * at + c] = code;
+            // The course's film is gamma 2 over 255 codes: the middle of the code, squared.
+            let g = (f64::from(code) + 0.5) / 255.0;
+            data[at][c] = (g * g).min(1.0) as f32;
+        }
+    }
+    Ok(())
+}
+
+/// Checks that an answer is for `tile` and, when it says the size of its image, that the size is
+/// the scene's.
+fn read_header(
+    result: &Value,
+    tile: [usize; 4],
+    (width, height): (usize, usize),
+) -> Result<(), String> {
+    let [x0, y0, x1, y1] = tile;
+    let echoed: Option<Vec<u64>> = result
+        .get("tile")
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_u64).collect());
+    if echoed.as_deref() != Some(&[x0 as u64, y0 as u64, x1 as u64, y1 as u64][..]) {
+        return Err(format!(
+            "the answer for the tile x {x0}..{x1}, y {y0}..{y1} names another tile ({})",
+            result.get("tile").map_or("none".into(), |t| {
+                crate::escape::truncate(&t.to_string(), 80)
+            })
+        ));
+    }
+    if let Some(size) = result.get("size") {
+        let made: Option<Vec<u64>> = size
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_u64).collect());
+        let want = [width as u64, height as u64];
+        if made.as_deref() != Some(&want[..]) {
+            return Err(format!(
+                "the candidate's camera makes an image of size {} but the scene is {width}x{height}",
+                crate::escape::truncate(&size.to_string(), 40)
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Renders `job` through `session`, tile by tile (see the module docs); the candidate must list
-/// `"render"` among its hello's `ops`, else the render is declined without a request.
+/// `"render"` among its hello's `ops`, else the render is declined without a request. A job
+/// naming a [`program`](RenderJob::program) is first asked of the program when the hello lists
+/// `"render_program"`; if the program does not render it (declined, raised, an answer of the
+/// wrong size or form), the scene's description is rendered within the time left, and the image
+/// says why. A program that runs out of time is the render's time-out.
 pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
     if session.hello().error.is_none() && !session.hello().answers("render") {
         return RenderOutcome::Declined(
             "the candidate's hello does not list \"render\" among its ops".into(),
         );
     }
+    let start = Instant::now();
+    let Some(program) = job.program else {
+        return render_tiles(session, job, start, None);
+    };
+    let why = if session.hello().answers("render_program") {
+        match render_tiles(session, job, start, Some(program)) {
+            done @ (RenderOutcome::Rendered(_) | RenderOutcome::TimedOut { .. }) => return done,
+            failed => failed.reason().unwrap_or_default(),
+        }
+    } else {
+        "the candidate does not run its own program (its hello does not list \"render_program\")"
+            .to_string()
+    };
+    match render_tiles(session, job, start, None) {
+        RenderOutcome::Rendered(mut image) => {
+            image.made_by = MadeBy::DescriptionInstead {
+                program: program.to_string(),
+                why: crate::escape::truncate(&why, 300),
+            };
+            RenderOutcome::Rendered(image)
+        }
+        other => other,
+    }
+}
+
+/// Renders `job` from its description, or by `program` (its film), every tile within the job's
+/// time limit counted from `start`.
+fn render_tiles(
+    session: &mut Session,
+    job: &RenderJob,
+    start: Instant,
+    program: Option<&str>,
+) -> RenderOutcome {
     let camera = job.scene.camera(None);
     let (width, height) = (camera.width, camera.height);
     let scene = match serde_json::to_value(job.scene) {
@@ -276,9 +402,10 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
         Ok(v) => v,
         Err(why) => return RenderOutcome::Declined(why),
     };
-    let start = Instant::now();
+    let asked = RenderJob { program, ..*job };
     let deadline = start + job.time_limit;
     let mut data = vec![[0f32; 3]; width * height];
+    let mut film = program.map(|_| vec![0u8; 3 * width * height]);
     let mut rows_done = 0;
     for (k, tile) in tiles(width, height).into_iter().enumerate() {
         let left = deadline.saturating_duration_since(Instant::now());
@@ -290,14 +417,18 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
         if left.is_zero() {
             return timed_out;
         }
-        let request = render_request(job, &scene, tile);
+        let request = render_request(&asked, &scene, tile);
         match session.call(&format!("render-{k}"), &request, left) {
             CallOutcome::Result(result) => {
                 if let Some(why) = result.get("declined") {
                     let why = why.as_str().map_or_else(|| why.to_string(), str::to_string);
                     return RenderOutcome::Declined(crate::escape::truncate(&why, 400));
                 }
-                if let Err(why) = read_tile(&result, tile, (width, height), &mut data) {
+                let read = match film.as_deref_mut() {
+                    Some(film) => read_film_tile(&result, tile, (width, height), &mut data, film),
+                    None => read_tile(&result, tile, (width, height), &mut data),
+                };
+                if let Err(why) = read {
                     return RenderOutcome::Invalid(why);
                 }
                 if tile[2] == width {
@@ -320,6 +451,8 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
         spp: job.spp,
         seconds: start.elapsed().as_secs_f64(),
         data,
+        made_by: program.map_or(MadeBy::Description, |p| MadeBy::Program(p.to_string())),
+        film,
     })
 }
 

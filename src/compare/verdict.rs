@@ -34,6 +34,9 @@ struct Intervals {
     hi: Vec<[f64; 3]>,
     encoding: Option<Encoding>,
     table: [(f64, f64); 256],
+    /// The upper end of the encoding's top code's interval (an 8-bit candidate): the film clamps,
+    /// so that code stands for every value from its lower end up, above 1 too.
+    top_hi: Option<f64>,
 }
 
 impl Intervals {
@@ -57,6 +60,7 @@ impl Intervals {
                     hi,
                     encoding: Some(encoding),
                     table,
+                    top_hi: Some(table[encoding.encode(1.0) as usize].1),
                 }
             }
             CandidateImage::Linear { data, .. } => {
@@ -70,6 +74,7 @@ impl Intervals {
                     hi: data.iter().map(|p| p.map(|x| spread(x).1)).collect(),
                     encoding: None,
                     table,
+                    top_hi: None,
                 }
             }
         }
@@ -378,7 +383,11 @@ impl PixelPass {
             let mu = golden.mean[i][c];
             let s2 = golden.variance[i][c];
             let b = golden.bound[i][c];
-            let (lo, hi) = (iv.lo[i][c], iv.hi[i][c]);
+            let (lo, mut hi) = (iv.lo[i][c], iv.hi[i][c]);
+            if iv.top_hi == Some(hi) {
+                // The top code of a clamping film: any mean from its lower end up gives it.
+                hi = hi.max(mu);
+            }
             let t = Term::of(lo, hi, mu, s2, b, claim);
             let z = t.z;
             self.misfit += (z * z).min(100.0);
@@ -794,6 +803,50 @@ mod tests {
         assert_eq!((e.regions[0].x, e.regions[0].y), (0, 0));
         assert_eq!(e.regions[0].channel, "G");
         assert!(e.regions[0].z > 0.0);
+    }
+
+    /// The film clamps: a golden brighter than 1 in blue is written as the top code (254 in the
+    /// course's encoding) and passes; a lower code still fails, and so does the top code where
+    /// the golden is below the code's interval.
+    #[test]
+    fn the_top_code_stands_for_every_brighter_value() {
+        let (w, h) = (8, 8);
+        let golden = Golden::new(
+            w,
+            h,
+            1024,
+            vec![[0.5, 0.9, 1.2]; w * h],
+            vec![[1e-4, 1e-4, 1e-4]; w * h],
+            None,
+        )
+        .unwrap();
+        let options = CompareOptions::default();
+        let image = |blue: u8| CandidateImage::Rgb8 {
+            width: w,
+            height: h,
+            data: (0..w * h)
+                .flat_map(|_| {
+                    [
+                        Encoding::Course.encode(0.5),
+                        Encoding::Course.encode(0.9),
+                        blue,
+                    ]
+                })
+                .collect(),
+        };
+        assert_eq!(Encoding::Course.encode(1.2), 254);
+        assert!(evaluate(&image(254), &golden, Encoding::Course, &options).passed);
+        assert!(!evaluate(&image(250), &golden, Encoding::Course, &options).passed);
+        let dim = Golden::new(
+            w,
+            h,
+            1024,
+            vec![[0.5, 0.9, 0.9]; w * h],
+            vec![[1e-4, 1e-4, 1e-4]; w * h],
+            None,
+        )
+        .unwrap();
+        assert!(!evaluate(&image(254), &dim, Encoding::Course, &options).passed);
     }
 
     /// A linear candidate equal to the golden passes; off by 1% in red fails, darker.

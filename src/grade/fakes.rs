@@ -80,6 +80,8 @@ impl CodeChecker for FakeCode {
                     spp: job.spp,
                     seconds: 0.0,
                     data: vec![[0.5; 3]; camera.width * camera.height],
+                    film: None,
+                    made_by: Default::default(),
                 })
             })
             .collect()

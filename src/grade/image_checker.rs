@@ -303,10 +303,19 @@ impl ImageChecker for CompareImageChecker {
         scene: &SceneSource,
         heatmap_out: &Path,
     ) -> ImageOutcome {
-        let candidate = CandidateImage::Linear {
-            width: render.width,
-            height: render.height,
-            data: render.data.clone(),
+        // A program's film is judged as the PNG it would have written; a description's render
+        // as the linear means it is.
+        let candidate = match &render.film {
+            Some(film) => CandidateImage::Rgb8 {
+                width: render.width,
+                height: render.height,
+                data: film.clone(),
+            },
+            None => CandidateImage::Linear {
+                width: render.width,
+                height: render.height,
+                data: render.data.clone(),
+            },
         };
         self.judge(&candidate, scene, render.spp, "the render", heatmap_out)
     }

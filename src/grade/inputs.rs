@@ -258,11 +258,14 @@ impl ImageOutcome {
 /// The render as the 8-bit image of the course's encoding (what the course's code would have
 /// written as a PNG).
 pub(crate) fn encoded(image: &RenderedImage) -> crate::image_io::Rgb8Image {
-    let data = image
-        .data
-        .iter()
-        .flat_map(|p| p.map(|x| crate::compare::Encoding::Course.encode(f64::from(x))))
-        .collect();
+    let data = match &image.film {
+        Some(film) => film.clone(),
+        None => image
+            .data
+            .iter()
+            .flat_map(|p| p.map(|x| crate::compare::Encoding::Course.encode(f64::from(x))))
+            .collect(),
+    };
     crate::image_io::Rgb8Image {
         width: image.width,
         height: image.height,

@@ -9,9 +9,19 @@
 //! nothing. A render that raises, hangs, declines, returns NaN or the wrong size scores 0 for
 //! its group with the reason, and the rest of the grade stands.
 //!
+//! A group with a `main_function` (the built-in week rubrics set one per `main.py` scene) is
+//! rendered by that function of the submission's own `main.py`: its scene, camera, renderer and
+//! film, at the group's size, spp and depth, and what is judged is the 8-bit film it saves. So a
+//! mistake in the student's scene or film costs the group, as it would cost the student's own
+//! image. When the function cannot render (it is missing, raises, saves no picture or one of
+//! another size), the group falls back to the description, within the same time limit, and
+//! says why.
+//!
 //! What this module promises the reports: the outcome's `metrics` hold the comparison of the
 //! render (as an uploaded image's would) plus `source` (`"render"`), `render` (`spp`,
-//! `seconds`, `width`, `height`, or `not_run` with the reason) and `upload` (the uploaded
+//! `seconds`, `width`, `height`, `made_by` (`"main_function"` or `"description"`), the group's
+//! `main_function` and, when it was not used, `main_function_not_used` with the reason; or
+//! `not_run` with the reason) and `upload` (the uploaded
 //! image's verdict, or why there is none); the check's message starts with what was judged
 //! ("The render of your code (4 spp, 7.1 s) ...") and ends with a sentence on the upload.
 
@@ -23,7 +33,7 @@ use serde_json::{Value, json};
 use super::inputs::{ImageChecker, ImageOutcome};
 use super::result::CheckResult;
 use super::rubric::{Group, SceneSource};
-use crate::candidate::render::{RenderJob, RenderOutcome, RenderedImage};
+use crate::candidate::render::{MadeBy, RenderJob, RenderOutcome, RenderedImage};
 use crate::scene::SceneDescription;
 
 /// The scene description an image group renders: the built-in's or the rubric's scene file.
@@ -36,7 +46,10 @@ pub(crate) fn scene_description(scene: &SceneSource) -> Result<SceneDescription,
 
 /// The render jobs of the rubric's render groups, in `groups`' order: `Err` for a group whose
 /// scene cannot be had (it is not rendered).
-pub(crate) fn jobs_of(groups: &[&Group]) -> Vec<Result<(SceneDescription, u32, Duration), String>> {
+#[allow(clippy::type_complexity)]
+pub(crate) fn jobs_of<'g>(
+    groups: &[&'g Group],
+) -> Vec<Result<(SceneDescription, u32, Duration, Option<&'g str>), String>> {
     groups
         .iter()
         .map(|g| {
@@ -48,6 +61,7 @@ pub(crate) fn jobs_of(groups: &[&Group]) -> Vec<Result<(SceneDescription, u32, D
                 d,
                 g.render_spp(),
                 Duration::from_secs_f64(g.render_seconds()),
+                g.main_function.as_deref(),
             ))
         })
         .collect()
@@ -64,11 +78,12 @@ pub(crate) fn render_groups(
     let ok: Vec<RenderJob> = wanted
         .iter()
         .filter_map(|w| w.as_ref().ok())
-        .map(|(scene, spp, limit)| RenderJob {
+        .map(|(scene, spp, limit, program)| RenderJob {
             scene,
             spp: *spp,
             seed,
             time_limit: *limit,
+            program: *program,
         })
         .collect();
     let mut done = if ok.is_empty() {
@@ -129,12 +144,78 @@ pub(crate) fn judge(
 }
 
 fn rendered_json(image: &RenderedImage) -> Value {
-    json!({
+    let mut made = json!({
         "spp": image.spp,
         "seconds": (image.seconds * 1000.0).round() / 1000.0,
         "width": image.width,
         "height": image.height,
+    });
+    match &image.made_by {
+        MadeBy::Description => made["made_by"] = json!("description"),
+        MadeBy::Program(program) => {
+            made["made_by"] = json!("main_function");
+            made["main_function"] = json!(program);
+        }
+        MadeBy::DescriptionInstead { program, why } => {
+            made["made_by"] = json!("description");
+            made["main_function"] = json!(program);
+            made["main_function_not_used"] = json!(why);
+        }
+    }
+    made
+}
+
+/// The course's jittered renders take floor(sqrt(spp))^2 samples and its film divides by spp;
+/// a film made by the submission that is brighter by exactly spp / floor(sqrt(spp))^2 divides by
+/// the samples taken. Says so, when the comparison's best explanation is that uniform scale.
+fn film_hint(g: &Group, render: &Value, metrics: &Value) -> Option<String> {
+    if render["made_by"].as_str() != Some("main_function") {
+        return None;
+    }
+    let spp = u32::try_from(render["spp"].as_u64()?).ok()?;
+    let scene = scene_description(&g.scene_source()?).ok()?;
+    if scene.render.sampling != crate::scene::PixelSampling::CourseJittered {
+        return None;
+    }
+    let taken = {
+        let m = (f64::from(spp).sqrt().floor()) as u32;
+        m * m
+    };
+    // "scale:1.25", or per channel "scale:1.25,1.25,1.33" (the clamp and the sky's blue).
+    let scales: Vec<f64> = metrics["diagnosis"]["best"]
+        .as_str()?
+        .strip_prefix("scale:")?
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .ok()?;
+    let expected = f64::from(spp) / f64::from(taken);
+    let mut sorted = scales.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let near = (median - expected).abs() <= 0.03 * expected
+        && scales
+            .iter()
+            .all(|k| (k - expected).abs() <= 0.08 * expected);
+    (taken != spp && near).then(|| {
+        format!(
+            " A film brighter by {spp}/{taken} is what dividing by the {taken} samples render_jittered takes gives, instead of by samples_per_pixel ({spp}) as the course's write_to_film does."
+        )
     })
+}
+
+/// What the message says was judged: the render, by which function or from what, at what spp.
+fn judged(render: &Value) -> String {
+    let timing = match (render["spp"].as_u64(), render["seconds"].as_f64()) {
+        (Some(spp), Some(s)) => format!(" ({spp} spp, {s:.1} s)"),
+        _ => String::new(),
+    };
+    match (render["made_by"].as_str(), render["main_function"].as_str()) {
+        (Some("main_function"), Some(f)) => {
+            format!("The image your main.py's {f}() made{timing}")
+        }
+        _ => format!("The render of your code{timing}"),
+    }
 }
 
 /// Rewrites the message of a render group's check to say what was judged (the render of the
@@ -145,10 +226,7 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
         return;
     };
     let render = &image.metrics["render"];
-    let what = match (render["spp"].as_u64(), render["seconds"].as_f64()) {
-        (Some(spp), Some(s)) => format!("The render of your code ({spp} spp, {s:.1} s)"),
-        _ => "The render of your code".to_string(),
-    };
+    let what = judged(render);
     let mut message = check.message.clone();
     for (from, to) in [
         (
@@ -183,5 +261,17 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
         },
     };
     message.push_str(&said);
+    if let Some(hint) = film_hint(g, render, &image.metrics) {
+        message.push_str(&hint);
+    }
+    if let (Some(f), Some(why)) = (
+        render["main_function"].as_str(),
+        render["main_function_not_used"].as_str(),
+    ) {
+        message.push_str(&format!(
+            " Your main.py's {f}() was not used ({}), so the grader rendered its own description of the scene with your classes.",
+            why.trim_end_matches('.')
+        ));
+    }
     check.message = message;
 }

@@ -29,6 +29,8 @@
 //!                                # code and judges that; "upload": the file is judged instead
 //! spp = 4                        # render: samples per pixel (default 4)
 //! render_seconds = 60            # render: wall time it may take (default 60), else not run
+//! main_function = "renderSphere" # render: optional, the submission's main.py function run to
+//!                                # render it (its own scene, renderer and film)
 //! points = 20
 //!
 //! [[group]]
@@ -217,6 +219,13 @@ pub struct Group {
     /// [`DEFAULT_RENDER_SECONDS`]); past it the group is not run, with the reason.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub render_seconds: Option<f64>,
+    /// For rendered image groups: the submission's own `main.py` function that renders the
+    /// scene (`renderMoving`). The grader runs it, through the submission's renderer and film,
+    /// and judges the film it saves; when it cannot (no such function, it raises, no picture),
+    /// the scene's description is rendered with the submission's classes and the report says
+    /// why.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub main_function: Option<String>,
 }
 
 /// Where an image group's judged image comes from.
@@ -663,9 +672,10 @@ impl Rubric {
             || g.source.is_some()
             || g.spp.is_some()
             || g.render_seconds.is_some()
+            || g.main_function.is_some()
         {
             return Err(self.invalid(format!(
-                "code group {:?} takes no file, scene, golden, source, spp or render_seconds",
+                "code group {:?} takes no file, scene, golden, source, spp, render_seconds or main_function",
                 g.id
             )));
         }
@@ -733,12 +743,23 @@ impl Rubric {
 
     fn validate_render_settings(&self, g: &Group) -> Result<(), RubricError> {
         if g.image_source() == ImageSource::Upload
-            && (g.spp.is_some() || g.render_seconds.is_some())
+            && (g.spp.is_some() || g.render_seconds.is_some() || g.main_function.is_some())
         {
             return Err(self.invalid(format!(
-                "image group {:?}: spp and render_seconds are for source = \"render\", not \"upload\"",
+                "image group {:?}: spp, render_seconds and main_function are for source = \"render\", not \"upload\"",
                 g.id
             )));
+        }
+        if let Some(f) = &g.main_function {
+            let identifier = f.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+                && f.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !identifier || f.len() > 100 {
+                return Err(self.invalid(format!(
+                    "image group {:?}: main_function = {:?}: it must be a Python function name",
+                    g.id,
+                    crate::escape::truncate(f, 100)
+                )));
+            }
         }
         if let Some(spp) = g.spp {
             if !(1..=MAX_RENDER_SPP).contains(&spp) {
@@ -868,7 +889,7 @@ mod tests {
             (
                 "points = 5",
                 "source = \"upload\"\nspp = 8\npoints = 5",
-                "spp and render_seconds are for source = \"render\"",
+                "main_function are for source = \"render\"",
             ),
             (
                 "points = 5",

@@ -57,32 +57,70 @@ pub fn week_render_spp(week: Week) -> u32 {
     }
 }
 
-/// The week's scenes with the file name the course's `main.py` writes each to.
-pub fn week_scenes(week: Week) -> &'static [(&'static str, &'static str)] {
+/// A scene of a week: the built-in scene, the file the course's `main.py` writes it to, and the
+/// `main.py` function that renders it, when the grader runs that function (its
+/// `main_function`).
+pub type WeekScene = (&'static str, &'static str, Option<&'static str>);
+
+/// The week's scenes ([`WeekScene`]).
+///
+/// Week 7's two scenes have no `main_function`: their `main.py` reads the course's pictures
+/// (`textures/earthmap.jpg`, ...) from the submission's folder, and the goldens are of pictures
+/// the project generates; so they are rendered from their description, with the generated
+/// pictures handed to the submission's `ImageTexture`.
+pub fn week_scenes(week: Week) -> &'static [WeekScene] {
     match week.number() {
         5 => &[
-            ("week05-quad", "week05_quad.png"),
-            ("week05-quad-light", "week05_quad_light1.png"),
-            ("week05-point-light", "week05_point_light.png"),
-            ("week05-point-light-shadow", "week05_point_light_shadow.png"),
+            ("week05-quad", "week05_quad.png", Some("renderQuad")),
+            (
+                "week05-quad-light",
+                "week05_quad_light1.png",
+                Some("renderQuadLight"),
+            ),
+            (
+                "week05-point-light",
+                "week05_point_light.png",
+                Some("renderPointLight"),
+            ),
+            (
+                "week05-point-light-shadow",
+                "week05_point_light_shadow.png",
+                Some("renderPointLightShadow"),
+            ),
         ],
         6 => &[
-            ("week06-mirror-point-light", "week06_point_light.png"),
-            ("week06-mirrors", "week06_glass_sky.png"),
-            ("week06-dielectric", "week06_dielec_sky.png"),
+            (
+                "week06-mirror-point-light",
+                "week06_point_light.png",
+                Some("renderMirrorPointLight"),
+            ),
+            (
+                "week06-mirrors",
+                "week06_glass_sky.png",
+                Some("renderMirrors"),
+            ),
+            (
+                "week06-dielectric",
+                "week06_dielec_sky.png",
+                Some("renderDielectric"),
+            ),
         ],
         7 => &[
-            ("week07-procedural-texture", "week07_texture_sky.png"),
-            ("week07-earth", "week07_texture_earth_sky.png"),
+            ("week07-procedural-texture", "week07_texture_sky.png", None),
+            ("week07-earth", "week07_texture_earth_sky.png", None),
         ],
         8 => &[
-            ("week08-phong", "week08_brdf_Phong.png"),
-            ("week08-blinn", "week08_brdf_Blinn.png"),
+            ("week08-phong", "week08_brdf_Phong.png", Some("renderPhong")),
+            ("week08-blinn", "week08_brdf_Blinn.png", Some("renderBlinn")),
         ],
-        9 => &[("week09-blinn", "week09_nojittered.png")],
+        9 => &[("week09-blinn", "week09_nojittered.png", Some("renderBlinn"))],
         _ => &[
-            ("week10-dof", "week10_jitter_DoF.png"),
-            ("week10-moving", "week10_moving_nojitter.png"),
+            ("week10-dof", "week10_jitter_DoF.png", Some("renderDoF")),
+            (
+                "week10-moving",
+                "week10_moving_nojitter.png",
+                Some("renderMoving"),
+            ),
         ],
     }
 }
@@ -164,18 +202,21 @@ fn week_rubric_toml(week: Week) -> String {
     let scenes = week_scenes(week);
     let scored = scenes
         .iter()
-        .filter(|(scene, _)| unscored_image(scene).is_none())
+        .filter(|(scene, _, _)| unscored_image(scene).is_none())
         .count();
     let each = IMAGE_POINTS / scored.max(1) as f64;
     let spp = week_render_spp(week);
-    for (scene, file) in scenes {
+    for (scene, file, function) in scenes {
         let why = unscored_image(scene);
         if let Some(why) = why {
             let _ = write!(t, "\n# No points: {why}.");
         }
+        let main = function.map_or_else(String::new, |f| {
+            format!("main_function = \"{f}\" # the submission's main.py renders it, through its own film\n")
+        });
         let _ = write!(
             t,
-            "\n[[group]]\nid = \"image.{scene}\"\nname = \"{scene} rendered from your code ({file})\"\nkind = \"image\"\nfile = \"{file}\"\nscene = \"{scene}\"\nsource = \"render\" # rendered by the grader from the submission's code\nspp = {spp}\nrender_seconds = {}\npoints = {}\nvisibility = \"visible\"\n",
+            "\n[[group]]\nid = \"image.{scene}\"\nname = \"{scene} rendered from your code ({file})\"\nkind = \"image\"\nfile = \"{file}\"\nscene = \"{scene}\"\nsource = \"render\" # rendered by the grader from the submission's code\n{main}spp = {spp}\nrender_seconds = {}\npoints = {}\nvisibility = \"visible\"\n",
             points(WEEK_RENDER_SECONDS),
             points(if why.is_some() { 0.0 } else { each })
         );

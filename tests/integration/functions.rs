@@ -157,7 +157,8 @@ fn catalogue(week: u8) -> Vec<(String, String)> {
 }
 
 /// Image-only mistakes: no function request can show them (they are in `main.py`'s scenes or
-/// the film), so the image groups judge them.
+/// the film), so the image groups judge them, rendered by the submission's own `main.py`
+/// (`grade_weeks::image_only_mistakes_cost_their_image_and_are_named`).
 const IMAGE_ONLY: &[&str] = &["motion_on_wrong_sphere", "film_divides_by_samples_taken"];
 
 /// Departures the catalogue marks as giving the solution's answers everywhere (Schlick's `r0`

@@ -125,11 +125,9 @@ fn graded_by_the_package(root: &Path, rubric: &str, submission: &Path) -> Value 
 /// Week `week`'s solution through the week's Gradescope package (100 of 100, every test
 /// passed), then its skeleton by `grade` (at most 5).
 ///
-/// The catalogue's two mistakes that only images show are not here, since the grader's renders
-/// cannot show them, by design: `motion_on_wrong_sphere` is in `main.py`'s scene, and the
-/// grader renders its own description of the scene with the submission's classes;
-/// `film_divides_by_samples_taken` is in the student's film (`Camera.write_to_film`), and the
-/// adapter averages each pixel's samples itself. Both show in an uploaded image.
+/// Every scene but week 7's is rendered by the solution's own `main.py` function (its
+/// `main_function`), and the package's feedback says so. The catalogue's two mistakes that only
+/// images show are graded in [`image_only_mistakes_cost_their_image_and_are_named`].
 fn week_is_graded_fairly(week: u8) {
     let Some(python) = python() else {
         return;
@@ -157,6 +155,20 @@ fn week_is_graded_fairly(week: u8) {
             "{rubric}: no test of {wanted}: {names:?}"
         );
     }
+    let by_main = tests
+        .iter()
+        .filter(|t| {
+            t["output"]
+                .as_str()
+                .unwrap_or_default()
+                .contains("main.py's render")
+        })
+        .count();
+    let wanted = if week == 7 { 0 } else { 1 };
+    assert!(
+        by_main >= wanted && (week != 7 || by_main == 0),
+        "{rubric}: {by_main} images made by main.py: {tests:#?}"
+    );
 
     let subs = root.path().join("subs");
     assemble(&subs.join("skeleton"), &[base.join("skeleton")]);
@@ -187,6 +199,157 @@ fn week_is_graded_fairly(week: u8) {
         score <= 5.0,
         "{rubric}: the skeleton scores {score}: {:#?}",
         checks(&skeleton)
+    );
+}
+
+/// A rubric of one image group of week `week`'s scene `scene`, rendered by `function` of the
+/// submission's `main.py` at 5 spp.
+fn one_image_rubric(dir: &Path, week: u8, scene: &str, function: &str) -> PathBuf {
+    let path = dir.join(format!("{scene}.toml"));
+    let text = format!(
+        "name = \"{scene}\"\nweek = {week}\nseed = 7\ncode_time_budget_seconds = 120\n\n\
+         [[group]]\nid = \"image.{scene}\"\nname = \"{scene}\"\nkind = \"image\"\n\
+         file = \"{scene}.png\"\nscene = \"{scene}\"\nmain_function = \"{function}\"\n\
+         spp = 5\nrender_seconds = 120\npoints = 30\n"
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Grades the batch `subs` with `rubric`; the image check of each submission.
+fn image_checks(root: &Path, subs: &Path, rubric: &Path, python: &Path) -> Vec<(String, Value)> {
+    let out = root.join(format!(
+        "out-{}",
+        rubric.file_stem().unwrap().to_string_lossy()
+    ));
+    let run = run_in(
+        root,
+        &[
+            "grade",
+            "--batch",
+            subs.to_str().unwrap(),
+            "--rubric",
+            rubric.to_str().unwrap(),
+            "--python",
+            python.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(subs).unwrap().flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let r = report(&out, &name);
+        let image = r["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["id"].as_str().unwrap().starts_with("image."))
+            .unwrap()
+            .clone();
+        found.push((name, image));
+    }
+    found.sort_by(|a, b| a.0.cmp(&b.0));
+    found
+}
+
+/// The catalogue's mistakes that only an image shows cost the image group when the grader runs
+/// the submission's own `main.py` function: `film_divides_by_samples_taken` (week 9's film
+/// divides by the floor(sqrt(spp))^2 samples taken, named by its brightness of spp / taken) and
+/// `motion_on_wrong_sphere` (week 10's `renderMoving` moves the centre sphere). A submission
+/// whose `main.py` is missing, or whose function raises, is rendered from the scene's
+/// description instead, with its own classes (full marks here), and the message says why.
+#[test]
+fn image_only_mistakes_cost_their_image_and_are_named() {
+    let Some(python) = python() else {
+        return;
+    };
+    let root = tempfile::tempdir().unwrap();
+    let w9 = weeks().join("week09");
+    let subs = root.path().join("subs9");
+    assemble(&subs.join("solution"), &[w9.join("solution")]);
+    assemble(
+        &subs.join("film"),
+        &[
+            w9.join("solution"),
+            w9.join("mistakes/film_divides_by_samples_taken"),
+        ],
+    );
+    assemble(&subs.join("no-main"), &[w9.join("solution")]);
+    std::fs::remove_file(subs.join("no-main/main.py")).unwrap();
+    assemble(&subs.join("raising-main"), &[w9.join("solution")]);
+    let main = subs.join("raising-main/main.py");
+    let text = std::fs::read_to_string(&main).unwrap();
+    let text = text.replace(
+        "def renderBlinn():\n",
+        "def renderBlinn():\n    raise RuntimeError('not today')\n",
+    );
+    assert!(text.contains("not today"));
+    std::fs::write(&main, text).unwrap();
+    let rubric = one_image_rubric(root.path(), 9, "week09-blinn", "renderBlinn");
+    let checks = image_checks(root.path(), &subs, &rubric, python);
+    let names: Vec<&str> = checks.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["film", "no-main", "raising-main", "solution"]);
+    let message = |c: &Value| c["message"].as_str().unwrap().to_string();
+    let (_, film) = &checks[0];
+    assert_eq!(film["score"].as_f64(), Some(0.0), "{film:#}");
+    assert!(
+        message(film).contains("dividing by the 4 samples render_jittered takes"),
+        "{film:#}"
+    );
+    for (name, c) in &checks[1..] {
+        assert_eq!(c["score"].as_f64(), Some(30.0), "{name}: {c:#}");
+        let render = &c["image"]["metrics"]["render"];
+        if name == "solution" {
+            assert_eq!(render["made_by"], "main_function", "{c:#}");
+            assert!(message(c).starts_with("The image your main.py's renderBlinn() made"));
+        } else {
+            assert_eq!(render["made_by"], "description", "{name}: {c:#}");
+            let why = if name == "no-main" {
+                "has no main.py"
+            } else {
+                "not today"
+            };
+            assert!(
+                render["main_function_not_used"]
+                    .as_str()
+                    .is_some_and(|w| w.contains(why)),
+                "{name}: {c:#}"
+            );
+            assert!(message(c).contains("was not used"), "{name}: {c:#}");
+        }
+    }
+
+    let w10 = weeks().join("week10");
+    let subs = root.path().join("subs10");
+    assemble(&subs.join("solution"), &[w10.join("solution")]);
+    assemble(
+        &subs.join("moving"),
+        &[
+            w10.join("solution"),
+            w10.join("mistakes/motion_on_wrong_sphere"),
+        ],
+    );
+    let rubric = one_image_rubric(root.path(), 10, "week10-moving", "renderMoving");
+    let checks = image_checks(root.path(), &subs, &rubric, python);
+    assert_eq!(checks[0].0, "moving");
+    assert_eq!(
+        checks[0].1["score"].as_f64(),
+        Some(0.0),
+        "{:#}",
+        checks[0].1
+    );
+    assert!(message(&checks[0].1).contains("differs"));
+    assert_eq!(
+        checks[1].1["score"].as_f64(),
+        Some(30.0),
+        "{:#}",
+        checks[1].1
     );
 }
 
