@@ -14,6 +14,11 @@
 //! one asked for, a pixel count that differs), a NaN or infinite value, an error, a death, or no
 //! answer within the time left of the job's limit ends the render with the reason, and memory is
 //! the image's own size (`3 * width * height` `f32`s) plus one answer line.
+//!
+//! When the job's program rendered the image, [`render_scene`] then asks for the tiles of one
+//! band of rows in [`CHECKED_BAND_PERIOD`] from the description ([`checked_tiles`]), with the same
+//! spp and seed and within the same time limit, and hands them back beside the film
+//! ([`RenderedImage::class_rows`]): the caller can tie the film to the candidate's own classes.
 
 use std::time::{Duration, Instant};
 
@@ -84,7 +89,28 @@ pub struct RenderedImage {
     pub film: Option<Vec<u8>>,
     /// How it was made.
     pub made_by: MadeBy,
+    /// For a program's film: some of its rows rendered again from the scene's description with
+    /// the candidate's own classes ([`ClassRows`]), so that the film can be tied to the
+    /// candidate's code. `None` for a render from the description.
+    pub class_rows: Option<ClassRows>,
 }
+
+/// Rows of a program's film rendered again from the scene's description by the candidate's
+/// own classes, at the same spp and seed. A program could save a picture it carries (a
+/// reference render, say) instead of rendering; these rows are what its classes compute, and a
+/// grader judges them too ([`checked_tiles`] says which rows).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClassRows {
+    /// The rows, top to bottom.
+    pub rows: Vec<usize>,
+    /// Their mean linear RGB, the rows stacked in that order (`rows.len() * width` pixels), or
+    /// why the classes did not render them (the render's [`RenderOutcome::reason`]).
+    pub rendered: Result<Vec<[f32; 3]>, String>,
+}
+
+/// One band of rows in this many is rendered again from the description after a program's
+/// film ([`checked_tiles`]): about a sixth of the image, so a sixth of the render's time.
+pub const CHECKED_BAND_PERIOD: usize = 6;
 
 /// How a render ended.
 #[derive(Clone, Debug, PartialEq)]
@@ -156,6 +182,28 @@ pub fn tiles(width: usize, height: usize) -> Vec<[usize; 4]> {
         }
     }
     out
+}
+
+/// The tiles of a `width` x `height` image that are rendered again from the description after a
+/// program's film, and the rows they cover (top to bottom): of the bands of rows [`tiles`] makes
+/// (its whole-row tiles, or single rows when a row takes several tiles), one in
+/// [`CHECKED_BAND_PERIOD`], starting at the band `seed % CHECKED_BAND_PERIOD`, so which rows are
+/// checked depends on the grader's seed. An image with fewer bands than that starts at band 0.
+pub fn checked_tiles(width: usize, height: usize, seed: u64) -> (Vec<[usize; 4]>, Vec<usize>) {
+    let all = tiles(width, height);
+    let band_rows = all.first().map_or(1, |t| t[3] - t[1]);
+    let bands = height.div_ceil(band_rows.max(1));
+    let mut start = (seed % CHECKED_BAND_PERIOD as u64) as usize;
+    if start >= bands {
+        start = 0;
+    }
+    let chosen: Vec<[usize; 4]> = all
+        .into_iter()
+        .filter(|t| (t[1] / band_rows.max(1)) % CHECKED_BAND_PERIOD == start)
+        .collect();
+    let mut rows: Vec<usize> = chosen.iter().flat_map(|t| t[1]..t[3]).collect();
+    rows.dedup();
+    (chosen, rows)
 }
 
 /// The scene as sent: each image texture carries its picture as `png_hex`, the hex of a PNG
@@ -361,18 +409,19 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
     }
     let start = Instant::now();
     let Some(program) = job.program else {
-        return render_tiles(session, job, start, None);
+        return render_tiles(session, job, start, None, None);
     };
     let why = if session.hello().answers("render_program") {
-        match render_tiles(session, job, start, Some(program)) {
-            done @ (RenderOutcome::Rendered(_) | RenderOutcome::TimedOut { .. }) => return done,
+        match render_tiles(session, job, start, Some(program), None) {
+            RenderOutcome::Rendered(image) => return with_class_rows(session, job, start, image),
+            done @ RenderOutcome::TimedOut { .. } => return done,
             failed => failed.reason().unwrap_or_default(),
         }
     } else {
         "the candidate does not run its own program (its hello does not list \"render_program\")"
             .to_string()
     };
-    match render_tiles(session, job, start, None) {
+    match render_tiles(session, job, start, None, None) {
         RenderOutcome::Rendered(mut image) => {
             image.made_by = MadeBy::DescriptionInstead {
                 program: program.to_string(),
@@ -384,13 +433,37 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
     }
 }
 
-/// Renders `job` from its description, or by `program` (its film), every tile within the job's
-/// time limit counted from `start`.
+/// Renders again from the description, with the candidate's classes, the rows of a program's
+/// film that [`checked_tiles`] picks, within the time left of the job's limit, and keeps them in
+/// the image's [`class_rows`](RenderedImage::class_rows).
+fn with_class_rows(
+    session: &mut Session,
+    job: &RenderJob,
+    start: Instant,
+    mut image: RenderedImage,
+) -> RenderOutcome {
+    let (width, height) = (image.width, image.height);
+    let (tiles, rows) = checked_tiles(width, height, job.seed);
+    let rendered = match render_tiles(session, job, start, None, Some(&tiles)) {
+        RenderOutcome::Rendered(sample) => Ok(rows
+            .iter()
+            .flat_map(|&y| sample.data[y * width..(y + 1) * width].iter().copied())
+            .collect()),
+        other => Err(other.reason().unwrap_or_default()),
+    };
+    image.class_rows = Some(ClassRows { rows, rendered });
+    RenderOutcome::Rendered(image)
+}
+
+/// Renders `job` from its description, or by `program` (its film), every tile (or the tiles
+/// of `only`, the rest of the image left black) within the job's time limit counted from
+/// `start`.
 fn render_tiles(
     session: &mut Session,
     job: &RenderJob,
     start: Instant,
     program: Option<&str>,
+    only: Option<&[[usize; 4]]>,
 ) -> RenderOutcome {
     let camera = job.scene.camera(None);
     let (width, height) = (camera.width, camera.height);
@@ -407,7 +480,8 @@ fn render_tiles(
     let mut data = vec![[0f32; 3]; width * height];
     let mut film = program.map(|_| vec![0u8; 3 * width * height]);
     let mut rows_done = 0;
-    for (k, tile) in tiles(width, height).into_iter().enumerate() {
+    let plan = only.map_or_else(|| tiles(width, height), <[_]>::to_vec);
+    for (k, tile) in plan.into_iter().enumerate() {
         let left = deadline.saturating_duration_since(Instant::now());
         let timed_out = RenderOutcome::TimedOut {
             limit: job.time_limit,
@@ -453,6 +527,7 @@ fn render_tiles(
         data,
         made_by: program.map_or(MadeBy::Description, |p| MadeBy::Program(p.to_string())),
         film,
+        class_rows: None,
     })
 }
 
@@ -476,6 +551,34 @@ mod tests {
             assert!(seen.iter().all(|&n| n == 1), "{w}x{h}");
         }
         assert!(tiles(0, 5).is_empty());
+    }
+
+    #[test]
+    fn checked_rows_are_one_band_in_the_period_chosen_by_the_seed() {
+        for (w, h) in [(320, 180), (400, 400), (5000, 3), (7, 1000), (1, 1)] {
+            let band = tiles(w, h)[0][3] - tiles(w, h)[0][1];
+            let mut covered = vec![0usize; h];
+            for seed in 0..CHECKED_BAND_PERIOD as u64 {
+                let (chosen, rows) = checked_tiles(w, h, seed);
+                assert!(!rows.is_empty(), "{w}x{h} seed {seed}");
+                // Whole rows: every pixel of a chosen row is in exactly one chosen tile.
+                let pixels: usize = chosen.iter().map(|t| (t[2] - t[0]) * (t[3] - t[1])).sum();
+                assert_eq!(pixels, rows.len() * w, "{w}x{h} seed {seed}");
+                assert!(rows.windows(2).all(|r| r[0] < r[1]));
+                // About one row in the period, never more than a band over it.
+                assert!(
+                    rows.len() <= h.div_ceil(CHECKED_BAND_PERIOD) + band,
+                    "{w}x{h}"
+                );
+                for &r in &rows {
+                    covered[r] += 1;
+                }
+            }
+            // Over the period's seeds every row is checked (when the image has that many bands).
+            if h.div_ceil(band) >= CHECKED_BAND_PERIOD {
+                assert!(covered.iter().all(|&n| n == 1), "{w}x{h}: {covered:?}");
+            }
+        }
     }
 
     /// The answer of a pixel at the worst length the course adapter writes (`repr` of a float
@@ -516,5 +619,39 @@ mod tests {
         let huge = json!({"tile": [0, 0, 1, 1], "rgb": [0, 1e300, 0]});
         let e = read_tile(&huge, [0, 0, 1, 1], (2, 2), &mut data).unwrap_err();
         assert!(e.contains("finite"), "{e}");
+    }
+
+    #[test]
+    fn film_answers_hold_8_bit_codes_and_decode_as_the_course_film_encodes() {
+        let mut data = vec![[0f32; 3]; 4];
+        let mut film = vec![0u8; 12];
+        let ok = json!({"tile": [0, 1, 2, 2], "size": [2, 2], "film": [0, 128, 255, 1, 2, 3]});
+        read_film_tile(&ok, [0, 1, 2, 2], (2, 2), &mut data, &mut film).unwrap();
+        assert_eq!(&film[6..], &[0, 128, 255, 1, 2, 3]);
+        assert_eq!(&film[..6], &[0; 6], "rows outside the tile stay untouched");
+        // Gamma 2 over 255 codes: a code stands for the middle of its interval, squared.
+        let middle = |code: f64| (((code + 0.5) / 255.0) * ((code + 0.5) / 255.0)) as f32;
+        assert_eq!(data[2], [middle(0.0), middle(128.0), 1.0]);
+        assert_eq!(data[3], [middle(1.0), middle(2.0), middle(3.0)]);
+        let refused = [
+            (json!([0, 256, 0]), "pixel (0, 0) is not an 8-bit code: 256"),
+            (json!([0, 0, -1]), "pixel (0, 0) is not an 8-bit code: -1"),
+            (json!([1.5, 0, 0]), "pixel (0, 0) is not an 8-bit code: 1.5"),
+            (json!(["7", 0, 0]), "is not an 8-bit code"),
+            (json!([0, 0]), "has 2 codes, not 3 x 1"),
+            (json!([0, 0, 0, 0]), "has 4 codes, not 3 x 1"),
+        ];
+        for (codes, said) in refused {
+            let answer = json!({"tile": [0, 0, 1, 1], "film": codes});
+            let e =
+                read_film_tile(&answer, [0, 0, 1, 1], (2, 2), &mut data, &mut film).unwrap_err();
+            assert!(e.contains(said), "{codes}: {e}");
+        }
+        let linear = json!({"tile": [0, 0, 1, 1], "rgb": [0, 0, 0]});
+        let e = read_film_tile(&linear, [0, 0, 1, 1], (2, 2), &mut data, &mut film).unwrap_err();
+        assert!(e.contains("has no \"film\" list"), "{e}");
+        let sized = json!({"tile": [0, 0, 1, 1], "size": [3, 2], "film": [0, 0, 0]});
+        let e = read_film_tile(&sized, [0, 0, 1, 1], (2, 2), &mut data, &mut film).unwrap_err();
+        assert!(e.contains("but the scene is 2x2"), "{e}");
     }
 }

@@ -1,4 +1,4 @@
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -63,8 +63,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if let Some(name) = args.print_rubric.as_deref().filter(|n| !n.is_empty()) {
         let Some(text) = rtoracle::grade::week_rubrics::builtin_rubric_toml(name) else {
+            // `grade --print-rubric SUBMISSION` reads the folder as the rubric's name.
+            let folder = if Path::new(name).is_dir() {
+                "; it is a folder: to print the rubric in use, write --print-rubric= or put \
+                 --print-rubric last"
+            } else {
+                ""
+            };
             anyhow::bail!(
-                "--print-rubric {}: not a built-in rubric (known: {})",
+                "--print-rubric {}: not a built-in rubric (known: {}){folder}",
                 terminal_line(name),
                 rtoracle::grade::week_rubrics::BUILTIN_RUBRICS.join(", ")
             );

@@ -103,6 +103,40 @@ impl Golden {
         self
     }
 
+    /// The golden of some of its rows only, stacked top to bottom in the order given: the
+    /// golden a render of just those rows is judged against. Each pixel keeps its mean, variance
+    /// and sample bound from the whole image (its neighbours in the scene, not in the stack);
+    /// the field of view is dropped, since a stack of rows is not a camera's image. `Err` when a
+    /// row is outside the image or none is given.
+    pub fn rows(&self, rows: &[usize]) -> Result<Golden, CompareError> {
+        if rows.is_empty() {
+            return Err(CompareError::Golden(
+                "no rows of the golden asked for".into(),
+            ));
+        }
+        if let Some(&y) = rows.iter().find(|&&y| y >= self.height) {
+            return Err(CompareError::Golden(format!(
+                "row {y} is outside the {}x{} golden",
+                self.width, self.height
+            )));
+        }
+        let pick = |v: &[[f64; 3]]| -> Vec<[f64; 3]> {
+            rows.iter()
+                .flat_map(|&y| v[y * self.width..(y + 1) * self.width].iter().copied())
+                .collect()
+        };
+        Ok(Golden {
+            width: self.width,
+            height: rows.len(),
+            samples_per_pixel: self.samples_per_pixel,
+            mean: pick(&self.mean),
+            variance: pick(&self.variance),
+            scene: self.scene.clone(),
+            vfov: None,
+            bound: pick(&self.bound),
+        })
+    }
+
     fn neighbourhood_bound(&self) -> Vec<[f64; 3]> {
         let (w, h) = (self.width as isize, self.height as isize);
         let sd: Vec<[f64; 3]> = self.variance.iter().map(|v| v.map(f64::sqrt)).collect();
@@ -274,6 +308,30 @@ mod tests {
         assert!((g.bound[0][0] - 0.85).abs() < 1e-12);
         // Green: own spread 3 * 0.1 = 0.3 beats |0.1 - 0.5| = 0.4? No: 0.4 wins.
         assert!((g.bound[0][1] - 0.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_golden_of_rows_keeps_each_pixel_as_the_whole_image_has_it() {
+        // Three rows of one pixel: 0.1, 0.5, 0.9, with variances 0.01, 0.04, 0.09.
+        let g = Golden::new(
+            1,
+            3,
+            16,
+            vec![[0.1; 3], [0.5; 3], [0.9; 3]],
+            vec![[0.01; 3], [0.04; 3], [0.09; 3]],
+            None,
+        )
+        .unwrap();
+        let r = g.rows(&[2, 0]).unwrap();
+        assert_eq!((r.width, r.height), (1, 2));
+        assert_eq!(r.mean, vec![[0.9; 3], [0.1; 3]]);
+        assert_eq!(r.variance, vec![[0.09; 3], [0.01; 3]]);
+        // Row 0's bound is its neighbour's (row 1): |0.5 - 0.1| + 3 * 0.2 = 1.0 (at most 1),
+        // not what rows 2 and 0 stacked side by side would give.
+        assert_eq!(r.bound[1], g.bound[0]);
+        assert_eq!(r.bound[0], g.bound[2]);
+        assert!(g.rows(&[3]).is_err());
+        assert!(g.rows(&[]).is_err());
     }
 
     #[test]

@@ -82,6 +82,7 @@ impl CodeChecker for FakeCode {
                     data: vec![[0.5; 3]; camera.width * camera.height],
                     film: None,
                     made_by: Default::default(),
+                    class_rows: None,
                 })
             })
             .collect()

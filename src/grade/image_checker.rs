@@ -176,6 +176,19 @@ impl CompareImageChecker {
                 return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
             }
         };
+        self.judge_against(candidate, &golden, spp, name, Some(heatmap_out))
+    }
+
+    /// Compares `candidate` (named `name`), a render of `spp` samples per pixel, with `golden`,
+    /// writing the heatmap to `heatmap_out` when one is given.
+    fn judge_against(
+        &self,
+        candidate: &CandidateImage,
+        golden: &Golden,
+        spp: u32,
+        name: &str,
+        heatmap_out: Option<&Path>,
+    ) -> ImageOutcome {
         let (w, h) = candidate.size();
         if (w, h) != (golden.width, golden.height) {
             return ImageOutcome::unusable(format!(
@@ -187,13 +200,15 @@ impl CompareImageChecker {
             samples_per_pixel: spp,
             ..self.options
         };
-        let comparison = match compare_image(candidate, &golden, &options) {
+        let comparison = match compare_image(candidate, golden, &options) {
             Ok(c) => c,
             Err(e) => return ImageOutcome::unusable(format!("{name}: {e}")),
         };
-        let heatmap = write_heatmap(heatmap_out, &comparison)
-            .ok()
-            .map(|_| heatmap_out.to_path_buf());
+        let heatmap = heatmap_out.and_then(|out| {
+            write_heatmap(out, &comparison)
+                .ok()
+                .map(|_| out.to_path_buf())
+        });
         let mut diagnosis = comparison.diagnosis.as_ref().map(|d| {
             let mut s = d.summary.clone();
             if let Some(r) = comparison.regions.first() {
@@ -318,6 +333,40 @@ impl ImageChecker for CompareImageChecker {
             },
         };
         self.judge(&candidate, scene, render.spp, "the render", heatmap_out)
+    }
+
+    fn check_rows(
+        &self,
+        scene: &SceneSource,
+        spp: u32,
+        width: usize,
+        rows: &[usize],
+        data: &[[f32; 3]],
+    ) -> ImageOutcome {
+        let golden = match self
+            .render_golden(scene, spp)
+            .map_err(|e| e.to_string())
+            .and_then(|(g, _)| {
+                if g.width == width {
+                    g.rows(rows).map_err(|e| e.to_string())
+                } else {
+                    Err(format!(
+                        "the rows are {width} pixels wide, the golden {}",
+                        g.width
+                    ))
+                }
+            }) {
+            Ok(g) => g,
+            Err(e) => {
+                return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
+            }
+        };
+        let candidate = CandidateImage::Linear {
+            width,
+            height: rows.len(),
+            data: data.to_vec(),
+        };
+        self.judge_against(&candidate, &golden, spp, "the rows", None)
     }
 
     fn check_scene(

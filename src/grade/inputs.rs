@@ -134,6 +134,22 @@ pub trait ImageChecker: Sync {
     ) -> ImageOutcome {
         judge_as_png(render, |png| self.check_scene(png, scene, heatmap_out))
     }
+
+    /// Judges some rows of a render of `scene` at `spp` samples per pixel (`data`: the rows
+    /// stacked top to bottom, `width` pixels each, linear RGB) against the same rows of the
+    /// golden [`check_render`](Self::check_render) would use. The default cannot judge rows
+    /// and says so ([`ImageVerdict::Unusable`]).
+    fn check_rows(
+        &self,
+        scene: &SceneSource,
+        spp: u32,
+        width: usize,
+        rows: &[usize],
+        data: &[[f32; 3]],
+    ) -> ImageOutcome {
+        let _ = (scene, spp, width, rows, data);
+        ImageOutcome::unusable(format!("{} cannot judge rows of a render", self.describe()))
+    }
 }
 
 /// Counts of one shape kind's vectors.

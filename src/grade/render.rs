@@ -17,11 +17,21 @@
 //! another size), the group falls back to the description, within the same time limit, and
 //! says why.
 //!
+//! A film the program saves could be any picture the submission carries (the reference's own
+//! render, a classmate's). So after a program's film, the submission's own classes render again,
+//! from the grader's description of the scene, a band of about one row in
+//! [`crate::candidate::render::CHECKED_BAND_PERIOD`] (which band follows the seed), and the film
+//! earns its points only if those rows match the reference's same rows too: a correct picture
+//! over classes that compute something else scores 0, and says so. Classes that cannot render
+//! the rows make the group unusable, with the reason.
+//!
 //! What this module promises the reports: the outcome's `metrics` hold the comparison of the
 //! render (as an uploaded image's would) plus `source` (`"render"`), `render` (`spp`,
 //! `seconds`, `width`, `height`, `made_by` (`"main_function"` or `"description"`), the group's
 //! `main_function` and, when it was not used, `main_function_not_used` with the reason; or
-//! `not_run` with the reason) and `upload` (the uploaded
+//! `not_run` with the reason; after a program's film, `class_rows` with the `rows` rendered
+//! again by the classes, their `verdict`, its `diagnosis`, and whether the film alone matched,
+//! `film_matches`) and `upload` (the uploaded
 //! image's verdict, or why there is none); the check's message starts with what was judged
 //! ("The render of your code (4 spp, 7.1 s) ...") and ends with a sentence on the upload.
 
@@ -30,10 +40,10 @@ use std::time::Duration;
 
 use serde_json::{Value, json};
 
-use super::inputs::{ImageChecker, ImageOutcome};
-use super::result::CheckResult;
+use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict};
+use super::result::{CheckResult, CheckStatus};
 use super::rubric::{Group, SceneSource};
-use crate::candidate::render::{MadeBy, RenderJob, RenderOutcome, RenderedImage};
+use crate::candidate::render::{ClassRows, MadeBy, RenderJob, RenderOutcome, RenderedImage};
 use crate::scene::SceneDescription;
 
 /// The scene description an image group renders: the built-in's or the rubric's scene file.
@@ -122,7 +132,12 @@ pub(crate) fn judge(
         RenderOutcome::Rendered(image) => {
             let scene = g.scene_source().expect("validated");
             let outcome = images.check_render(image, &scene, heatmap_out);
-            (outcome, rendered_json(image))
+            let mut made = rendered_json(image);
+            let outcome = match &image.class_rows {
+                Some(rows) => tie_to_classes(outcome, image, rows, &scene, images, &mut made),
+                None => outcome,
+            };
+            (outcome, made)
         }
         failed => {
             let why = failed.reason().unwrap_or_default();
@@ -141,6 +156,60 @@ pub(crate) fn judge(
     metrics.insert("upload".into(), upload_json);
     outcome.metrics = Value::Object(metrics);
     outcome
+}
+
+/// A program's film earns its points only when the submission's classes, rendering some of its
+/// rows again from the scene's description ([`ClassRows`]), match the reference there too: a
+/// `main.py` that saves a picture it carries, not one its code computes, fails here. Records
+/// the rows' verdict in `made["class_rows"]`; a film that already fails is left as it is.
+fn tie_to_classes(
+    film: ImageOutcome,
+    image: &RenderedImage,
+    rows: &ClassRows,
+    scene: &SceneSource,
+    images: &dyn ImageChecker,
+    made: &mut Value,
+) -> ImageOutcome {
+    let judged = match &rows.rendered {
+        Ok(data) => images.check_rows(scene, image.spp, image.width, &rows.rows, data),
+        Err(why) => ImageOutcome::unusable(why.clone()),
+    };
+    let what = format!(
+        "{} of its {} rows rendered again from the grader's description of the scene with your classes",
+        rows.rows.len(),
+        image.height
+    );
+    made["class_rows"] = json!({
+        "rows": rows.rows.len(),
+        "verdict": &judged.verdict,
+        "diagnosis": &judged.diagnosis,
+        "film_matches": film.verdict == ImageVerdict::Pass,
+    });
+    if film.verdict != ImageVerdict::Pass {
+        return film;
+    }
+    let tail = "an image earns its points only when it is what your code computes";
+    match judged.verdict {
+        ImageVerdict::Pass => film,
+        ImageVerdict::Fail => ImageOutcome {
+            verdict: ImageVerdict::Fail,
+            diagnosis: Some(format!(
+                "{what} differ from the reference{}: {tail}",
+                judged
+                    .diagnosis
+                    .as_deref()
+                    .map_or(String::new(), |d| format!(" ({})", d.trim_end_matches('.')))
+            )),
+            ..film
+        },
+        ImageVerdict::Unusable(why) => ImageOutcome {
+            verdict: ImageVerdict::Unusable(format!(
+                "your classes could not render the scene to tie the image to your code ({what}: {}); {tail}",
+                why.trim_end_matches('.')
+            )),
+            ..film
+        },
+    }
 }
 
 fn rendered_json(image: &RenderedImage) -> Value {
@@ -239,6 +308,14 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
         if let Some(rest) = message.strip_prefix(&from) {
             message = format!("{to}{rest}");
             break;
+        }
+    }
+    // A film that matches but is not what the classes compute: say that it matched.
+    if render["class_rows"]["film_matches"] == true && check.status != CheckStatus::Passed {
+        if let Some(d) = image.diagnosis.as_deref() {
+            if message.starts_with(&format!("{what} differs")) {
+                message = format!("{what} matches the reference, but it scores 0: {d}.");
+            }
         }
     }
     let upload = &image.metrics["upload"];

@@ -263,7 +263,9 @@ fn image_checks(root: &Path, subs: &Path, rubric: &Path, python: &Path) -> Vec<(
 /// divides by the floor(sqrt(spp))^2 samples taken, named by its brightness of spp / taken) and
 /// `motion_on_wrong_sphere` (week 10's `renderMoving` moves the centre sphere). A submission
 /// whose `main.py` is missing, or whose function raises, is rendered from the scene's
-/// description instead, with its own classes (full marks here), and the message says why.
+/// description instead, with its own classes (full marks here), and the message says why. A
+/// `main.py` that saves a picture it carries (the reference's render at another seed) over
+/// classes that are wrong scores 0: the rows its classes render again do not match.
 #[test]
 fn image_only_mistakes_cost_their_image_and_are_named() {
     let Some(python) = python() else {
@@ -291,11 +293,82 @@ fn image_only_mistakes_cost_their_image_and_are_named() {
     );
     assert!(text.contains("not today"));
     std::fs::write(&main, text).unwrap();
+    // A main.py that saves a picture it carries (the reference's own render at another seed, as
+    // good as an honest film) over classes that render the scene wrongly.
+    let carried = subs.join("carried");
+    assemble(
+        &carried,
+        &[
+            w9.join("solution"),
+            w9.join("mistakes/lobe_around_wrong_axis"),
+        ],
+    );
+    // At 5 spp the course's jittered film is 4 samples over 5: the scene as a program of 5 spp
+    // sets it (`render NAME --spp` keeps the scene's own 30 and estimates its pixel).
+    let dumped = run_in(root.path(), &["scenes", "--dump", "week09-blinn"]);
+    assert!(dumped.status.success());
+    let toml = String::from_utf8(dumped.stdout)
+        .unwrap()
+        .replace("samples_per_pixel = 30\n", "samples_per_pixel = 5\n");
+    assert!(toml.contains("samples_per_pixel = 5\n"));
+    let scene_file = root.path().join("week09-blinn-5spp.toml");
+    std::fs::write(&scene_file, toml).unwrap();
+    let made = run_in(
+        root.path(),
+        &[
+            "render",
+            scene_file.to_str().unwrap(),
+            "--spp",
+            "5",
+            "--seed",
+            "99",
+            "-o",
+            carried.join("carried.png").to_str().unwrap(),
+        ],
+    );
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    // The picture travels inside the code, as a submission's own files would carry it.
+    let png = std::fs::read(carried.join("carried.png")).unwrap();
+    std::fs::remove_file(carried.join("carried.png")).unwrap();
+    let hex: String = png.iter().map(|b| format!("{b:02x}")).collect();
+    let main = carried.join("main.py");
+    let text = std::fs::read_to_string(&main).unwrap().replace(
+        "def renderBlinn():\n",
+        &format!(
+            "CARRIED = '{hex}'\n\ndef renderBlinn():\n    import io\n    from PIL import Image\n    \
+             Image.open(io.BytesIO(bytes.fromhex(CARRIED))).save('week09_nojittered.png')\n    return\n"
+        ),
+    );
+    assert!(text.contains("CARRIED"));
+    std::fs::write(&main, text).unwrap();
     let rubric = one_image_rubric(root.path(), 9, "week09-blinn", "renderBlinn");
     let checks = image_checks(root.path(), &subs, &rubric, python);
     let names: Vec<&str> = checks.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(names, ["film", "no-main", "raising-main", "solution"]);
+    assert_eq!(
+        names,
+        ["carried", "film", "no-main", "raising-main", "solution"]
+    );
     let message = |c: &Value| c["message"].as_str().unwrap().to_string();
+    let (_, carried) = &checks[0];
+    assert_eq!(carried["score"].as_f64(), Some(0.0), "{carried:#}");
+    let render = &carried["image"]["metrics"]["render"];
+    assert_eq!(render["made_by"], "main_function", "{carried:#}");
+    // The carried picture itself passes: only the classes' rows tell it from an honest film.
+    assert_eq!(render["class_rows"]["film_matches"], true, "{carried:#}");
+    assert_eq!(
+        render["class_rows"]["verdict"]["verdict"], "fail",
+        "{carried:#}"
+    );
+    assert!(
+        message(carried).contains("matches the reference, but it scores 0")
+            && message(carried).contains("rendered again from the grader's description"),
+        "{carried:#}"
+    );
+    let checks = &checks[1..];
     let (_, film) = &checks[0];
     assert_eq!(film["score"].as_f64(), Some(0.0), "{film:#}");
     assert!(
@@ -307,6 +380,7 @@ fn image_only_mistakes_cost_their_image_and_are_named() {
         let render = &c["image"]["metrics"]["render"];
         if name == "solution" {
             assert_eq!(render["made_by"], "main_function", "{c:#}");
+            assert_eq!(render["class_rows"]["verdict"]["verdict"], "pass", "{c:#}");
             assert!(message(c).starts_with("The image your main.py's renderBlinn() made"));
         } else {
             assert_eq!(render["made_by"], "description", "{name}: {c:#}");
@@ -407,6 +481,34 @@ fn built_in_rubrics_print_and_read_back() {
         stderr.contains("week11") && stderr.contains("week10"),
         "{stderr}"
     );
+    // A submission folder right after the flag is taken as the rubric's name: said, with the way
+    // to print the rubric in use, which both other spellings do.
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let out = run_in(dir.path(), &["grade", "--print-rubric", "sub"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("--print-rubric sub: not a built-in rubric")
+            && stderr.contains("it is a folder"),
+        "{stderr}"
+    );
+    for args in [
+        &["grade", "--print-rubric=", "sub"][..],
+        &["grade", "sub", "--print-rubric"][..],
+    ] {
+        let out = run_in(dir.path(), args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(
+            String::from_utf8_lossy(&out.stdout),
+            rtoracle::grade::rubric::WEEK04_RUBRIC,
+            "{args:?}"
+        );
+    }
     let out = run_in(dir.path(), &["grade", "--rubric", "week11", "x"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
