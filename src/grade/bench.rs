@@ -1,6 +1,8 @@
 //! The fixture submissions of this repository, made into real submissions, and the grading
 //! benchmark (`cargo bench --bench grade`, `rtoracle bench grade`): one submission, and a batch
-//! of 30 on 2 threads, against a baseline measured in the same run (starting Python once); and a
+//! of 30 on 2 threads, against a baseline measured in the same run (starting Python once), and
+//! that batch and the rendered submission again unsandboxed (same limits and watchdog) for the
+//! sandbox's share; and a
 //! batch of 10 triangle submissions against the 160x160 scene file of
 //! `examples/rubrics/triangles.toml` with a cold golden cache, against the same batch with the
 //! built-in `triangles` scene (embedded golden) in the same run: the golden is rendered once
@@ -186,7 +188,31 @@ pub fn run() -> String {
 
     // The grader's renders measured on their own (one submission, one core); the other figures
     // judge the uploaded images, as they did before renders, so they stay comparable.
-    let rendered = rendered_one(&honest, work.path());
+    let sandboxed = CourseCodeChecker::default();
+    let isolation = crate::sandbox::isolation_for(&sandboxed.policy)
+        .map_or_else(|e| format!("no sandbox: {e}"), |i| i.name().to_string());
+    // The sandbox's share: the same work with the same limits and watchdog, no isolation.
+    let unsandboxed = CourseCodeChecker {
+        policy: crate::sandbox::SandboxPolicy {
+            unsandboxed: true,
+            ..sandboxed.policy.clone()
+        },
+        ..CourseCodeChecker::default()
+    };
+    let rendered = rendered_one(&honest, work.path(), &sandboxed, "rendered");
+    // One run of a Python render varies by a tenth or more: three of each kind, taking turns
+    // (the first sandboxed run is the one shown above), medians compared.
+    let mut with_sandbox = vec![rendered.total];
+    let mut without = Vec::new();
+    for k in 0..3 {
+        let out = format!("rendered-unsandboxed-{k}");
+        without.push(rendered_one(&honest, work.path(), &unsandboxed, &out).total);
+        if k < 2 {
+            let out = format!("rendered-{k}");
+            with_sandbox.push(rendered_one(&honest, work.path(), &sandboxed, &out).total);
+        }
+    }
+    let (rendered_sandboxed, rendered_bare) = (median(with_sandbox), median(without));
     let rubric = Rubric::week04_uploads();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
@@ -205,20 +231,24 @@ pub fn run() -> String {
         .expect("grading works");
         secs(t.elapsed())
     });
-    let batch_time = pool.install(|| {
-        let t = Instant::now();
-        let entries = batch::grade_batch(
-            &subs,
-            &rubric,
-            &CourseCodeChecker::default(),
-            &CompareImageChecker::default(),
-            &work.path().join("batch"),
-            &Format::ALL,
-        )
-        .expect("batch grading works");
-        assert_eq!(entries.len(), 30);
-        secs(t.elapsed())
-    });
+    let batch_of_30 = |code: &CourseCodeChecker, out: &str| {
+        pool.install(|| {
+            let t = Instant::now();
+            let entries = batch::grade_batch(
+                &subs,
+                &rubric,
+                code,
+                &CompareImageChecker::default(),
+                &work.path().join(out),
+                &Format::ALL,
+            )
+            .expect("batch grading works");
+            assert_eq!(entries.len(), 30);
+            secs(t.elapsed())
+        })
+    };
+    let batch_time = batch_of_30(&sandboxed, "batch");
+    let unsandboxed_time = batch_of_30(&unsandboxed, "batch-unsandboxed");
     let (builtin, scene_file) = pool.install(|| scene_file_batches(work.path()));
     let mut report = String::new();
     report.push_str(&format!(
@@ -250,10 +280,22 @@ pub fn run() -> String {
         report.push('\n');
     }
     report.push_str(&format!(
+        "    the same, unsandboxed                 {:8.3} s  : the sandbox ({isolation}) costs {:+.1}%  (medians of 3 runs each, {rendered_sandboxed:.3} s sandboxed)",
+        rendered_bare,
+        100.0 * (rendered_sandboxed / rendered_bare - 1.0)
+    ));
+    report.push('\n');
+    report.push_str(&format!(
         "  batch of 30 (all fixtures, 2 threads)   {:8.3} s  = {:6.1} x baseline, {:.3} s per submission  (target < 180 s)",
         batch_time,
         batch_time / baseline,
         batch_time / 30.0
+    ));
+    report.push('\n');
+    report.push_str(&format!(
+        "    the same batch, unsandboxed           {:8.3} s  : the sandbox ({isolation}) costs {:+.1}%",
+        unsandboxed_time,
+        100.0 * (batch_time / unsandboxed_time - 1.0)
     ));
     report.push('\n');
     report.push_str(&week08_one(work.path()).lines(baseline));
@@ -281,7 +323,7 @@ struct Rendered {
 
 /// Grades `submission` with the built-in week-4 rubric (which renders both scenes from its
 /// code) on one thread, and reads each render's spp and time from its report.
-fn rendered_one(submission: &Path, work: &Path) -> Rendered {
+fn rendered_one(submission: &Path, work: &Path, code: &CourseCodeChecker, out: &str) -> Rendered {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -291,9 +333,9 @@ fn rendered_one(submission: &Path, work: &Path) -> Rendered {
         let report = grade_to_dir(
             submission,
             &Rubric::week04(),
-            &CourseCodeChecker::default(),
+            code,
             &CompareImageChecker::default(),
-            &work.join("rendered"),
+            &work.join(out),
             &Format::ALL,
         )
         .expect("grading works");

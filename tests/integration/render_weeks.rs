@@ -10,9 +10,9 @@
 //!
 //! Every render is seeded (the Python with [`SEED`], the golden with rtoracle's golden seed), so
 //! each verdict is the same on every run: there is no false alarm to budget for. The mistakes
-//! listed are those that show at this size; how often honest renders of other seeds pass, and
-//! how often each mistake fails at larger sizes, are measured figures in
-//! `docs/scenes-and-rendering.md`.
+//! listed are those that show at this size; how often honest renders of other seeds pass at full
+//! size is a measured figure (`bench/false_alarms.sh`, in `docs/comparing-images.md`, "Measured
+//! false alarms and power").
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
