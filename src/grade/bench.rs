@@ -150,20 +150,8 @@ fn secs(d: Duration) -> f64 {
     d.as_secs_f64()
 }
 
-/// Runs the benchmark and returns its figures as text: one submission and a batch of 30, in
-/// seconds and against the baseline.
-pub fn run() -> String {
-    let work = tempfile::tempdir().expect("a temporary folder");
-    let names = fixture_names();
-    let subs = work.path().join("subs");
-    for i in 0..30 {
-        let name = &names[i % names.len()];
-        materialize(name, &subs.join(format!("{i:02}-{name}"))).expect("fixtures materialize");
-    }
-    let honest = work.path().join("honest");
-    materialize("honest", &honest).expect("the honest fixture");
-
-    // Baseline: starting the interpreter once, as the grader must at least do.
+/// Baseline: the median of five starts of the interpreter, as the grader must at least do.
+fn python_start_baseline() -> f64 {
     let python = ["/usr/bin/python3", "/usr/local/bin/python3", "python3"]
         .into_iter()
         .find(|p| {
@@ -184,7 +172,62 @@ pub fn run() -> String {
         })
         .collect();
     starts.sort_by(f64::total_cmp);
-    let baseline = starts[2];
+    starts[2]
+}
+
+/// The grader's renders of `honest` sandboxed and not: the first sandboxed run, and the medians
+/// of three runs each way.
+fn rendered_each_way(
+    honest: &Path,
+    work: &Path,
+    sandboxed: &CourseCodeChecker,
+    unsandboxed: &CourseCodeChecker,
+) -> (Rendered, f64, f64) {
+    let rendered = rendered_one(honest, work, sandboxed, "rendered");
+    // One run of a Python render varies by a tenth or more: three of each kind, taking turns
+    // (the first sandboxed run is the one shown above), medians compared.
+    let mut with_sandbox = vec![rendered.total];
+    let mut without = Vec::new();
+    for k in 0..3 {
+        let out = format!("rendered-unsandboxed-{k}");
+        without.push(rendered_one(honest, work, unsandboxed, &out).total);
+        if k < 2 {
+            let out = format!("rendered-{k}");
+            with_sandbox.push(rendered_one(honest, work, sandboxed, &out).total);
+        }
+    }
+    (rendered, median(with_sandbox), median(without))
+}
+
+/// Seconds to grade `submission` once from its uploaded images, in every format.
+fn graded_once(submission: &Path, rubric: &Rubric, out: &Path) -> f64 {
+    let t = Instant::now();
+    grade_to_dir(
+        submission,
+        rubric,
+        &CourseCodeChecker::default(),
+        &CompareImageChecker::default(),
+        out,
+        &Format::ALL,
+    )
+    .expect("grading works");
+    secs(t.elapsed())
+}
+
+/// Runs the benchmark and returns its figures as text: one submission and a batch of 30, in
+/// seconds and against the baseline.
+pub fn run() -> String {
+    let work = tempfile::tempdir().expect("a temporary folder");
+    let names = fixture_names();
+    let subs = work.path().join("subs");
+    for i in 0..30 {
+        let name = &names[i % names.len()];
+        materialize(name, &subs.join(format!("{i:02}-{name}"))).expect("fixtures materialize");
+    }
+    let honest = work.path().join("honest");
+    materialize("honest", &honest).expect("the honest fixture");
+
+    let baseline = python_start_baseline();
 
     // The grader's renders measured on their own (one submission, one core); the other figures
     // judge the uploaded images, as they did before renders, so they stay comparable.
@@ -199,38 +242,14 @@ pub fn run() -> String {
         },
         ..CourseCodeChecker::default()
     };
-    let rendered = rendered_one(&honest, work.path(), &sandboxed, "rendered");
-    // One run of a Python render varies by a tenth or more: three of each kind, taking turns
-    // (the first sandboxed run is the one shown above), medians compared.
-    let mut with_sandbox = vec![rendered.total];
-    let mut without = Vec::new();
-    for k in 0..3 {
-        let out = format!("rendered-unsandboxed-{k}");
-        without.push(rendered_one(&honest, work.path(), &unsandboxed, &out).total);
-        if k < 2 {
-            let out = format!("rendered-{k}");
-            with_sandbox.push(rendered_one(&honest, work.path(), &sandboxed, &out).total);
-        }
-    }
-    let (rendered_sandboxed, rendered_bare) = (median(with_sandbox), median(without));
+    let (rendered, rendered_sandboxed, rendered_bare) =
+        rendered_each_way(&honest, work.path(), &sandboxed, &unsandboxed);
     let rubric = Rubric::week04_uploads();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
         .expect("a pool");
-    let one = pool.install(|| {
-        let t = Instant::now();
-        grade_to_dir(
-            &honest,
-            &rubric,
-            &CourseCodeChecker::default(),
-            &CompareImageChecker::default(),
-            &work.path().join("one"),
-            &Format::ALL,
-        )
-        .expect("grading works");
-        secs(t.elapsed())
-    });
+    let one = pool.install(|| graded_once(&honest, &rubric, &work.path().join("one")));
     let batch_of_30 = |code: &CourseCodeChecker, out: &str| {
         pool.install(|| {
             let t = Instant::now();
