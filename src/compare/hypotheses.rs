@@ -125,6 +125,12 @@ pub(crate) fn scaled(golden: &Golden, k: [f64; 3]) -> Golden {
     )
     .expect("a scaled golden has the same size and finite values")
     .with_vfov(golden.vfov)
+    .with_deviation(golden.deviation.as_ref().map(|d| {
+        d.iter()
+            .map(|v| [0, 1, 2].map(|c| v[c] * k[c].abs()))
+            .collect()
+    }))
+    .expect("scaled deviations stay finite distances")
 }
 
 /// The golden's mean and variance at the point `(x, y)` (pixel units, `(0.5, 0.5)` the centre of

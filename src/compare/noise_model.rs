@@ -1,5 +1,18 @@
 //! The golden as the noise model reads it: per pixel and channel the mean of `M` samples, their
-//! per-sample variance, and a bound on how far one sample may lie from the mean.
+//! per-sample variance, the largest distance of one of them from the mean (when the golden
+//! recorded it), and a bound on how far one sample may lie from the mean.
+//!
+//! The bound is what Bernstein's inequality needs: how far a single sample of the candidate may
+//! land from the golden's mean. Three standard deviations of the pixel and its neighbours cover
+//! one-bounce colours; they do not cover a rare bright path (a specular lobe met by a scattered
+//! ray, a bounce into a small light), whose probability is too small to show in the variance
+//! but whose samples lie far away. The golden's measured deviations do: the pixel scale's bound
+//! ([`Golden::tail_bound`]) takes the largest of them over a 5x5 neighbourhood, so a path the
+//! golden saw once in the ~25 M samples around a pixel counts as possible there. The sums over
+//! tiles and the image keep the edge-tolerant bound ([`Golden::bound`]): one rare sample moves a
+//! sum of hundreds of pixels by a small share of its standard deviation, while the largest
+//! bound of its terms, which Bernstein's inequality charges to the whole sum, would cost a
+//! tile most of its power (a missing shadow in a 32x32 image of a point light passed with it).
 //!
 //! The goldens themselves (their files, the cache, how each scene gets one) are
 //! [`crate::golden`]'s; [`Golden::of_scene`] reads the one [`crate::golden::golden_of`] gives.
@@ -26,6 +39,14 @@ pub fn recorded_scene(record: &GoldenRecord) -> Option<SceneDescription> {
     (scene.scene_sha256() == want).then_some(scene.description)
 }
 
+/// How many standard deviations from the mean a golden's farthest sample must lie for its pixel
+/// to count as heavy-tailed. The farthest of `M = 4096` samples of a light-tailed colour lies
+/// about 3.5 to 4.5 of them away (a normal's largest of 4096 is about 3.5); a rare event seen
+/// `k` times lies about `sqrt(M / k)` away (64 for one sample in 4096, 6 for 110). Below the
+/// threshold the sample bound stays the edge-tolerant one, whose power a pattern mistake (a
+/// texture's u and v swapped) needs at the pixel scale.
+const HEAVY_TAIL: f64 = 6.0;
+
 /// A golden image: per pixel and channel the mean of `samples_per_pixel` samples and their
 /// per-sample variance, plus what the comparison derives from them.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,10 +66,18 @@ pub struct Golden {
     /// The vertical field of view of the scene's camera in degrees, when known (the diagnosis
     /// names a zoom as a field of view).
     pub vfov: Option<f64>,
+    /// Per pixel and channel, the largest distance of one of the golden's samples from its mean,
+    /// when the golden recorded it (rtoracle's goldens do; an EXR of another renderer may not).
+    pub deviation: Option<Vec<[f64; 3]>>,
     /// Per pixel and channel, a bound on how far one sample may lie from the mean: the largest
     /// `|mu_nb - mu| + 3 sd_nb` over the 3x3 neighbourhood, at most 1. Edge-tolerant: a pixel
-    /// beside an edge may receive samples of the other side that the golden never drew.
+    /// beside an edge may receive samples of the other side that the golden never drew. The
+    /// sums over tiles and the image use it.
     pub(crate) bound: Vec<[f64; 3]>,
+    /// [`Self::bound`] or the largest measured deviation over the 5x5 neighbourhood of the
+    /// pixels with a heavy tail ([`HEAVY_TAIL`]), whichever is larger, at most 1: tail-tolerant too, a pixel may receive a rare bright sample its
+    /// neighbours' samples show. The pixel scale uses it.
+    pub(crate) tail_bound: Vec<[f64; 3]>,
 }
 
 impl Golden {
@@ -91,10 +120,46 @@ impl Golden {
                 .collect(),
             scene,
             vfov: None,
+            deviation: None,
             bound: Vec::new(),
+            tail_bound: Vec::new(),
         };
         golden.bound = golden.neighbourhood_bound();
+        golden.tail_bound = golden.bound.clone();
         Ok(golden)
+    }
+
+    /// The same golden with its samples' largest deviations from the mean known (`None`:
+    /// unknown); they must be `width * height` finite values, not negative.
+    pub fn with_deviation(
+        mut self,
+        deviation: Option<Vec<[f64; 3]>>,
+    ) -> Result<Self, CompareError> {
+        if let Some(d) = &deviation {
+            if d.len() != self.mean.len() {
+                return Err(CompareError::Golden(format!(
+                    "a {}x{} golden needs {} deviations; it has {}",
+                    self.width,
+                    self.height,
+                    self.mean.len(),
+                    d.len()
+                )));
+            }
+            if !d
+                .iter()
+                .all(|p| p.iter().all(|x| x.is_finite() && *x >= 0.0))
+            {
+                return Err(CompareError::Golden(
+                    "the golden has a deviation that is not a finite distance".into(),
+                ));
+            }
+        }
+        self.tail_bound = match &deviation {
+            Some(d) => self.with_tails(d),
+            None => self.bound.clone(),
+        };
+        self.deviation = deviation;
+        Ok(self)
     }
 
     /// The same golden with the camera's vertical field of view `vfov` (degrees) known.
@@ -133,29 +198,51 @@ impl Golden {
             variance: pick(&self.variance),
             scene: self.scene.clone(),
             vfov: None,
+            deviation: self.deviation.as_deref().map(pick),
             bound: pick(&self.bound),
+            tail_bound: pick(&self.tail_bound),
         })
     }
 
     fn neighbourhood_bound(&self) -> Vec<[f64; 3]> {
-        let (w, h) = (self.width as isize, self.height as isize);
         let sd: Vec<[f64; 3]> = self.variance.iter().map(|v| v.map(f64::sqrt)).collect();
+        self.over_neighbours(1, |i, j, c| {
+            (self.mean[j][c] - self.mean[i][c]).abs() + 3.0 * sd[j][c]
+        })
+    }
+
+    /// [`Self::tail_bound`] from the measured deviations `d`: a neighbour's deviation counts
+    /// when it shows a heavy tail, more than [`HEAVY_TAIL`] of its standard deviations.
+    fn with_tails(&self, d: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let tails = self.over_neighbours(2, |_, j, c| {
+            let heavy = d[j][c] > HEAVY_TAIL * self.variance[j][c].sqrt();
+            if heavy { d[j][c] } else { 0.0 }
+        });
+        self.bound
+            .iter()
+            .zip(tails)
+            .map(|(b, t)| [0, 1, 2].map(|c| b[c].max(t[c])))
+            .collect()
+    }
+
+    /// Per pixel `i` and channel `c`, the largest `value(i, j, c)` over the pixels `j` within
+    /// `radius` (a square, cut at the image's border), at most 1.
+    fn over_neighbours(
+        &self,
+        radius: isize,
+        value: impl Fn(usize, usize, usize) -> f64,
+    ) -> Vec<[f64; 3]> {
+        let (w, h) = (self.width as isize, self.height as isize);
         let mut out = vec![[0.0; 3]; self.mean.len()];
         for y in 0..h {
             for x in 0..w {
                 let i = (y * w + x) as usize;
-                let mu = self.mean[i];
                 let mut b = [0.0f64; 3];
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let (nx, ny) = (x + dx, y + dy);
-                        if nx < 0 || ny < 0 || nx >= w || ny >= h {
-                            continue;
-                        }
+                for ny in (y - radius).max(0)..=(y + radius).min(h - 1) {
+                    for nx in (x - radius).max(0)..=(x + radius).min(w - 1) {
                         let j = (ny * w + nx) as usize;
-                        for c in 0..3 {
-                            let v = (self.mean[j][c] - mu[c]).abs() + 3.0 * sd[j][c];
-                            b[c] = b[c].max(v);
+                        for (c, b) in b.iter_mut().enumerate() {
+                            *b = b.max(value(i, j, c));
                         }
                     }
                 }
@@ -177,6 +264,11 @@ impl Golden {
             film.mean.iter().map(|m| m.to_array()).collect(),
             variance.iter().map(|v| v.to_array()).collect(),
             scene,
+        )?
+        .with_deviation(
+            film.deviation
+                .as_ref()
+                .map(|d| d.iter().map(|v| v.to_array()).collect()),
         )
     }
 
@@ -220,7 +312,7 @@ impl Golden {
             widen(variance),
             record.scene,
         )
-        .map(|g| g.with_vfov(vfov))
+        .and_then(|g| g.with_vfov(vfov).with_deviation(image.deviation.map(widen)))
         .map_err(|e| bad(e.to_string()))
     }
 
@@ -289,6 +381,49 @@ impl Golden {
 mod tests {
     use super::*;
 
+    /// A sample the golden saw once, 0.5 from the mean of pixel (3, 3) of a flat 7x7 golden
+    /// (standard deviation 0.001 everywhere, so 500 of them: a heavy tail): the pixel scale's
+    /// bound is 0.5 within two pixels of it (the 5x5 neighbourhood) and three standard
+    /// deviations beyond; without the deviations, three standard deviations everywhere.
+    #[test]
+    fn a_measured_deviation_bounds_its_5x5_neighbourhood() {
+        let n = 49;
+        let flat = Golden::new(7, 7, 4096, vec![[0.1; 3]; n], vec![[1e-6; 3]; n], None).unwrap();
+        let mut deviation = vec![[0.0; 3]; n];
+        deviation[3 * 7 + 3] = [0.5, 0.0, 0.0];
+        let seen = flat.clone().with_deviation(Some(deviation)).unwrap();
+        for y in 0..7usize {
+            for x in 0..7usize {
+                let i = y * 7 + x;
+                let near = x.abs_diff(3) <= 2 && y.abs_diff(3) <= 2;
+                let red = if near { 0.5 } else { 0.003 };
+                let what = format!("({x}, {y}) {:?}", seen.tail_bound[i]);
+                assert!((seen.tail_bound[i][0] - red).abs() < 1e-12, "{what}");
+                assert!((seen.tail_bound[i][1] - 0.003).abs() < 1e-12, "{what}");
+                assert!((flat.tail_bound[i][0] - 0.003).abs() < 1e-12, "{what}");
+                // The sums' bound stays the edge-tolerant one.
+                assert!((seen.bound[i][0] - 0.003).abs() < 1e-12, "{what}");
+            }
+        }
+        // A farthest sample 5 standard deviations away is a light tail: no change.
+        let light = flat
+            .clone()
+            .with_deviation(Some(vec![[0.005; 3]; n]))
+            .unwrap();
+        assert_eq!(light.tail_bound, flat.bound);
+        assert!(
+            flat.clone()
+                .with_deviation(Some(vec![[0.0; 3]; 48]))
+                .is_err()
+        );
+        assert!(
+            flat.clone()
+                .with_deviation(Some(vec![[-0.1; 3]; 49]))
+                .is_err()
+        );
+        assert!(flat.with_deviation(Some(vec![[f64::NAN; 3]; 49])).is_err());
+    }
+
     fn tiny() -> Golden {
         Golden::new(
             2,
@@ -347,6 +482,7 @@ mod tests {
             height: 1,
             mean: vec![[0.5; 3]],
             variance: variance.then(|| vec![[0.01; 3]]),
+            deviation: None,
             attributes: spp
                 .map(|s| vec![("rtoracle.spp".to_string(), s.to_string())])
                 .unwrap_or_default(),

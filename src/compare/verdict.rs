@@ -37,6 +37,8 @@ struct Intervals {
     /// The upper end of the encoding's top code's interval (an 8-bit candidate): the film clamps,
     /// so that code stands for every value from its lower end up, above 1 too.
     top_hi: Option<f64>,
+    /// The lower end of that code's interval (see [`Intervals::censored_below`]).
+    top_lo: Option<f64>,
 }
 
 impl Intervals {
@@ -61,6 +63,7 @@ impl Intervals {
                     encoding: Some(encoding),
                     table,
                     top_hi: Some(table[encoding.encode(1.0) as usize].1),
+                    top_lo: Some(table[encoding.encode(1.0) as usize].0),
                 }
             }
             CandidateImage::Linear { data, .. } => {
@@ -75,8 +78,34 @@ impl Intervals {
                     encoding: None,
                     table,
                     top_hi: None,
+                    top_lo: None,
                 }
             }
+        }
+    }
+
+    /// The `below` a sum adds for term `t` of a candidate whose interval's own upper end is
+    /// `raw_hi`: a lower bound on how much darker the candidate is than an honest one, under the
+    /// clamping film's censoring.
+    ///
+    /// An 8-bit film clamps each pixel's mean: an honest candidate shows `min(mean, clamp)`,
+    /// whose expectation lies below the golden's mean wherever the mean may reach the top code
+    /// (overexposed lights and highlights). Summed over many such pixels, `mu - hi` would then
+    /// lean dark for an honest image. So the sums compare the candidate with a lower bound of
+    /// that expectation instead: with `Y` the candidate's mean minus the top code's lower end
+    /// `top`, `E[min(mean, top)] = mu - E[Y+]`, and `E[Y+] = (E[Y] + E|Y|) / 2 <= (m + sqrt(m^2
+    /// + v)) / 2` for `m = mu - top` and `v` the variance of the candidate's mean. The top code's
+    /// own upper end is used (not "any brighter value", which the pixel scale keeps). Far below
+    /// the top the shortfall is about `v / (4 |m|)`, a small share of a standard deviation.
+    #[inline]
+    fn censored_below(&self, t: &Term, raw_hi: f64) -> f64 {
+        match self.top_lo {
+            Some(top) => {
+                let m = t.mu - top;
+                let shortfall = 0.5 * (m + (m * m + t.variance).sqrt());
+                t.mu - t.slack - shortfall - raw_hi
+            }
+            None => t.below,
         }
     }
 
@@ -250,7 +279,8 @@ struct Claim {
 }
 
 /// One channel of one pixel: the candidate's interval `[lo, hi]` against the golden's mean
-/// `mu`, per-sample variance `s2` and bound `b`.
+/// `mu`, per-sample variance `s2` and bound `b` (the sums'; the pixel test uses the golden's
+/// tail-tolerant bound, `Golden::tail_bound`).
 struct Term {
     lo: f64,
     hi: f64,
@@ -263,9 +293,9 @@ struct Term {
     below: f64,
     /// The variance of the candidate's mean minus the golden's under the claim.
     variance: f64,
-    /// Bernstein's bound on one term.
+    /// Bernstein's bound on one term of a sum.
     bound: f64,
-    /// The pixel test's p-value (before the Sidak correction).
+    /// The pixel test's p-value (before the Sidak correction), with the tail-tolerant bound.
     p: f64,
     /// Its signed z.
     z: f64,
@@ -275,7 +305,7 @@ struct Term {
 
 impl Term {
     #[inline]
-    fn of(lo: f64, hi: f64, mu: f64, s2: f64, b: f64, claim: &Claim) -> Self {
+    fn of(lo: f64, hi: f64, mu: f64, s2: f64, (b, tail): (f64, f64), claim: &Claim) -> Self {
         // The golden's range: its mean up to f32 and float-order rounding.
         let slack = 1e-6 * (1.0 + mu.abs());
         let (mu_lo, mu_hi) = (mu - slack, mu + slack);
@@ -303,7 +333,7 @@ impl Term {
             below,
             variance,
             bound,
-            p: bernstein_p(t, variance, bound),
+            p: bernstein_p(t, variance, tail / claim.n),
             z: sign * z_of(t, variance),
             slack,
         }
@@ -382,13 +412,14 @@ impl PixelPass {
         for c in 0..3 {
             let mu = golden.mean[i][c];
             let s2 = golden.variance[i][c];
-            let b = golden.bound[i][c];
+            let bounds = (golden.bound[i][c], golden.tail_bound[i][c]);
             let (lo, mut hi) = (iv.lo[i][c], iv.hi[i][c]);
+            let raw_hi = hi;
             if iv.top_hi == Some(hi) {
                 // The top code of a clamping film: any mean from its lower end up gives it.
                 hi = hi.max(mu);
             }
-            let t = Term::of(lo, hi, mu, s2, b, claim);
+            let t = Term::of(lo, hi, mu, s2, bounds, claim);
             let z = t.z;
             self.misfit += (z * z).min(100.0);
             self.z_map[i][c] = z as f32;
@@ -413,7 +444,8 @@ impl PixelPass {
             // are decided exactly at the pixel scale (a rule that reads only the golden).
             let width_here = iv.width_at(mu);
             if t.variance.sqrt() >= width_here {
-                let (above, below, variance, bound) = (t.above, t.below, t.variance, t.bound);
+                let below = iv.censored_below(&t, raw_hi);
+                let (above, variance, bound) = (t.above, t.variance, t.bound);
                 self.tiles8[g.tile(8, x, y, c)].add(above, below, variance, bound);
                 self.tiles32[g.tile(32, x, y, c)].add(above, below, variance, bound);
                 self.global[c].add(above, below, variance, bound);
@@ -847,6 +879,63 @@ mod tests {
         )
         .unwrap();
         assert!(!evaluate(&image(254), &dim, Encoding::Course, &options).passed);
+    }
+
+    /// An overexposed region (every pixel's mean 1.02 in blue, its samples `1.02 +- 0.45`) is
+    /// censored by the film: an honest 4-spp candidate shows the top code two times in three
+    /// and is darker otherwise, so `mu - hi` summed over the region leans dark by about 24
+    /// standard deviations. The sums compare it with the expected clamped mean instead, so the
+    /// honest candidate passes (fixed seed), and the same region rendered at half its
+    /// brightness still fails at a sum's scale.
+    #[test]
+    fn an_overexposed_region_is_judged_by_its_clamped_mean() {
+        let (w, h, n) = (64, 64, 4u32);
+        let (mu, spread) = (1.02, 0.2f64.sqrt());
+        let golden = Golden::new(
+            w,
+            h,
+            4096,
+            vec![[0.25, 0.25, mu]; w * h],
+            vec![[0.0, 0.0, spread * spread]; w * h],
+            None,
+        )
+        .unwrap();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut coin = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state >> 63 == 1
+        };
+        let image = |blue: &mut dyn FnMut() -> f64| CandidateImage::Rgb8 {
+            width: w,
+            height: h,
+            data: (0..w * h)
+                .flat_map(|_| {
+                    let q = Encoding::Course.encode(0.25);
+                    [q, q, Encoding::Course.encode(blue())]
+                })
+                .collect(),
+        };
+        let mut honest = || {
+            let sum: f64 = (0..n)
+                .map(|_| if coin() { mu + spread } else { mu - spread })
+                .sum();
+            sum / n as f64
+        };
+        let options = CompareOptions {
+            samples_per_pixel: n,
+            ..CompareOptions::default()
+        };
+        let e = evaluate(&image(&mut honest), &golden, Encoding::Course, &options);
+        assert!(e.passed, "{:?}", e.scales);
+        let e = evaluate(&image(&mut || 0.51), &golden, Encoding::Course, &options);
+        assert!(!e.passed);
+        assert!(
+            e.scales[1..].iter().any(|s| s.failing > 0),
+            "{:?}",
+            e.scales
+        );
     }
 
     /// A linear candidate equal to the golden passes; off by 1% in red fails, darker.

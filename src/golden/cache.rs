@@ -30,8 +30,9 @@ use super::source::GoldenScene;
 use crate::image_io::{ExrImage, write_atomically};
 
 /// The version of the cache's layout and key, part of every cache file's name: raised whenever
-/// what a cached golden holds, or what its key means, changes.
-pub const CACHE_FORMAT: u32 = 2;
+/// what a cached golden holds, or what its key means, changes (3: goldens carry the `deviation`
+/// layer, the largest distance of a sample from the mean).
+pub const CACHE_FORMAT: u32 = 3;
 
 /// The folder rtoracle caches in: `$RTORACLE_CACHE_DIR`, else `$XDG_CACHE_HOME/rtoracle`, else
 /// `$HOME/.cache/rtoracle` (empty variables count as unset); `None` when none is set.

@@ -49,7 +49,7 @@ pub struct PixelDifference {
     pub x: usize,
     /// Row (0 at the top).
     pub y: usize,
-    /// The channel: `R`, `G`, `B`, `variance.R`, `variance.G` or `variance.B`.
+    /// The channel: `R`, `G`, `B`, or one of the `variance.` or `deviation.` layer's.
     pub channel: &'static str,
     /// The expected (committed) value.
     pub expected: f32,
@@ -116,7 +116,8 @@ const IDENTITY_ATTRIBUTES: &[&str] = &[
     ATTR_INPUTS,
 ];
 
-/// Compares `actual` with `expected` pixel by pixel (mean and variance) within `tolerance`,
+/// Compares `actual` with `expected` pixel by pixel (mean, variance and deviation) within
+/// `tolerance`,
 /// and their identifying attributes (scene, scene hash, spp, seed, profile, inputs) exactly.
 pub fn compare_goldens(
     expected: &ExrImage,
@@ -146,15 +147,26 @@ pub fn compare_goldens(
     // (expected values, actual values, channel names) per layer.
     type LayerPair<'a> = (&'a [[f32; 3]], &'a [[f32; 3]], [&'static str; 3]);
     let mut layers: Vec<LayerPair> = vec![(&expected.mean, &actual.mean, MEAN)];
-    match (&expected.variance, &actual.variance) {
-        (Some(e), Some(a)) => layers.push((e, a, VARIANCE)),
-        (None, None) => {}
-        (Some(_), None) => diff
-            .structural
-            .push("the variance layer is missing".to_string()),
-        (None, Some(_)) => diff
-            .structural
-            .push("there is a variance layer where none was expected".to_string()),
+    const DEVIATION: [&str; 3] = ["deviation.R", "deviation.G", "deviation.B"];
+    for (expected, actual, names, layer) in [
+        (&expected.variance, &actual.variance, VARIANCE, "variance"),
+        (
+            &expected.deviation,
+            &actual.deviation,
+            DEVIATION,
+            "deviation",
+        ),
+    ] {
+        match (expected, actual) {
+            (Some(e), Some(a)) => layers.push((e, a, names)),
+            (None, None) => {}
+            (Some(_), None) => diff
+                .structural
+                .push(format!("the {layer} layer is missing")),
+            (None, Some(_)) => diff
+                .structural
+                .push(format!("there is a {layer} layer where none was expected")),
+        }
     }
     let mut differing = vec![false; expected.width * expected.height];
     let mut worst_gap = -1.0f32;
@@ -194,6 +206,7 @@ mod tests {
             height: 1,
             mean: values.iter().map(|&v| [v, v, v]).collect(),
             variance: Some(values.iter().map(|&v| [v * v, 0.0, 0.0]).collect()),
+            deviation: Some(values.iter().map(|&v| [v, 0.0, 0.0]).collect()),
             attributes: vec![(ATTR_SCENE.to_string(), "s".to_string())],
         }
     }
@@ -236,6 +249,14 @@ mod tests {
         let mut a = e.clone();
         a.variance = None;
         assert!(!compare_goldens(&e, &a, &Tolerance::default()).is_match());
+
+        let mut a = e.clone();
+        a.deviation.as_mut().unwrap()[0][0] = 0.5;
+        let d = compare_goldens(&e, &a, &Tolerance::default());
+        assert_eq!(d.worst.unwrap().channel, "deviation.R");
+        a.deviation = None;
+        let d = compare_goldens(&e, &a, &Tolerance::default());
+        assert_eq!(d.structural, ["the deviation layer is missing"]);
 
         let mut a = e.clone();
         a.attributes[0].1 = "other".into();

@@ -5,9 +5,10 @@ use std::path::Path;
 
 use super::GoldenError;
 use super::format::{
-    ATTR_CAMERA, ATTR_INPUTS, ATTR_PROFILE, ATTR_SAMPLING, ATTR_SCENE, ATTR_SCENE_SHA256,
-    ATTR_SCENE_TOML, ATTR_SEED, ATTR_SPP, ATTR_VARIANCE, ATTR_VERSION, CAMERA_CONVENTION,
-    DEFAULT_PROFILE, SAMPLING, VARIANCE_MEANING, golden_file_name,
+    ATTR_CAMERA, ATTR_DEVIATION, ATTR_INPUTS, ATTR_PROFILE, ATTR_SAMPLING, ATTR_SCENE,
+    ATTR_SCENE_SHA256, ATTR_SCENE_TOML, ATTR_SEED, ATTR_SPP, ATTR_VARIANCE, ATTR_VERSION,
+    CAMERA_CONVENTION, DEFAULT_PROFILE, DEVIATION_MEANING, SAMPLING, VARIANCE_MEANING,
+    golden_file_name,
 };
 use super::source::GoldenScene;
 use crate::image_io::encode_exr;
@@ -24,6 +25,7 @@ pub fn golden_attributes(scene: &GoldenScene, spp: u32, seed: u64) -> Vec<(Strin
         (ATTR_CAMERA, CAMERA_CONVENTION.to_string()),
         (ATTR_SAMPLING, SAMPLING.to_string()),
         (ATTR_VARIANCE, VARIANCE_MEANING.to_string()),
+        (ATTR_DEVIATION, DEVIATION_MEANING.to_string()),
     ];
     if scene.profile != DEFAULT_PROFILE {
         attributes.push((ATTR_PROFILE, scene.profile.clone()));

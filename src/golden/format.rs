@@ -2,8 +2,8 @@
 //! string attributes that say what it was made from.
 //!
 //! Every golden carries [`ATTR_SCENE`], [`ATTR_SCENE_SHA256`], [`ATTR_SPP`], [`ATTR_SEED`],
-//! [`ATTR_VERSION`] and the three descriptions ([`ATTR_CAMERA`], [`ATTR_SAMPLING`],
-//! [`ATTR_VARIANCE`]). Three more are written only when they say something beyond the defaults,
+//! [`ATTR_VERSION`] and the four descriptions ([`ATTR_CAMERA`], [`ATTR_SAMPLING`],
+//! [`ATTR_VARIANCE`], [`ATTR_DEVIATION`]). Three more are written only when they say something beyond the defaults,
 //! so that the goldens of the built-in scenes keep their bytes:
 //! - [`ATTR_PROFILE`], when the profile is not [`DEFAULT_PROFILE`] (absent: that profile);
 //! - [`ATTR_INPUTS`], when the scene reads other files (absent: none);
@@ -33,6 +33,8 @@ pub const ATTR_CAMERA: &str = "rtoracle.camera";
 pub const ATTR_SAMPLING: &str = "rtoracle.sampling";
 /// The attribute describing the `variance` layer.
 pub const ATTR_VARIANCE: &str = "rtoracle.variance";
+/// The attribute describing the `deviation` layer.
+pub const ATTR_DEVIATION: &str = "rtoracle.deviation";
 /// The attribute naming the profile the golden was rendered in; absent: [`DEFAULT_PROFILE`].
 pub const ATTR_PROFILE: &str = "rtoracle.profile";
 /// The attribute listing the other files the scene read (textures), one `SHA256  NAME` line
@@ -58,6 +60,11 @@ independently per sample (x then y), from a PCG64 stream per pixel seeded by (se
 /// What the `variance` layer holds, written into every golden.
 pub const VARIANCE_MEANING: &str = "per-sample variance of each channel (Welford's update in f64, \
 divided by n - 1), rounded to f32; the variance of the mean is this divided by rtoracle.spp";
+
+/// What the `deviation` layer holds, written into every golden.
+pub const DEVIATION_MEANING: &str = "per channel, the largest |sample - mean| of the pixel's \
+samples (the mean as the R, G, B channels hold it before rounding), rounded up to f32: a measured \
+bound on how far one sample of the scene lands from the pixel's mean";
 
 /// Name of the golden file of `scene`: `<scene>.exr`.
 pub fn golden_file_name(scene: &str) -> String {

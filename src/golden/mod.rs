@@ -40,9 +40,10 @@ pub use diff::{GoldenDiff, PixelDifference, Tolerance, compare_goldens};
 pub use embedded::{embedded_golden, embedded_golden_image, embedded_scenes};
 pub use encode::golden_attributes;
 pub use format::{
-    ATTR_CAMERA, ATTR_INPUTS, ATTR_PROFILE, ATTR_SAMPLING, ATTR_SCENE, ATTR_SCENE_SHA256,
-    ATTR_SCENE_TOML, ATTR_SEED, ATTR_SPP, ATTR_VARIANCE, ATTR_VERSION, CAMERA_CONVENTION,
-    DEFAULT_PROFILE, GoldenRecord, SAMPLING, VARIANCE_MEANING, golden_file_name,
+    ATTR_CAMERA, ATTR_DEVIATION, ATTR_INPUTS, ATTR_PROFILE, ATTR_SAMPLING, ATTR_SCENE,
+    ATTR_SCENE_SHA256, ATTR_SCENE_TOML, ATTR_SEED, ATTR_SPP, ATTR_VARIANCE, ATTR_VERSION,
+    CAMERA_CONVENTION, DEFAULT_PROFILE, DEVIATION_MEANING, GoldenRecord, SAMPLING,
+    VARIANCE_MEANING, golden_file_name,
 };
 pub use source::{
     GoldenInput, GoldenScene, at_spp, files_read, golden_fits, scene_sha256, sha256_hex,
@@ -279,6 +280,7 @@ fn film_of(image: &ExrImage, spp: u32) -> Film {
         samples_per_pixel: spp,
         mean: widen(&image.mean),
         variance: image.variance.as_deref().map(widen),
+        deviation: image.deviation.as_deref().map(widen),
     }
 }
 

@@ -1,9 +1,12 @@
-//! OpenEXR files: linear `f32` R, G, B, an optional `variance` layer, and string attributes.
+//! OpenEXR files: linear `f32` R, G, B, optional `variance` and `deviation` layers, and string
+//! attributes.
 //!
 //! rtoracle writes one single-part scan-line file per image: channels `R`, `G`, `B` (the
-//! per-pixel mean) and, when the film kept it, `variance.R`, `variance.G`, `variance.B` (the
-//! per-sample variance; OpenEXR reads the `variance.` prefix as a layer called `variance`). All
-//! samples are `f32`, rounded to nearest from the film's `f64`. Blocks are ZIP-compressed 16 lines
+//! per-pixel mean) and, when the film kept them, `variance.R`, `variance.G`, `variance.B` (the
+//! per-sample variance; OpenEXR reads the `variance.` prefix as a layer called `variance`) and
+//! `deviation.R`, `deviation.G`, `deviation.B` (the largest distance of a sample from the mean).
+//! All samples are `f32`, rounded to nearest from the film's `f64`, except the deviation, rounded
+//! up (it is a bound). Blocks are ZIP-compressed 16 lines
 //! at a time in increasing line order, written by one thread, and the header's attributes are
 //! sorted by name (as OpenEXR's own library writes them), so the same film and attributes give
 //! the same bytes every time, on any machine and any number of threads.
@@ -31,6 +34,9 @@ pub struct ExrImage {
     pub mean: Vec<[f32; 3]>,
     /// Per-sample variance of each channel, when the file has a `variance` layer.
     pub variance: Option<Vec<[f32; 3]>>,
+    /// The largest distance of a sample from the mean, per channel, when the file has a
+    /// `deviation` layer.
+    pub deviation: Option<Vec<[f32; 3]>>,
     /// String attributes of the header, sorted by name.
     pub attributes: Vec<(String, String)>,
 }
@@ -45,10 +51,23 @@ impl ExrImage {
     }
 }
 
+/// The nearest `f32` not below `x` (for a bound; `x` not negative, as a deviation is).
+fn f32_at_least(x: f64) -> f32 {
+    let near = x as f32;
+    if (near as f64) < x {
+        // The next f32 up: `near` is not negative (nor infinite, being below `x`), so its
+        // successor is one step of its bits (0 steps to the smallest subnormal).
+        f32::from_bits(near.to_bits() + 1)
+    } else {
+        near
+    }
+}
+
 /// The four magic bytes every OpenEXR file starts with.
 const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 
-/// Writes a film as EXR (f32 R, G, B, and a `variance` layer when the film has one) with the
+/// Writes a film as EXR (f32 R, G, B, and `variance` and `deviation` layers when the film has
+/// them) with the
 /// given string attributes, atomically and deterministically ([`encode_exr`] gives the bytes).
 pub fn write_exr(
     path: &Path,
@@ -77,7 +96,8 @@ pub fn encode_exr(
         ));
     }
     let count = film.width * film.height;
-    if film.mean.len() != count || film.variance.as_ref().is_some_and(|v| v.len() != count) {
+    let wrong = |layer: &Option<Vec<glam::DVec3>>| layer.as_ref().is_some_and(|v| v.len() != count);
+    if film.mean.len() != count || wrong(&film.variance) || wrong(&film.deviation) {
         return Err(ImageError::format(
             name,
             format!(
@@ -102,6 +122,15 @@ pub fn encode_exr(
             .enumerate()
         {
             channels.push(channel(label, variance, c));
+        }
+    }
+    if let Some(deviation) = &film.deviation {
+        for (c, label) in ["deviation.R", "deviation.G", "deviation.B"]
+            .into_iter()
+            .enumerate()
+        {
+            let up = deviation.iter().map(|v| f32_at_least(v[c])).collect();
+            channels.push(AnyChannel::new(label, FlatSamples::F32(up)));
         }
     }
 
@@ -231,7 +260,8 @@ fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
 /// The first part (layer) with `R`, `G` and `B` channels is read, at its largest resolution
 /// level; any sample type (half, float, uint) becomes `f32`; `A` and other channels are
 /// ignored except `variance.R`, `variance.G`, `variance.B` (or a part named `variance` with
-/// `R`, `G`, `B`), which become [`ExrImage::variance`]. String attributes are returned sorted by
+/// `R`, `G`, `B`), which become [`ExrImage::variance`], and the same of `deviation`
+/// ([`ExrImage::deviation`]). String attributes are returned sorted by
 /// name. A missing, non-EXR, truncated or damaged file, or one without R, G, B, is an error
 /// naming the file.
 pub fn read_exr(path: &Path) -> Result<ExrImage, ImageError> {
@@ -250,7 +280,8 @@ pub fn decode_exr(bytes: &[u8], name: &Path) -> Result<ExrImage, ImageError> {
         height: main.size.1,
     };
     let mean = samples.rgb(main)?;
-    let variance = variance_of(layers, main, &samples)?;
+    let variance = layer_of("variance", layers, main, &samples)?;
+    let deviation = layer_of("deviation", layers, main, &samples)?;
     let mut attributes: Vec<(String, String)> = image
         .attributes
         .other
@@ -271,6 +302,7 @@ pub fn decode_exr(bytes: &[u8], name: &Path) -> Result<ExrImage, ImageError> {
         height: samples.height,
         mean,
         variance,
+        deviation,
         attributes,
     })
 }
@@ -397,14 +429,16 @@ impl Samples<'_> {
     }
 }
 
-/// The variance: `variance.*` channels beside R, G, B, or a part named `variance`; `None` when
-/// the file has neither, an error when it has part of one.
-fn variance_of(
+/// The layer `name` (`variance` or `deviation`): `NAME.*` channels beside R, G, B, or a part
+/// named `NAME`; `None` when the file has neither, an error when it has part of one.
+fn layer_of(
+    name: &str,
     layers: &[DecodedLayer],
     main: &DecodedLayer,
     samples: &Samples<'_>,
 ) -> Result<Option<Vec<[f32; 3]>>, ImageError> {
-    let prefixed = ["variance.R", "variance.G", "variance.B"].map(|c| find(main, c));
+    let labels = ["R", "G", "B"].map(|c| format!("{name}.{c}"));
+    let prefixed = labels.each_ref().map(|c| find(main, c));
     match prefixed {
         [Some(r), Some(g), Some(b)] => Ok(Some(samples.triple([r, g, b])?)),
         [None, None, None] => {
@@ -412,12 +446,12 @@ fn variance_of(
                 l.attributes
                     .layer_name
                     .as_ref()
-                    .is_some_and(|n| n.bytes() == b"variance")
+                    .is_some_and(|n| n.bytes() == name.as_bytes())
             });
             match part {
                 Some(part) if part.size != main.size => Err(ImageError::format(
                     samples.name,
-                    "the variance part's size differs from the image's",
+                    format!("the {name} part's size differs from the image's"),
                 )),
                 Some(part) if ["R", "G", "B"].iter().all(|c| find(part, c).is_some()) => {
                     Ok(Some(samples.rgb(part)?))
@@ -426,16 +460,16 @@ fn variance_of(
             }
         }
         _ => {
-            let missing: Vec<&str> = ["variance.R", "variance.G", "variance.B"]
-                .into_iter()
+            let missing: Vec<&str> = labels
+                .iter()
                 .zip(prefixed)
                 .filter(|(_, c)| c.is_none())
-                .map(|(n, _)| n)
+                .map(|(n, _)| n.as_str())
                 .collect();
             Err(ImageError::format(
                 samples.name,
                 format!(
-                    "has a partial variance layer (missing {})",
+                    "has a partial {name} layer (missing {})",
                     missing.join(", ")
                 ),
             ))
@@ -549,6 +583,11 @@ mod tests {
                     .map(|i| DVec3::new(0.0, 1e-3 * i as f64, 0.25))
                     .collect()
             }),
+            deviation: variance.then(|| {
+                (0..width * height)
+                    .map(|i| DVec3::new(0.0, 0.1 + 1e-3 * i as f64, 0.7))
+                    .collect()
+            }),
         }
     }
 
@@ -572,6 +611,21 @@ mod tests {
         for (a, b) in f.variance.unwrap().iter().zip(&v) {
             assert_eq!([a.x as f32, a.y as f32, a.z as f32], *b);
         }
+        // The deviation is a bound: rounded up to the next f32 when f32 cannot hold it.
+        let d = back.deviation.clone().unwrap();
+        for (a, b) in f.deviation.unwrap().iter().zip(&d) {
+            for (x, y) in a.to_array().into_iter().zip(*b) {
+                let below = if y > 0.0 {
+                    f32::from_bits(y.to_bits() - 1)
+                } else {
+                    -1.0
+                };
+                assert!(f64::from(y) >= x && f64::from(below) < x, "{x} {y}");
+            }
+        }
+        // 0.1 rounds up to f32 anyway; 0.7 rounds down to nearest, so it is stored one up.
+        assert!(f64::from(0.7f32) < 0.7);
+        assert_eq!(d[0], [0.0, 0.1f32, f32::from_bits(0.7f32.to_bits() + 1)]);
         assert_eq!(back.attribute("mid"), Some("ünïcode ✓"));
         assert_eq!(back.attribute("alpha"), Some("first"));
         let names: Vec<&str> = back.attributes.iter().map(|(k, _)| k.as_str()).collect();
@@ -583,6 +637,7 @@ mod tests {
         let bytes = encode_exr(&film(false), &[], Path::new("t.exr")).unwrap();
         let back = decode_exr(&bytes, Path::new("t.exr")).unwrap();
         assert!(back.variance.is_none());
+        assert!(back.deviation.is_none());
         assert!(back.attributes.is_empty());
     }
 

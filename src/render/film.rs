@@ -17,6 +17,10 @@ pub struct Film {
     pub mean: Vec<DVec3>,
     /// Per-sample variance per pixel and channel (Welford's update, divided by `n - 1`).
     pub variance: Option<Vec<DVec3>>,
+    /// Per pixel and channel, the largest distance of one of its samples from its mean; kept
+    /// with the variance. A golden's measured bound on a sample (see
+    /// `compare::Golden`): a rare bright path the variance hardly shows still shows here.
+    pub deviation: Option<Vec<DVec3>>,
 }
 
 impl Film {

@@ -44,7 +44,7 @@ pub(super) trait Trace: Sync + Sized {
         job: &Job<'_, Self>,
         j: usize,
         means: &mut [DVec3],
-        variances: &mut [DVec3],
+        variances: &mut [Spread],
     );
 }
 
@@ -59,6 +59,27 @@ pub(super) struct Moments {
     same: [u64; 4],
     running_mean: [f64; 4],
     m2: [f64; 4],
+    /// Per channel, the smallest and the largest sample so far (kept when `VARIANCE`).
+    lo: [f64; 4],
+    hi: [f64; 4],
+}
+
+/// What a pixel's samples say of their spread, kept for goldens: the per-sample variance of each
+/// channel, and the largest distance of a sample from the mean (`max(hi - mean, mean - lo)`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Spread {
+    /// Per-sample variance (Welford's update, divided by `n - 1`).
+    pub(super) variance: DVec3,
+    /// The largest `|sample - mean|` of the pixel's samples.
+    pub(super) deviation: DVec3,
+}
+
+impl Spread {
+    /// No spread: every sample equal.
+    pub(super) const ZERO: Spread = Spread {
+        variance: DVec3::ZERO,
+        deviation: DVec3::ZERO,
+    };
 }
 
 impl Moments {
@@ -71,11 +92,13 @@ impl Moments {
             same: [u64::MAX; 4],
             running_mean: [0.0; 4],
             m2: [0.0; 4],
+            lo: [f64::INFINITY; 4],
+            hi: [f64::NEG_INFINITY; 4],
         }
     }
 
     /// Adds sample number `s` (from 0), in order: the sum, whether it equals the first, and
-    /// (when `VARIANCE`) Welford's update.
+    /// (when `VARIANCE`) Welford's update and the smallest and largest sample.
     #[inline(always)]
     // Lane loops index several arrays in step.
     #[allow(clippy::needless_range_loop)]
@@ -92,6 +115,8 @@ impl Moments {
                 let delta = colour[c] - self.running_mean[c];
                 self.running_mean[c] += delta / n;
                 self.m2[c] += delta * (colour[c] - self.running_mean[c]);
+                self.lo[c] = self.lo[c].min(colour[c]);
+                self.hi[c] = self.hi[c].max(colour[c]);
             }
         }
     }
@@ -99,13 +124,14 @@ impl Moments {
     /// The pixel's mean of `spp` samples into `mean`: the sum over the count, except when every
     /// sample equals the first (in every channel): then that colour exactly, since a sum of
     /// equal values over their count can be off by an ulp: (0.2 + 0.2 + 0.2) / 3 =
-    /// 0.20000000000000004. When `VARIANCE`, the unbiased variance into `variance`.
+    /// 0.20000000000000004. When `VARIANCE`, the unbiased variance and the largest deviation
+    /// from that mean into `spread`.
     #[inline(always)]
     pub(super) fn store<const VARIANCE: bool>(
         &self,
         spp: u32,
         mean: &mut DVec3,
-        variance: Option<&mut DVec3>,
+        spread: Option<&mut Spread>,
     ) {
         let [fx, fy, fz, _] = self.first;
         let [sx, sy, sz, _] = self.sum;
@@ -114,13 +140,21 @@ impl Moments {
         } else {
             DVec3::new(sx, sy, sz) / spp as f64
         };
-        if let (true, Some(variance)) = (VARIANCE, variance) {
+        if let (true, Some(spread)) = (VARIANCE, spread) {
             let [mx, my, mz, _] = self.m2;
-            *variance = if spp > 1 {
+            spread.variance = if spp > 1 {
                 DVec3::new(mx, my, mz) / (spp - 1) as f64
             } else {
                 DVec3::ZERO
             };
+            let m = *mean;
+            let [lx, ly, lz, _] = self.lo;
+            let [hx, hy, hz, _] = self.hi;
+            let (lo, hi) = (DVec3::new(lx, ly, lz), DVec3::new(hx, hy, hz));
+            // Zero when every sample is the mean (and for a pixel of no sample, whose bounds
+            // are still infinite).
+            let d = (hi - m).max(m - lo);
+            spread.deviation = DVec3::select(d.is_finite_mask(), d.max(DVec3::ZERO), DVec3::ZERO);
         }
     }
 }
@@ -217,7 +251,7 @@ impl<'a, T: Trace> Job<'a, T> {
     /// processor has it (four lanes per vector instead of two: the same operations, so the same
     /// bits).
     #[inline]
-    fn row<const VARIANCE: bool>(&self, j: usize, means: &mut [DVec3], variances: &mut [DVec3]) {
+    fn row<const VARIANCE: bool>(&self, j: usize, means: &mut [DVec3], variances: &mut [Spread]) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has AVX2, just checked.
@@ -239,7 +273,7 @@ impl<'a, T: Trace> Job<'a, T> {
         &self,
         j: usize,
         means: &mut [DVec3],
-        variances: &mut [DVec3],
+        variances: &mut [Spread],
     ) {
         self.row_any::<VARIANCE>(j, means, variances);
     }
@@ -251,7 +285,7 @@ impl<'a, T: Trace> Job<'a, T> {
         &self,
         j: usize,
         means: &mut [DVec3],
-        variances: &mut [DVec3],
+        variances: &mut [Spread],
     ) {
         if self.course.is_some() {
             return T::row::<VARIANCE, 3>(self, j, means, variances);
@@ -264,7 +298,7 @@ impl<'a, T: Trace> Job<'a, T> {
     }
 
     /// Renders every row into `mean` (and `variance` when it is not empty), rows in parallel.
-    pub(super) fn run(&self, mean: &mut [DVec3], variance: &mut [DVec3], progress: &ProgressBar) {
+    pub(super) fn run(&self, mean: &mut [DVec3], variance: &mut [Spread], progress: &ProgressBar) {
         let width = self.camera.width;
         if variance.is_empty() {
             mean.par_chunks_mut(width)
@@ -286,7 +320,7 @@ impl<'a, T: Trace> Job<'a, T> {
 }
 
 /// The film of `job`, row by row on this thread (the dispatch's path), as the bits of its means
-/// then its variances.
+/// then its variances and deviations.
 #[cfg(test)]
 pub(super) fn film_bits<T: Trace>(job: &Job<'_, T>) -> Vec<u64> {
     film_bits_with(job, |job, j, means, variances| {
@@ -298,11 +332,11 @@ pub(super) fn film_bits<T: Trace>(job: &Job<'_, T>) -> Vec<u64> {
 #[cfg(test)]
 pub(super) fn film_bits_with<T: Trace>(
     job: &Job<'_, T>,
-    row: impl Fn(&Job<'_, T>, usize, &mut [DVec3], &mut [DVec3]),
+    row: impl Fn(&Job<'_, T>, usize, &mut [DVec3], &mut [Spread]),
 ) -> Vec<u64> {
     let (width, height) = (job.camera.width, job.camera.height);
     let mut mean = vec![DVec3::ZERO; width * height];
-    let mut variance = vec![DVec3::ZERO; width * height];
+    let mut variance = vec![Spread::ZERO; width * height];
     for (j, (means, variances)) in mean
         .chunks_mut(width)
         .zip(variance.chunks_mut(width))
@@ -311,7 +345,8 @@ pub(super) fn film_bits_with<T: Trace>(
         row(job, j, means, variances);
     }
     mean.iter()
-        .chain(&variance)
+        .chain(variance.iter().map(|s| &s.variance))
+        .chain(variance.iter().map(|s| &s.deviation))
         .flat_map(|c| c.to_array().map(f64::to_bits))
         .collect()
 }

@@ -12,7 +12,7 @@ use glam::DVec3;
 
 use super::PixelSampler;
 use super::fixed_origin::{ALL_CANDIDATES, Candidates, Cone, FixedOrigin};
-use super::job::{Job, Moments, Trace};
+use super::job::{Job, Moments, Spread, Trace};
 use super::packet::{Directions, NO_HIT, WIDTH};
 use crate::geometry::Interval;
 use crate::scene::{Camera, Scene};
@@ -195,7 +195,7 @@ impl Pinhole {
         j: usize,
         pixels: [Pixel; PIXELS],
         means: [&mut DVec3; PIXELS],
-        mut variances: [Option<&mut DVec3>; PIXELS],
+        mut variances: [Option<&mut Spread>; PIXELS],
     ) {
         let (width, spp) = (job.camera.width, job.spp);
         let per = WIDTH / PIXELS;
@@ -260,7 +260,7 @@ impl Trace for Pinhole {
         job: &Job<'_, Self>,
         j: usize,
         means: &mut [DVec3],
-        variances: &mut [DVec3],
+        variances: &mut [Spread],
     ) {
         let width = job.camera.width;
         let pinhole = job.tracer;
@@ -274,7 +274,7 @@ impl Trace for Pinhole {
                 let [x, y, z, _] = pinhole.albedos[me];
                 means[i] = DVec3::new(x, y, z);
                 if VARIANCE {
-                    variances[i] = DVec3::ZERO;
+                    variances[i] = Spread::ZERO;
                 }
                 continue;
             }
@@ -314,11 +314,11 @@ impl Pinhole {
         j: usize,
         group: &[Pixel],
         means: &mut [DVec3],
-        variances: &mut [DVec3],
+        variances: &mut [Spread],
     ) {
         let pixels: [Pixel; PIXELS] = std::array::from_fn(|p| group[p]);
         let mut group_means = [DVec3::ZERO; PIXELS];
-        let mut group_variances = [DVec3::ZERO; PIXELS];
+        let mut group_variances = [Spread::ZERO; PIXELS];
         {
             let mean_refs = group_means.each_mut();
             let variance_refs = group_variances.each_mut().map(Some);

@@ -3,7 +3,7 @@ use std::io::IsTerminal;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::job::{Job, Moments, PixelJitter, Trace};
+use super::job::{Job, Moments, PixelJitter, Spread, Trace};
 use super::pinhole::Pinhole;
 use super::{Film, PixelSampler, trace};
 use crate::scene::{Background, Camera, Integrator, Material, PixelSampling, Profile, World};
@@ -15,7 +15,7 @@ pub struct RenderOptions {
     pub samples_per_pixel: u32,
     /// The seed of every pixel's random stream.
     pub seed: u64,
-    /// Keep the per-sample variance (for goldens).
+    /// Keep the per-sample variance and the largest sample deviation (for goldens).
     pub variance: bool,
     /// How sample positions are drawn.
     pub jitter: PixelJitter,
@@ -59,7 +59,7 @@ impl Trace for World {
         job: &Job<'_, Self>,
         j: usize,
         means: &mut [DVec3],
-        variances: &mut [DVec3],
+        variances: &mut [Spread],
     ) {
         let width = job.camera.width;
         let world = job.tracer;
@@ -206,7 +206,7 @@ pub fn render(
     };
     let mut mean = vec![DVec3::ZERO; width * height];
     let mut variance = if options.variance {
-        vec![DVec3::ZERO; width * height]
+        vec![Spread::ZERO; width * height]
     } else {
         Vec::new()
     };
@@ -229,7 +229,12 @@ pub fn render(
         height,
         samples_per_pixel: spp,
         mean,
-        variance: options.variance.then_some(variance),
+        deviation: options
+            .variance
+            .then(|| variance.iter().map(|s| s.deviation).collect()),
+        variance: options
+            .variance
+            .then(|| variance.iter().map(|s| s.variance).collect()),
     })
 }
 
@@ -259,6 +264,7 @@ mod tests {
             film.mean
                 .iter()
                 .chain(film.variance.as_deref().unwrap_or(&[]))
+                .chain(film.deviation.as_deref().unwrap_or(&[]))
                 .flat_map(|c| c.to_array().map(f64::to_bits))
                 .collect()
         };

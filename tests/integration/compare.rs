@@ -847,6 +847,7 @@ fn compare_with_a_golden_alone_uses_the_spp_it_records() {
                 .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
                 .collect()
         }),
+        deviation: None,
     };
     rtoracle::image_io::write_exr(&dir.path().join("bare.exr"), &film, &image.attributes).unwrap();
     let out = compare_cli(dir.path(), &["honest.png", "--golden", "bare.exr"]);

@@ -95,6 +95,7 @@ fn exr_comparator_tells_pixels_from_bytes() {
             samples_per_pixel: 4096,
             mean: to(&img.mean),
             variance: img.variance.as_deref().map(to),
+            deviation: img.deviation.as_deref().map(to),
         }
     };
     let copy = |name: &str, img: &ExrImage| {
@@ -160,6 +161,10 @@ fn assert_same_pixels(expected: &ExrImage, actual: &ExrImage, what: &str) {
     assert!(
         bits(expected.variance.as_ref().unwrap()) == bits(actual.variance.as_ref().unwrap()),
         "{what}: variances"
+    );
+    assert!(
+        bits(expected.deviation.as_ref().unwrap()) == bits(actual.deviation.as_ref().unwrap()),
+        "{what}: deviations"
     );
     for name in [ATTR_SCENE, ATTR_SCENE_SHA256, ATTR_SPP, ATTR_SEED] {
         assert_eq!(
@@ -339,6 +344,38 @@ fn embedded_goldens_are_the_files() {
     assert!(embedded_golden("no-such-scene").is_none());
 }
 
+/// The `deviation` layer against the variance, by two inequalities that hold for any `n`
+/// numbers with unbiased variance `s2` and largest distance `d` from their mean: the largest
+/// squared distance is at least the mean one, `d^2 >= s2 (n - 1) / n`, and at most Samuelson's
+/// `d <= sqrt(s2) (n - 1) / sqrt(n)`; both up to the layers' f32 rounding (the deviation rounded
+/// up, the variance and the mean to nearest).
+fn assert_deviation_fits_the_variance(scene: &str, g: &ExrImage) {
+    let deviation = g
+        .deviation
+        .as_ref()
+        .unwrap_or_else(|| panic!("{scene}: no deviation layer"));
+    let n: f64 = g.attribute(ATTR_SPP).unwrap().parse().unwrap();
+    let variance = g.variance.as_ref().unwrap();
+    for (i, (d, (s2, mu))) in deviation
+        .iter()
+        .zip(variance.iter().zip(&g.mean))
+        .enumerate()
+    {
+        for c in 0..3 {
+            let (d, s2, mu) = (d[c] as f64, s2[c] as f64, mu[c] as f64);
+            let slack = 1e-6 * (1.0 + mu.abs() + d);
+            assert!(
+                d * d >= s2 * (n - 1.0) / n * (1.0 - 1e-6) - slack,
+                "{scene} pixel {i} channel {c}: deviation {d} below the spread of variance {s2}"
+            );
+            assert!(
+                d <= s2.sqrt() * (n - 1.0) / n.sqrt() * (1.0 + 1e-6) + slack,
+                "{scene} pixel {i} channel {c}: deviation {d} beyond Samuelson's bound of {s2}"
+            );
+        }
+    }
+}
+
 #[test]
 fn goldens_have_the_documented_channels_and_attributes() {
     for scene in embedded_scenes() {
@@ -351,6 +388,7 @@ fn goldens_have_the_documented_channels_and_attributes() {
             "{scene}"
         );
         assert!(g.variance.is_some(), "{scene}");
+        assert_deviation_fits_the_variance(scene, &g);
         assert_eq!(g.attribute(ATTR_SCENE), Some(scene));
         // 4096 samples, or under the course's jittered sampling (weeks 9 and 10) the whole
         // passes over its strata that hold at least 4096: less than one more pass of week 10's
@@ -525,12 +563,23 @@ fn openexr_reads_the_goldens() {
         names.sort();
         assert_eq!(
             names,
-            ["B", "G", "R", "variance.B", "variance.G", "variance.R"],
+            [
+                "B",
+                "G",
+                "R",
+                "deviation.B",
+                "deviation.G",
+                "deviation.R",
+                "variance.B",
+                "variance.G",
+                "variance.R"
+            ],
             "{scene}"
         );
         for (layer, values) in [
             ("", &ours.mean),
             ("variance.", ours.variance.as_ref().unwrap()),
+            ("deviation.", ours.deviation.as_ref().unwrap()),
         ] {
             for (c, ch) in ["R", "G", "B"].into_iter().enumerate() {
                 let info = &channels[&format!("{layer}{ch}")];
@@ -663,6 +712,7 @@ fn golden_check_names_the_differing_pixel() {
         samples_per_pixel: 2,
         mean: to_film(&img.mean),
         variance: Some(to_film(img.variance.as_ref().unwrap())),
+        deviation: img.deviation.as_deref().map(to_film),
     };
     let tampered = encode_exr(&film, &img.attributes, Path::new("x")).unwrap();
     std::fs::write(dir.path().join("g/week04-quad.exr"), tampered).unwrap();
