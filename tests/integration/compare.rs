@@ -860,3 +860,56 @@ fn compare_with_a_golden_alone_uses_the_spp_it_records() {
         "{text}"
     );
 }
+
+/// A `--golden` whose `deviation` layer holds a negative or NaN distance (not a bound on
+/// anything) is refused before any work, one line naming the file; the same golden with its
+/// deviations intact passes an honest render.
+#[test]
+fn compare_refuses_a_golden_whose_deviation_is_not_a_distance() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = rtoracle::scene::builtin("week04-quad").unwrap();
+    write(
+        dir.path(),
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 20, 8),
+    );
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("golden/week04-quad.exr");
+    let image = rtoracle::image_io::read_exr(&committed).unwrap();
+    let widen = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
+        v.iter()
+            .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+            .collect()
+    };
+    let film = |deviation: Vec<glam::DVec3>| rtoracle::render::Film {
+        width: image.width,
+        height: image.height,
+        samples_per_pixel: 4096,
+        mean: widen(&image.mean),
+        variance: image.variance.as_deref().map(widen),
+        deviation: Some(deviation),
+    };
+    let intact = widen(image.deviation.as_deref().unwrap());
+    for (name, bad) in [("negative.exr", -0.5), ("nan.exr", f64::NAN)] {
+        let mut deviation = intact.clone();
+        deviation[7].y = bad;
+        let path = dir.path().join(name);
+        rtoracle::image_io::write_exr(&path, &film(deviation), &image.attributes).unwrap();
+        assert_bad_input(
+            &compare_cli(dir.path(), &["honest.png", "--golden", name]),
+            &format!("{name}: golden: the golden has a deviation that is not a finite distance"),
+        );
+    }
+    rtoracle::image_io::write_exr(
+        &dir.path().join("intact.exr"),
+        &film(intact),
+        &image.attributes,
+    )
+    .unwrap();
+    let out = compare_cli(dir.path(), &["honest.png", "--golden", "intact.exr"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}
