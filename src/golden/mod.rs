@@ -191,7 +191,7 @@ pub fn golden_of(
             let (bytes, image) = if image.attribute(ATTR_SCENE) == Some(scene.name.as_str()) {
                 (bytes, image)
             } else {
-                let bytes = encode::encode_golden(&film_of(&image, spp), scene, GOLDEN_SEED)?;
+                let bytes = encode::encode_golden(&image.to_film(spp), scene, GOLDEN_SEED)?;
                 let image = decode_exr(&bytes, path)?;
                 (bytes, image)
             };
@@ -264,24 +264,6 @@ pub fn golden_of(
         source,
         origin,
     })
-}
-
-/// The film a golden image holds (its f32 values widened exactly, so encoding it again gives the
-/// same values).
-fn film_of(image: &ExrImage, spp: u32) -> Film {
-    let widen = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
-        v.iter()
-            .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
-            .collect()
-    };
-    Film {
-        width: image.width,
-        height: image.height,
-        samples_per_pixel: spp,
-        mean: widen(&image.mean),
-        variance: image.variance.as_deref().map(widen),
-        deviation: image.deviation.as_deref().map(widen),
-    }
 }
 
 /// The embedded golden of a built-in `scene` when it was made from the scene as it is now (hash,

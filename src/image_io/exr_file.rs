@@ -42,6 +42,25 @@ pub struct ExrImage {
 }
 
 impl ExrImage {
+    /// The film this image holds, as `samples_per_pixel` samples per pixel: its f32 values
+    /// widened exactly to f64 (so writing it again gives the same values), its `variance` and
+    /// `deviation` layers when it has them.
+    pub fn to_film(&self, samples_per_pixel: u32) -> Film {
+        let widen = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
+            v.iter()
+                .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+                .collect()
+        };
+        Film {
+            width: self.width,
+            height: self.height,
+            samples_per_pixel,
+            mean: widen(&self.mean),
+            variance: self.variance.as_deref().map(widen),
+            deviation: self.deviation.as_deref().map(widen),
+        }
+    }
+
     /// The value of the string attribute `name`, if the header has it.
     pub fn attribute(&self, name: &str) -> Option<&str> {
         self.attributes
@@ -630,6 +649,19 @@ mod tests {
         assert_eq!(back.attribute("alpha"), Some("first"));
         let names: Vec<&str> = back.attributes.iter().map(|(k, _)| k.as_str()).collect();
         assert_eq!(names, ["alpha", "mid", "zeta"]);
+    }
+
+    /// Widening is exact: the film an EXR holds, written again, gives the same bytes.
+    #[test]
+    fn to_film_writes_back_the_same_bytes() {
+        let bytes = encode_exr(&film(true), &attrs(), Path::new("t.exr")).unwrap();
+        let back = decode_exr(&bytes, Path::new("t.exr")).unwrap();
+        let again = back.to_film(4);
+        assert!(again.deviation.is_some() && again.variance.is_some());
+        assert_eq!(
+            encode_exr(&again, &attrs(), Path::new("t.exr")).unwrap(),
+            bytes
+        );
     }
 
     #[test]

@@ -806,18 +806,24 @@ fn the_command_judges_renders_of_a_scene_file_at_its_sample_count() {
     );
 }
 
+/// Writes `honest.png` into `dir` (week04-quad, 20 spp, seed 8) and returns the committed
+/// golden of that scene.
+fn honest_quad_and_its_golden(dir: &Path) -> PathBuf {
+    let d = rtoracle::scene::builtin("week04-quad").unwrap();
+    write(
+        dir,
+        "honest.png",
+        &render_with_mistake(&d, Mistake::Honest, 20, 8),
+    );
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("golden/week04-quad.exr")
+}
+
 /// `--golden` alone with a built-in scene's golden judges at that scene's spp (20), and a golden
 /// that records no scene at 20 with a line saying it does not know.
 #[test]
 fn compare_with_a_golden_alone_uses_the_spp_it_records() {
     let dir = tempfile::tempdir().unwrap();
-    let d = rtoracle::scene::builtin("week04-quad").unwrap();
-    write(
-        dir.path(),
-        "honest.png",
-        &render_with_mistake(&d, Mistake::Honest, 20, 8),
-    );
-    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("golden/week04-quad.exr");
+    let committed = honest_quad_and_its_golden(dir.path());
     let out = compare_cli(
         dir.path(),
         &["honest.png", "--golden", committed.to_str().unwrap()],
@@ -834,20 +840,8 @@ fn compare_with_a_golden_alone_uses_the_spp_it_records() {
     let mut image = rtoracle::image_io::read_exr(&committed).unwrap();
     image.attributes.retain(|(k, _)| k == "rtoracle.spp");
     let film = rtoracle::render::Film {
-        width: image.width,
-        height: image.height,
-        samples_per_pixel: 4096,
-        mean: image
-            .mean
-            .iter()
-            .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
-            .collect(),
-        variance: image.variance.as_ref().map(|v| {
-            v.iter()
-                .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
-                .collect()
-        }),
         deviation: None,
+        ..image.to_film(4096)
     };
     rtoracle::image_io::write_exr(&dir.path().join("bare.exr"), &film, &image.attributes).unwrap();
     let out = compare_cli(dir.path(), &["honest.png", "--golden", "bare.exr"]);
@@ -867,28 +861,13 @@ fn compare_with_a_golden_alone_uses_the_spp_it_records() {
 #[test]
 fn compare_refuses_a_golden_whose_deviation_is_not_a_distance() {
     let dir = tempfile::tempdir().unwrap();
-    let d = rtoracle::scene::builtin("week04-quad").unwrap();
-    write(
-        dir.path(),
-        "honest.png",
-        &render_with_mistake(&d, Mistake::Honest, 20, 8),
-    );
-    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("golden/week04-quad.exr");
+    let committed = honest_quad_and_its_golden(dir.path());
     let image = rtoracle::image_io::read_exr(&committed).unwrap();
-    let widen = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
-        v.iter()
-            .map(|p| glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()))
-            .collect()
-    };
     let film = |deviation: Vec<glam::DVec3>| rtoracle::render::Film {
-        width: image.width,
-        height: image.height,
-        samples_per_pixel: 4096,
-        mean: widen(&image.mean),
-        variance: image.variance.as_deref().map(widen),
         deviation: Some(deviation),
+        ..image.to_film(4096)
     };
-    let intact = widen(image.deviation.as_deref().unwrap());
+    let intact = image.to_film(4096).deviation.unwrap();
     for (name, bad) in [("negative.exr", -0.5), ("nan.exr", f64::NAN)] {
         let mut deviation = intact.clone();
         deviation[7].y = bad;

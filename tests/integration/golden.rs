@@ -83,21 +83,7 @@ fn exr_comparator_tells_pixels_from_bytes() {
     let stored = snapshot_file("week04-sphere");
     let meta = stored.with_extension("");
     let image = read_exr(&stored).unwrap();
-    let film_of = |img: &ExrImage| {
-        let to = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
-            v.iter()
-                .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-                .collect()
-        };
-        rtoracle::render::Film {
-            width: img.width,
-            height: img.height,
-            samples_per_pixel: 4096,
-            mean: to(&img.mean),
-            variance: img.variance.as_deref().map(to),
-            deviation: img.deviation.as_deref().map(to),
-        }
-    };
+    let film_of = |img: &ExrImage| img.to_film(4096);
     let copy = |name: &str, img: &ExrImage| {
         let bytes = encode_exr(&film_of(img), &img.attributes, Path::new(name)).unwrap();
         let snap = dir.path().join(format!("{name}.snap"));
@@ -701,19 +687,7 @@ fn golden_check_names_the_differing_pixel() {
     let bytes = golden_bytes("week04-quad", 2);
     let mut img = decode_exr(&bytes, Path::new("x")).unwrap();
     img.mean[5 * 400 + 17][1] += 0.25;
-    let to_film = |v: &[[f32; 3]]| -> Vec<glam::DVec3> {
-        v.iter()
-            .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-            .collect()
-    };
-    let film = rtoracle::render::Film {
-        width: img.width,
-        height: img.height,
-        samples_per_pixel: 2,
-        mean: to_film(&img.mean),
-        variance: Some(to_film(img.variance.as_ref().unwrap())),
-        deviation: img.deviation.as_deref().map(to_film),
-    };
+    let film = img.to_film(2);
     let tampered = encode_exr(&film, &img.attributes, Path::new("x")).unwrap();
     std::fs::write(dir.path().join("g/week04-quad.exr"), tampered).unwrap();
     let out = run_in(
