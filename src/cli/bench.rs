@@ -5,6 +5,7 @@
 //! variant in [`Area`] and one arm in [`run`]. The helpers below (CPU time, a child's peak
 //! memory, the machine's load) are shared by all of them.
 
+mod baseline;
 mod render;
 
 use std::process::{Command, ExitCode};

@@ -963,3 +963,69 @@ fn a_texture_file_is_read_relative_to_the_scene_file() {
         "{text}"
     );
 }
+
+/// `bench render` times four scenes, week 4's, week 6's dielectric (seven bounces of mirror,
+/// glass and Lambertian) and week 8's Phong (shadow rays and BRDFs), against `bench/baseline.c`,
+/// and reports that the C loop rendered each one's film bit for bit; and the films on all
+/// threads are the one-thread films. Without a C compiler the C columns say why, and the rest
+/// still runs.
+#[test]
+fn bench_render_finds_the_c_loops_films_the_same_bit_for_bit() {
+    let has_cc = std::process::Command::new("cc")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    let run = |cc: &str| {
+        let out = rtoracle()
+            .args(["bench", "render", "--runs", "1", "--memory-width", "16"])
+            .args(["--cc", cc])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        stdout
+    };
+    let scenes = [
+        "week04-sphere",
+        "week04-quad",
+        "week06-dielectric",
+        "week08-phong",
+    ];
+    if has_cc {
+        let stdout = run("cc");
+        for scene in scenes {
+            let row = stdout
+                .lines()
+                .find(|l| l.trim_start().starts_with(scene))
+                .unwrap_or_else(|| panic!("no row for {scene}: {stdout}"));
+            assert!(row.ends_with("x  yes"), "{row}");
+        }
+        assert!(
+            stdout.contains("same film as on one thread: yes")
+                || stdout.contains("this machine has one core"),
+            "{stdout}"
+        );
+    } else {
+        eprintln!("SKIPPED: no `cc` here, the C loop's films were not compared");
+    }
+    let stdout = run("/nonexistent/cc");
+    for scene in scenes {
+        let row = stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(scene))
+            .unwrap();
+        assert!(
+            row.contains("skipped: no C compiler '/nonexistent/cc'"),
+            "{row}"
+        );
+    }
+    assert!(
+        stdout.contains("not measured (the C loop was skipped)"),
+        "{stdout}"
+    );
+}
