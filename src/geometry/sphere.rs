@@ -30,7 +30,7 @@ impl Sphere {
     /// When an intermediate would overflow or underflow (inputs near `f64::MAX` or far below 1),
     /// the problem is solved again with the positions and the radius scaled by one power of two
     /// and the direction by another, which is exact, and `t` is scaled back.
-    #[inline]
+    #[inline(always)]
     pub fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
         match Self::solve(ray.origin - self.center, ray.direction, self.radius) {
             Ok(roots) => roots,
@@ -39,7 +39,7 @@ impl Sphere {
     }
 
     /// The roots for `f = O - C`, or `Err` when an intermediate over- or underflowed.
-    #[inline]
+    #[inline(always)]
     fn solve(f: DVec3, d: DVec3, radius: f64) -> Result<Option<(f64, f64)>, ()> {
         let r2 = radius * radius;
         roots_of(f, d, d.dot(d), f.dot(d), r2, f.dot(f) - r2)
@@ -87,7 +87,7 @@ impl Sphere {
     }
 
     /// The root the course takes: the near one if the interval surrounds it, else the far one.
-    #[inline]
+    #[inline(always)]
     fn pick_root(&self, ray: &Ray, interval: Interval) -> Option<f64> {
         let (near, far) = self.roots(ray)?;
         if interval.surrounds(near) {
@@ -199,7 +199,7 @@ impl Shape for Sphere {
         Some(HitRecord::new(ray, t, outward, uv))
     }
 
-    #[inline]
+    #[inline(always)]
     fn hit_t(&self, ray: &Ray, interval: Interval) -> Option<f64> {
         self.pick_root(ray, interval)
     }

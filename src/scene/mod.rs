@@ -15,6 +15,7 @@ mod material;
 mod object;
 mod profile;
 mod settings;
+mod sphere_set;
 mod texture;
 mod validate;
 mod world;

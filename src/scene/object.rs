@@ -85,6 +85,23 @@ impl Scene {
         best
     }
 
+    /// How many objects, tested one by one in order, are hit within `interval` (not shrunk),
+    /// stopping at `limit` (the test follows the increment, so a first hit counts even when
+    /// `limit` is 0).
+    #[inline]
+    pub fn count_hits(&self, ray: &Ray, interval: Interval, limit: usize) -> usize {
+        let mut count = 0;
+        for o in &self.objects {
+            if o.shape.hit_t(ray, interval).is_some() {
+                count += 1;
+                if count >= limit {
+                    break;
+                }
+            }
+        }
+        count
+    }
+
     /// The full record of the closest hit, its `material` set to the object's material index.
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         let mut best = None;

@@ -1,10 +1,12 @@
 //! Everything a render reads ([`World`]): the objects and materials, the images of the textures
-//! prepared for the profile, the point lights, the settings, and (for large scenes) a bounding
-//! volume hierarchy.
+//! prepared for the profile, the point lights, the settings, and, for the closest-hit and
+//! occlusion queries, a bounding volume hierarchy (large scenes) or the spheres side by side
+//! (small scenes of static spheres).
 
 use glam::DVec3;
 
 use super::bvh::{BVH_MIN_OBJECTS, Bvh};
+use super::sphere_set::SphereSet;
 use super::{Material, Object, Profile, RenderSettings, Scene, TextureImage};
 use crate::geometry::{Interval, Ray};
 
@@ -38,6 +40,9 @@ pub struct World {
     /// division from it); 1 unless set.
     pub samples_per_pixel: u32,
     bvh: Option<Bvh>,
+    /// The spheres side by side, when every object is a static sphere and there is no
+    /// hierarchy.
+    spheres: Option<SphereSet>,
 }
 
 impl std::ops::Deref for World {
@@ -102,6 +107,11 @@ impl World {
         } else {
             None
         };
+        let spheres = if bvh.is_none() {
+            SphereSet::new(&scene)
+        } else {
+            None
+        };
         Self {
             scene,
             profile,
@@ -111,6 +121,7 @@ impl World {
             moving,
             samples_per_pixel: 1,
             bvh,
+            spheres,
         }
     }
 
@@ -125,33 +136,30 @@ impl World {
     }
 
     /// The closest hit's `t` and object index: exactly [`Scene::closest`]'s answer, through the
-    /// hierarchy when there is one.
-    #[inline]
+    /// hierarchy when there is one, or the side-by-side list of a scene of static spheres.
+    #[inline(always)]
     pub fn closest(&self, ray: &Ray, interval: Interval) -> Option<(f64, usize)> {
         match &self.bvh {
             Some(bvh) => bvh.closest(&self.scene, ray, interval),
-            None => self.scene.closest(ray, interval),
+            None => match self.spheres.as_ref().and_then(|s| s.closest(ray, interval)) {
+                Some(answer) => answer,
+                None => self.scene.closest(ray, interval),
+            },
         }
     }
 
     /// How many objects `ray` hits within `interval`, each tested against the whole interval (the
-    /// course's occlusion test), counting up to `limit`.
-    #[inline]
+    /// course's occlusion test), counting up to `limit`: exactly [`Scene::count_hits`]'s answer.
+    #[inline(always)]
     pub fn count_hits(&self, ray: &Ray, interval: Interval, limit: usize) -> usize {
         match &self.bvh {
             Some(bvh) => bvh.count_hits(&self.scene, ray, interval, limit),
-            None => {
-                let mut count = 0;
-                for o in &self.scene.objects {
-                    if crate::geometry::Shape::hit_t(&o.shape, ray, interval).is_some() {
-                        count += 1;
-                        if count >= limit {
-                            break;
-                        }
-                    }
-                }
-                count
-            }
+            None => match self.spheres.as_ref() {
+                Some(set) => set
+                    .count_hits(ray, interval, limit)
+                    .unwrap_or_else(|| self.scene.count_hits(ray, interval, limit)),
+                None => self.scene.count_hits(ray, interval, limit),
+            },
         }
     }
 
