@@ -107,14 +107,37 @@ pub(crate) fn load_average() -> Option<f64> {
         .ok()
 }
 
+/// Starts `command` so that an interruption (Ctrl-C, SIGTERM) kills it, and whatever it
+/// started, before the cleanups remove what it writes into: in a process group of its own,
+/// under the spawn gate, with the kill registered before the gate opens. The guard unregisters the kill; keep it until the child has been waited for.
+pub(crate) fn spawn_killed_on_interrupt(
+    command: &mut Command,
+) -> anyhow::Result<(std::process::Child, rtoracle::interrupt::CleanupGuard)> {
+    use std::os::unix::process::CommandExt;
+    let gate = rtoracle::interrupt::spawn_gate().context("interrupted")?;
+    // A group of its own, so the kill reaches what it starts too (a compiler's cc1 and as).
+    let child = command
+        .process_group(0)
+        .spawn()
+        .with_context(|| format!("cannot start {command:?}"))?;
+    let pid = child.id() as libc::pid_t;
+    let kill = rtoracle::interrupt::on_interrupt(move || {
+        // SAFETY: kill(2) on our own child's process group; at worst the child has exited
+        // and not been reaped, which keeps the group's id from being reused.
+        unsafe {
+            libc::kill(-pid, libc::SIGKILL);
+        }
+    });
+    drop(gate);
+    Ok((child, kill))
+}
+
 /// Runs `command` to completion and returns its exit status and its peak resident set size in
 /// bytes, from `wait4`'s resource usage of that one child (`ru_maxrss`, kilobytes on Linux).
 pub(crate) fn run_measuring_peak_rss(
     command: &mut Command,
 ) -> anyhow::Result<(std::process::ExitStatus, u64)> {
-    let child = command
-        .spawn()
-        .with_context(|| format!("cannot start {command:?}"))?;
+    let (child, _kill) = spawn_killed_on_interrupt(command)?;
     let pid = child.id() as libc::pid_t;
     let mut status: libc::c_int = 0;
     // SAFETY: zeroed memory is a valid `rusage` (plain integers and timevals).

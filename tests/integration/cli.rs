@@ -678,6 +678,40 @@ fn sigint_and_sigterm_mid_run_leave_nothing_behind() {
     }
 }
 
+/// `bench render` builds its C loop and measures memory in temporary folders, with a compiler
+/// and `rtoracle render` as children: interrupted while it times the reference, while it builds
+/// or runs the C loop, or while it measures memory, it exits with the signal's code and leaves
+/// nothing in its TMPDIR.
+#[test]
+fn an_interrupted_bench_render_leaves_nothing_behind() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let args = ["bench", "render", "--runs", "1", "--memory-width", "600"];
+    for (after, signal, code) in [
+        (400, SIGINT, 130),
+        (1300, SIGTERM, 143),
+        (1800, SIGINT, 130),
+        (2600, SIGINT, 130),
+        (3600, SIGTERM, 143),
+    ] {
+        let (got, left_in_tmp) = interrupted(root, &args, Duration::from_millis(after), signal);
+        // A run that finished before the signal exits 0; it must leave nothing either.
+        assert!(
+            got == Some(code) || got == Some(0),
+            "after {after} ms: {got:?}"
+        );
+        assert!(
+            left_in_tmp.is_empty(),
+            "after {after} ms: TMPDIR keeps {left_in_tmp:?}"
+        );
+        assert!(
+            names(root).is_empty(),
+            "after {after} ms: left {:?}",
+            names(root)
+        );
+    }
+}
+
 #[test]
 fn sigint_during_check_and_grade_leaves_no_sandbox_folder() {
     let tmp = tempfile::tempdir().unwrap();

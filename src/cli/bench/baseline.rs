@@ -20,7 +20,7 @@ use rtoracle::scene::{
     Profile, Texture, World,
 };
 
-use super::process_cpu_time;
+use super::{process_cpu_time, spawn_killed_on_interrupt};
 
 /// The C baseline's source, built into the binary so the benchmark runs anywhere.
 const BASELINE_C: &str = include_str!("../../../bench/baseline.c");
@@ -224,24 +224,36 @@ type RenderFn = unsafe extern "C" fn(*const CSceneHeader, u32, u64, *mut f64) ->
 pub(super) struct CBaseline {
     library: libloading::Library,
     _dir: tempfile::TempDir,
+    /// Removes the folder if the benchmark is interrupted.
+    _dir_guard: rtoracle::interrupt::CleanupGuard,
 }
 
 impl CBaseline {
     /// Builds `bench/baseline.c` with `cc -O3 -ffp-contract=off` (no fused multiply-adds, as
     /// the reference has none) into a shared library and loads it; `Err` says why it could not.
     pub(super) fn build(cc: &str) -> Result<Self, String> {
-        let dir =
-            tempfile::tempdir().map_err(|e| format!("cannot make a temporary folder: {e}"))?;
+        let (dir, dir_guard) =
+            rtoracle::interrupt::create_temporary(tempfile::tempdir, |d| d.path())
+                .map_err(|e| format!("cannot make a temporary folder: {e}"))?;
         let source = dir.path().join("baseline.c");
-        let library = std::path::PathBuf::from("/tmp/keep-libbaseline.so");
+        let library = dir.path().join("libbaseline.so");
         std::fs::write(&source, BASELINE_C).map_err(|e| format!("cannot write the source: {e}"))?;
-        let compiled = std::process::Command::new(cc)
+        let mut command = std::process::Command::new(cc);
+        command
             .args(["-O3", "-ffp-contract=off", "-shared", "-fPIC", "-o"])
             .arg(&library)
             .arg(&source)
             .arg("-lm")
-            .output()
-            .map_err(|e| format!("no C compiler '{cc}' ({e})"))?;
+            // The compiler's own temporary files go into the folder, removed with it.
+            .env("TMPDIR", dir.path())
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        let (child, _kill) = spawn_killed_on_interrupt(&mut command)
+            .map_err(|e| format!("no C compiler '{cc}' ({})", e.root_cause()))?;
+        let compiled = child
+            .wait_with_output()
+            .map_err(|e| format!("cannot wait for '{cc}': {e}"))?;
         if !compiled.status.success() {
             let stderr = String::from_utf8_lossy(&compiled.stderr);
             return Err(format!(
@@ -253,7 +265,11 @@ impl CBaseline {
         // initialisers and defines nothing that clashes with this process's symbols.
         let library = unsafe { libloading::Library::new(&library) }
             .map_err(|e| format!("cannot load what '{cc}' built: {e}"))?;
-        Ok(Self { library, _dir: dir })
+        Ok(Self {
+            library,
+            _dir: dir,
+            _dir_guard: dir_guard,
+        })
     }
 
     /// Renders `scene` at `spp` with `seed` on this thread: the film's means (row-major, three

@@ -359,7 +359,8 @@ fn time_c_loop(scenes: &[Prepared], one: &[Timing], cc: &str, runs: u32) -> Vec<
 /// not depend on the sample count), against the budget; and of a tiny render, for the fixed part.
 fn memory(width: u32) -> anyhow::Result<()> {
     let exe = std::env::current_exe().context("cannot find the rtoracle executable")?;
-    let dir = tempfile::tempdir().context("cannot make a temporary folder")?;
+    let (dir, _dir_guard) = rtoracle::interrupt::create_temporary(tempfile::tempdir, |d| d.path())
+        .context("cannot make a temporary folder")?;
     let measure = |w: u32| -> anyhow::Result<u64> {
         let out = dir.path().join(format!("memory-{w}.png"));
         let mut command = Command::new(&exe);
