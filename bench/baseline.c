@@ -346,8 +346,13 @@ static inline vec3 albedo(const world *w, vec3 o, vec3 d) {
     return colour_at(s->m, h.point);
 }
 
-/* Weeks 5 to 7: `Le a + Li a` with `Le` the unoccluded lights' `E min(1, 1/d)`. */
-static inline vec3 direct(const world *w, vec3 o, vec3 d, pcg *rng) {
+/*
+ * Weeks 5 to 10's path: at each hit in (1e-6, DBL_MAX), a light returns its emission, a miss the
+ * background; otherwise weeks 5 to 7 add `Le a` (`Le` the unoccluded lights' `E min(1, 1/d)`)
+ * and weigh what comes back by `a`, week 8 adds `sum BRDF(d, c - P) E c(n . (c - P))` and weighs
+ * what comes back by `BRDF(d, w) c(n . w)`.
+ */
+static inline vec3 path(const world *w, vec3 o, vec3 d, pcg *rng) {
     vec3 total = v3(0.0, 0.0, 0.0), weight = v3(1.0, 1.0, 1.0);
     for (int depth = 0; depth < w->in->max_depth; depth++) {
         double t;
@@ -357,46 +362,30 @@ static inline vec3 direct(const world *w, vec3 o, vec3 d, pcg *rng) {
         surface h = surface_of(s, o, d, t);
         vec3 next;
         if (!scatter(s->m, d, &h, rng, &next)) return add(total, vmul(weight, s->m->colour));
-        vec3 a = colour_at(s->m, h.point);
         vec3 le = v3(0.0, 0.0, 0.0);
-        for (int l = 0; l < w->n_lights; l++) {
-            const object *light = &w->objs[w->lights[l]];
-            vec3 to = sub(light->center, h.point);
-            double dist = sqrt(dot(to, to));
-            if (dist == 0.0 || occluded(w, h.point, light->center)) continue;
-            le = add(le, mul(light->m->colour, fmin(1.0, 1.0 / dist)));
+        if (w->in->integrator == BL_DIRECT) {
+            vec3 a = colour_at(s->m, h.point);
+            for (int l = 0; l < w->n_lights; l++) {
+                const object *light = &w->objs[w->lights[l]];
+                vec3 to = sub(light->center, h.point);
+                double dist = sqrt(dot(to, to));
+                if (dist == 0.0 || occluded(w, h.point, light->center)) continue;
+                le = add(le, mul(light->m->colour, fmin(1.0, 1.0 / dist)));
+            }
+            total = add(total, vmul(weight, vmul(le, a)));
+            weight = vmul(weight, a);
+        } else {
+            vec3 n = h.normal;
+            for (int l = 0; l < w->n_lights; l++) {
+                const object *light = &w->objs[w->lights[l]];
+                vec3 to = sub(light->center, h.point);
+                if (occluded(w, h.point, light->center)) continue;
+                vec3 f = brdf(w->in, s->m, d, to, &h);
+                le = add(le, mul(vmul(f, light->m->colour), cutoff(dot(n, to))));
+            }
+            total = add(total, vmul(weight, le));
+            weight = vmul(weight, mul(brdf(w->in, s->m, d, next, &h), cutoff(dot(n, next))));
         }
-        total = add(total, vmul(weight, vmul(le, a)));
-        weight = vmul(weight, a);
-        if (weight.x == 0.0 && weight.y == 0.0 && weight.z == 0.0) break;
-        o = h.point;
-        d = next;
-    }
-    return total;
-}
-
-/* Week 8: `sum BRDF(d, c - P) E c(n . (c - P))` plus `BRDF(d, w) Li c(n . w)`. */
-static inline vec3 brdf_path(const world *w, vec3 o, vec3 d, pcg *rng) {
-    vec3 total = v3(0.0, 0.0, 0.0), weight = v3(1.0, 1.0, 1.0);
-    for (int depth = 0; depth < w->in->max_depth; depth++) {
-        double t;
-        int k = closest(w, o, d, &t);
-        if (k < 0) return add(total, vmul(weight, background(w->in, d)));
-        const object *s = &w->objs[k];
-        surface h = surface_of(s, o, d, t);
-        vec3 next;
-        if (!scatter(s->m, d, &h, rng, &next)) return add(total, vmul(weight, s->m->colour));
-        vec3 n = h.normal;
-        vec3 le = v3(0.0, 0.0, 0.0);
-        for (int l = 0; l < w->n_lights; l++) {
-            const object *light = &w->objs[w->lights[l]];
-            vec3 to = sub(light->center, h.point);
-            if (occluded(w, h.point, light->center)) continue;
-            vec3 f = brdf(w->in, s->m, d, to, &h);
-            le = add(le, mul(vmul(f, light->m->colour), cutoff(dot(n, to))));
-        }
-        total = add(total, vmul(weight, le));
-        weight = vmul(weight, mul(brdf(w->in, s->m, d, next, &h), cutoff(dot(n, next))));
         if (weight.x == 0.0 && weight.y == 0.0 && weight.z == 0.0) break;
         o = h.point;
         d = next;
@@ -423,10 +412,8 @@ static void render(const world *w, uint32_t spp, uint64_t seed, double *film) {
                 vec3 colour;
                 if (in->integrator == BL_ALBEDO)
                     colour = albedo(w, in->center, d);
-                else if (in->integrator == BL_DIRECT)
-                    colour = direct(w, in->center, d, &rng);
                 else
-                    colour = brdf_path(w, in->center, d, &rng);
+                    colour = path(w, in->center, d, &rng);
                 sum = add(sum, colour);
                 if (s == 0)
                     first = colour;
