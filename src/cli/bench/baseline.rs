@@ -3,8 +3,8 @@
 //! C compiler and loaded into this process.
 //!
 //! It is loaded rather than run as a program so that it can call the reference's own `pow`
-//! (the `libm` crate's, which rounds differently from the C library's on about 3% of week 8's
-//! calls): the same function on the same arguments, so the two films can be compared bit for
+//! (the `libm` crate's, which rounds differently from the C library's on about 10% of the
+//! arguments week 8 can meet): the same function on the same arguments, so the two films can be compared bit for
 //! bit. `libloading` does the loading (the maintained wrapper of `dlopen`, rather than our own
 //! calls into `libc`).
 //!
