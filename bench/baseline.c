@@ -16,8 +16,9 @@
  * `pow` is the one library function on the paths of these scenes whose implementations round
  * differently: the system's (glibc's) and the one rtoracle uses (the `libm` crate, a port of
  * FreeBSD's msun, for the same bits on every platform) disagree in the last bit on about 10% of
- * the arguments week 8's Phong can meet (a base uniform in [0, 1), its exponents). rtoracle therefore hands its `pow` to this loop, which calls it
- * where the reference does: the same work, the same function, through a pointer.
+ * the arguments week 8's Phong can meet (a base uniform in [0, 1), its exponents). rtoracle
+ * therefore hands its `pow` to this loop, which calls it where the reference does: the same
+ * work, the same function, through a pointer.
  *
  * Build: cc -O3 -ffp-contract=off -shared -fPIC -o libbaseline.so baseline.c -lm
  * (the benchmark builds it so, in a temporary folder, and loads it).

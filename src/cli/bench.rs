@@ -109,7 +109,8 @@ pub(crate) fn load_average() -> Option<f64> {
 
 /// Starts `command` so that an interruption (Ctrl-C, SIGTERM) kills it, and whatever it
 /// started, before the cleanups remove what it writes into: in a process group of its own,
-/// under the spawn gate, with the kill registered before the gate opens. The guard unregisters the kill; keep it until the child has been waited for.
+/// under the spawn gate, with the kill registered before the gate opens. The guard unregisters
+/// the kill; keep it until the child has been waited for.
 pub(crate) fn spawn_killed_on_interrupt(
     command: &mut Command,
 ) -> anyhow::Result<(std::process::Child, rtoracle::interrupt::CleanupGuard)> {
