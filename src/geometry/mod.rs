@@ -46,7 +46,7 @@ pub trait Shape {
 /// The unit vector of `v`, computed as `v / |v|` (component-wise division, as the course's
 /// `unit_vector` does; glam's `normalize` multiplies by the reciprocal instead, which differs
 /// in the last bit for about half of all vectors).
-#[inline]
+#[inline(always)]
 pub fn unit_vector(v: DVec3) -> DVec3 {
     v / v.length()
 }

@@ -36,7 +36,7 @@ impl Ray {
 
     /// The point at parameter `t`: `origin + t * direction`, rounded component-wise as
     /// `o + (t * d)` (no fused multiply-add, as Python computes it).
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, t: f64) -> DVec3 {
         self.origin + self.direction * t
     }

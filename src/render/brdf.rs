@@ -20,7 +20,7 @@ pub fn halfvector(v: DVec3, l: DVec3) -> DVec3 {
 
 /// Phong: `kd albedo / pi + ks albedo max(0, R . V)^alpha` with `R = unit(reflect(-L, n))` and
 /// `V = unit(-view)`. `pow` is libm's.
-#[inline]
+#[inline(always)]
 pub fn phong(
     albedo: DVec3,
     kd: f64,
@@ -39,7 +39,7 @@ pub fn phong(
 /// `H = unit(halfvector(-view, L))` of the **unnormalised** `-view` and `L` (course departure,
 /// week 8: the half vector leans towards the longer of the two, so the highlight moves with the
 /// camera's focus distance and the light's distance). `pow` is libm's.
-#[inline]
+#[inline(always)]
 pub fn blinn(
     albedo: DVec3,
     kd: f64,

@@ -52,21 +52,124 @@ fn background(world: &World, direction: DVec3) -> DVec3 {
 }
 
 /// The radiance along a camera ray in `world`, drawing from `sampler`: the profile's integrator.
-#[inline]
+///
+/// One [`Path`] taken one [`step`] at a time, each step given the closest hit of the path's ray.
+/// The renderer's lanes of paths (`render::lanes`) take the same steps, four paths at a time.
+#[inline(always)]
 pub fn trace(world: &World, ray: &Ray, sampler: &mut PixelSampler) -> DVec3 {
+    let mut path = Path::new(world, *ray);
+    if path.is_exhausted() {
+        return DVec3::ZERO;
+    }
+    let interval = hit_interval(world);
+    loop {
+        let hit = world.closest(&path.ray, interval);
+        if let Some(colour) = step(world, &mut path, hit, Shadows::UNKNOWN, sampler) {
+            return colour;
+        }
+    }
+}
+
+/// Where the profile's integrator looks for hits: `(1e-6, f64::MAX)` in the course, the book's
+/// `(0.001, infinity)`.
+#[inline(always)]
+pub(crate) fn hit_interval(world: &World) -> Interval {
+    match world.profile {
+        Profile::Course => Interval::CAMERA,
+        Profile::Physical => Interval::new(0.001, f64::INFINITY),
+    }
+}
+
+/// A path in flight: the ray it traces next, the product of the weights so far (the course's
+/// `a Li` and `BRDF Li c(n . w)` are linear in `Li`, so the recursion is a loop: the same values,
+/// up to rounding, as the recursive code), what it has gathered, and the bounces it has left.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Path {
+    /// The ray whose closest hit the next step takes.
+    pub(crate) ray: Ray,
+    weight: DVec3,
+    total: DVec3,
+    left: u32,
+}
+
+impl Path {
+    /// A path starting with the camera ray `ray`: week 4's one look-up, or the scene's
+    /// `max_depth` bounces.
+    #[inline(always)]
+    pub(crate) fn new(world: &World, ray: Ray) -> Self {
+        let left = match (world.profile, world.settings.integrator) {
+            (Profile::Course, Integrator::Albedo) => 1,
+            _ => world.settings.max_depth,
+        };
+        Self {
+            ray,
+            weight: DVec3::ONE,
+            total: DVec3::ZERO,
+            left,
+        }
+    }
+
+    /// Whether the path has no bounce at all (a depth of 0: black, with nothing traced).
+    #[inline(always)]
+    pub(crate) fn is_exhausted(&self) -> bool {
+        self.left == 0
+    }
+}
+
+/// What is already known of the course's occlusion test at a step's hit point: bit `l` of
+/// `known` set when point light `l`'s answer is bit `l` of `occluded`. The lanes of paths test
+/// the shadow rays of four paths at once, before the step; what is not known is tested when the
+/// step needs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Shadows {
+    /// The lights whose answer is known.
+    pub(crate) known: u32,
+    /// Of those, the ones occluded.
+    pub(crate) occluded: u32,
+}
+
+impl Shadows {
+    /// Nothing known yet.
+    pub(crate) const UNKNOWN: Shadows = Shadows {
+        known: 0,
+        occluded: 0,
+    };
+
+    /// Whether `p` is in the shadow of point light number `light`: the known answer, or
+    /// [`occluded`].
+    #[inline(always)]
+    fn of(self, world: &World, p: DVec3, light: usize) -> bool {
+        if light < 32 && self.known & (1 << light) != 0 {
+            self.occluded & (1 << light) != 0
+        } else {
+            occluded(world, p, world.point_lights[light].center)
+        }
+    }
+}
+
+/// One bounce of `path`, whose ray's closest hit in [`hit_interval`] is `hit`: the path's colour
+/// when it ends here, `None` when it goes on (with its next ray in `path.ray`).
+#[inline(always)]
+pub(crate) fn step(
+    world: &World,
+    path: &mut Path,
+    hit: Option<(f64, usize)>,
+    shadows: Shadows,
+    sampler: &mut PixelSampler,
+) -> Option<DVec3> {
     match (world.profile, world.settings.integrator) {
-        (Profile::Physical, _) => physical(world, ray, sampler),
-        (Profile::Course, Integrator::Albedo) => albedo(world, ray),
-        (Profile::Course, Integrator::Direct) => direct(world, ray, sampler),
-        (Profile::Course, Integrator::Brdf) => brdf(world, ray, sampler),
+        (Profile::Physical, _) => physical(world, path, hit, sampler),
+        (Profile::Course, Integrator::Albedo) => Some(albedo(world, &path.ray, hit)),
+        (Profile::Course, Integrator::Direct) => direct(world, path, hit, shadows, sampler),
+        (Profile::Course, Integrator::Brdf) => brdf(world, path, hit, shadows, sampler),
     }
 }
 
 /// Week 4: the colour of the closest hit in `(1e-6, f64::MAX)` (a texture's value there), the
 /// background on a miss.
-#[inline]
-fn albedo(world: &World, ray: &Ray) -> DVec3 {
-    match world.closest(ray, Interval::CAMERA) {
+#[inline(always)]
+fn albedo(world: &World, ray: &Ray, hit: Option<(f64, usize)>) -> DVec3 {
+    match hit {
         Some((t, object)) => {
             let material = world.material_of(object);
             match material {
@@ -103,12 +206,12 @@ pub fn occluded(world: &World, p: DVec3, center: DVec3) -> bool {
 /// Course departure, weeks 5 to 7: no cosine and no `1 / (pi d^2)`, only `min(1, 1/d)` (or
 /// `1/d`); every scattering material receives it, mirrors and glass too. A light at distance 0
 /// (its centre on the surface) is left out, where the course divides by zero.
-#[inline]
-fn direct_term(world: &World, p: DVec3) -> DVec3 {
+#[inline(always)]
+fn direct_term(world: &World, p: DVec3, shadows: Shadows) -> DVec3 {
     let mut le = DVec3::ZERO;
-    for light in &world.point_lights {
+    for (l, light) in world.point_lights.iter().enumerate() {
         let d = (light.center - p).length();
-        if d == 0.0 || occluded(world, p, light.center) {
+        if d == 0.0 || shadows.of(world, p, l) {
             continue;
         }
         le += match world.settings.direct_term {
@@ -122,34 +225,45 @@ fn direct_term(world: &World, p: DVec3) -> DVec3 {
 /// Weeks 5 to 7's `compute_scattering(ray, scene, depth)`: depth 0 is black; every hit in
 /// `(1e-6, f64::MAX)`; a light returns its emission; otherwise `Le a + Li a` (the clamped term)
 /// or `Le + a Li` (the unclamped one), `Li` the scattered ray's; a miss returns the background.
-#[inline]
-fn direct(world: &World, ray: &Ray, sampler: &mut PixelSampler) -> DVec3 {
-    let mut total = DVec3::ZERO;
-    let mut weight = DVec3::ONE;
-    let mut ray = *ray;
-    for _ in 0..world.settings.max_depth {
-        let Some((t, object)) = world.closest(&ray, Interval::CAMERA) else {
-            return total + weight * background(world, ray.direction);
-        };
-        let material = world.material_of(object);
-        let hit = Surface::of(world, &ray, t, object, Interval::CAMERA);
-        let Some(scattered) = scatter::course(world, material, &ray, &hit, sampler) else {
-            return total + weight * material.albedo();
-        };
-        let a = scattered.attenuation;
-        let le = direct_term(world, hit.point);
-        total += match world.settings.direct_term {
-            DirectTerm::Clamped => weight * (le * a),
-            DirectTerm::Unclamped => weight * le,
-        };
-        weight *= a;
-        if weight == DVec3::ZERO {
-            // Whatever comes back is multiplied by zero.
-            break;
+#[inline(always)]
+fn direct(
+    world: &World,
+    path: &mut Path,
+    hit: Option<(f64, usize)>,
+    shadows: Shadows,
+    sampler: &mut PixelSampler,
+) -> Option<DVec3> {
+    let ray = path.ray;
+    let Some((t, object)) = hit else {
+        return Some(path.total + path.weight * background(world, ray.direction));
+    };
+    let material = world.material_of(object);
+    let hit = Surface::of(world, &ray, t, object, Interval::CAMERA);
+    let Some(scattered) = scatter::course(world, material, &ray, &hit, sampler) else {
+        return Some(path.total + path.weight * material.albedo());
+    };
+    let a = scattered.attenuation;
+    let le = direct_term(world, hit.point, shadows);
+    path.total += match world.settings.direct_term {
+        DirectTerm::Clamped => path.weight * (le * a),
+        DirectTerm::Unclamped => path.weight * le,
+    };
+    path.weight *= a;
+    path.next(scattered.ray)
+}
+
+impl Path {
+    /// After a bounce: the path's total when its weight is zero (whatever comes back is
+    /// multiplied by zero) or it has no bounce left, else `None` with `ray` its next ray.
+    #[inline(always)]
+    fn next(&mut self, ray: Ray) -> Option<DVec3> {
+        self.left -= 1;
+        if self.weight == DVec3::ZERO || self.left == 0 {
+            return Some(self.total);
         }
-        ray = scattered.ray;
+        self.ray = ray;
+        None
     }
-    total
 }
 
 /// Week 8's `c(x)`: 0 when `x < 1e-6`, else `x`.
@@ -161,7 +275,7 @@ fn cutoff(x: f64) -> f64 {
 /// `BRDF(ray_view, ray_light, hit)` of `material` (week 8): the albedo (or texture value) of the
 /// materials without a model of their own, the model's value of Phong, Blinn and
 /// Cook-Torrance.
-#[inline]
+#[inline(always)]
 fn brdf_of(world: &World, material: &Material, view: DVec3, light: DVec3, hit: &Surface) -> DVec3 {
     let n = hit.normal;
     match *material {
@@ -196,67 +310,72 @@ fn brdf_of(world: &World, material: &Material, view: DVec3, light: DVec3, hit: &
 /// dielectric's transmitted rays (`n . w < 0`) count for nothing and glass shows its reflection
 /// only. The occlusion test is week 5's ([`occluded`]); the facts leave open whether week 8's
 /// direct term tests it, and it is assumed to.
-#[inline]
-fn brdf(world: &World, ray: &Ray, sampler: &mut PixelSampler) -> DVec3 {
-    let mut total = DVec3::ZERO;
-    let mut weight = DVec3::ONE;
-    let mut ray = *ray;
-    for _ in 0..world.settings.max_depth {
-        let Some((t, object)) = world.closest(&ray, Interval::CAMERA) else {
-            return total + weight * background(world, ray.direction);
-        };
-        let material = world.material_of(object);
-        let hit = Surface::of(world, &ray, t, object, Interval::CAMERA);
-        let Some(scattered) = scatter::course(world, material, &ray, &hit, sampler) else {
-            return total + weight * material.albedo();
-        };
-        let n = hit.normal;
-        if world.settings.direct_light {
-            let mut le = DVec3::ZERO;
-            for light in &world.point_lights {
-                let to_light = light.center - hit.point;
-                if occluded(world, hit.point, light.center) {
-                    continue;
-                }
-                let f = brdf_of(world, material, ray.direction, to_light, &hit);
-                le += f * light.emit * cutoff(n.dot(to_light));
+#[inline(always)]
+fn brdf(
+    world: &World,
+    path: &mut Path,
+    hit: Option<(f64, usize)>,
+    shadows: Shadows,
+    sampler: &mut PixelSampler,
+) -> Option<DVec3> {
+    let ray = path.ray;
+    let Some((t, object)) = hit else {
+        return Some(path.total + path.weight * background(world, ray.direction));
+    };
+    let material = world.material_of(object);
+    let hit = Surface::of(world, &ray, t, object, Interval::CAMERA);
+    let Some(scattered) = scatter::course(world, material, &ray, &hit, sampler) else {
+        return Some(path.total + path.weight * material.albedo());
+    };
+    let n = hit.normal;
+    if world.settings.direct_light {
+        let mut le = DVec3::ZERO;
+        for (l, light) in world.point_lights.iter().enumerate() {
+            let to_light = light.center - hit.point;
+            if shadows.of(world, hit.point, l) {
+                continue;
             }
-            total += weight * le;
+            let f = brdf_of(world, material, ray.direction, to_light, &hit);
+            le += f * light.emit * cutoff(n.dot(to_light));
         }
-        let w = scattered.ray.direction;
-        weight *= brdf_of(world, material, ray.direction, w, &hit) * cutoff(n.dot(w));
-        if weight == DVec3::ZERO {
-            break;
-        }
-        ray = scattered.ray;
+        path.total += path.weight * le;
     }
-    total
+    let w = scattered.ray.direction;
+    path.weight *= brdf_of(world, material, ray.direction, w, &hit) * cutoff(n.dot(w));
+    path.next(scattered.ray)
 }
 
 /// The book's `ray_color` (book 1, with book 2's emission and background): depth 0 is black;
 /// hits in `(0.001, infinity)`; a light returns its emission, an absorbed ray black, a scattered
 /// one its attenuation times what it brings back; a miss the background.
-#[inline]
-fn physical(world: &World, ray: &Ray, sampler: &mut PixelSampler) -> DVec3 {
-    let interval = Interval::new(0.001, f64::INFINITY);
-    let mut weight = DVec3::ONE;
-    let mut ray = *ray;
-    for _ in 0..world.settings.max_depth {
-        let Some((t, object)) = world.closest(&ray, interval) else {
-            return weight * background(world, ray.direction);
-        };
-        let material = world.material_of(object);
-        if let Material::DiffuseLight { emit } = *material {
-            return weight * emit;
-        }
-        let hit = Surface::of(world, &ray, t, object, interval);
-        let Some(scattered) = scatter::physical(world, material, &ray, &hit, sampler) else {
-            return DVec3::ZERO;
-        };
-        weight *= scattered.attenuation;
-        ray = scattered.ray;
+#[inline(always)]
+fn physical(
+    world: &World,
+    path: &mut Path,
+    hit: Option<(f64, usize)>,
+    sampler: &mut PixelSampler,
+) -> Option<DVec3> {
+    let ray = path.ray;
+    let Some((t, object)) = hit else {
+        return Some(path.weight * background(world, ray.direction));
+    };
+    let material = world.material_of(object);
+    if let Material::DiffuseLight { emit } = *material {
+        return Some(path.weight * emit);
     }
-    DVec3::ZERO
+    let hit = Surface::of(world, &ray, t, object, hit_interval(world));
+    let Some(scattered) = scatter::physical(world, material, &ray, &hit, sampler) else {
+        return Some(DVec3::ZERO);
+    };
+    path.weight *= scattered.attenuation;
+    // The book's total stays zero: what a path brings back is its weight times what it ends on;
+    // a path that runs out of bounces is black.
+    path.left -= 1;
+    if path.left == 0 {
+        return Some(DVec3::ZERO);
+    }
+    path.ray = scattered.ray;
+    None
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 use super::PixelSampler;
+use crate::geometry::Ray;
 use crate::scene::Camera;
 
 /// How the sample positions inside a pixel are drawn.
@@ -210,6 +211,30 @@ impl<'a, T: Trace> Job<'a, T> {
             scale,
             ..Self::new(tracer, camera, spp, seed, PixelJitter::Uniform)
         }
+    }
+
+    /// Sample `s`'s camera ray through pixel `(i, j)`, drawn from the pixel's `sampler` in the
+    /// renderer's order: the x then the y offset ([`Job::offsets`]), then a disk point under
+    /// defocus, then, when something in the scene `moves`, the ray's time.
+    #[inline(always)]
+    pub(super) fn sample_ray<const JITTER: u8>(
+        &self,
+        sampler: &mut PixelSampler,
+        (i, j): (usize, usize),
+        s: u32,
+        moves: bool,
+    ) -> Ray {
+        let (ox, oy) = self.offsets::<JITTER>(sampler, s);
+        let disk = if self.camera.defocus {
+            sampler.in_unit_disk()
+        } else {
+            (0.0, 0.0)
+        };
+        let mut ray = self.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
+        if moves {
+            ray.time = sampler.next_f64();
+        }
+        ray
     }
 
     /// Sample `s`'s offset from its pixel's centre, drawn from `sampler` (x, then y) under the

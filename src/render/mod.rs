@@ -7,6 +7,8 @@ mod film;
 mod fixed_origin;
 mod integrator;
 mod job;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod optics;
 mod packet;
 mod pinhole;

@@ -9,7 +9,7 @@ use crate::geometry::unit_vector;
 
 /// `v` mirrored about the plane with unit normal `n`: `v - 2 (v . n) n` (week 6's `reflect`, the
 /// book's). `v` keeps its length.
-#[inline]
+#[inline(always)]
 pub fn reflect(v: DVec3, n: DVec3) -> DVec3 {
     v - 2.0 * v.dot(n) * n
 }
@@ -20,7 +20,7 @@ pub fn reflect(v: DVec3, n: DVec3) -> DVec3 {
 /// The fifth power is three IEEE multiplications, `(m^2)^2 m` (the same bits on every platform,
 /// within 2 ulp of `pow`, and many times cheaper than a call to `pow` on the path of every
 /// ray that meets glass).
-#[inline]
+#[inline(always)]
 pub fn schlick(cosine: f64, x: f64) -> f64 {
     let r0 = (1.0 - x) / (1.0 + x);
     let r0 = r0 * r0;
@@ -33,7 +33,7 @@ pub fn schlick(cosine: f64, x: f64) -> f64 {
 /// (facing `v`) at ratio `ratio` (outside index over inside, seen from `v`'s side), given
 /// `cos = min(-v . n, 1)`: `r_perp = ratio (v + cos n)`, `r_par = -sqrt(|1 - |r_perp|^2|) n`,
 /// `r_perp + r_par`. A unit vector up to rounding.
-#[inline]
+#[inline(always)]
 pub fn refracted(v: DVec3, n: DVec3, ratio: f64, cos: f64) -> DVec3 {
     let r_perp = ratio * (v + cos * n);
     let r_par = -(1.0 - r_perp.length_squared()).abs().sqrt() * n;
@@ -47,7 +47,7 @@ pub fn refracted(v: DVec3, n: DVec3, ratio: f64, cos: f64) -> DVec3 {
 /// (`ratio sin > 1`, total internal reflection) or when `schlick(cos, ratio)` is above a random
 /// number, which is drawn from `sampler` only when refraction is possible (the `or` short-circuits,
 /// in the course's code and in the book's); otherwise it refracts ([`refracted`]).
-#[inline]
+#[inline(always)]
 pub fn refract_or_reflect(v: DVec3, n: DVec3, ratio: f64, sampler: &mut PixelSampler) -> DVec3 {
     let cos = (-v.dot(n)).min(1.0);
     let sin = (1.0 - cos * cos).sqrt();

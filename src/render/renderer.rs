@@ -4,6 +4,8 @@ use glam::DVec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::job::{Job, Moments, PixelJitter, Spread, Trace};
+#[cfg(target_arch = "x86_64")]
+use super::lanes;
 use super::pinhole::Pinhole;
 use super::{Film, PixelSampler, trace};
 use crate::scene::{Background, Camera, Integrator, Material, PixelSampling, Profile, World};
@@ -52,8 +54,9 @@ pub enum RenderError {
 }
 
 impl Trace for World {
-    /// Each sample's ray (x then y offset, then a disk point under defocus, then a time when
-    /// something moves) through the world's integrator ([`trace`]), times the job's scale.
+    /// Each sample's ray ([`Job::sample_ray`]) through the world's integrator ([`trace`]), times
+    /// the job's scale; in a scene of static spheres, four paths at a time
+    /// ([`lanes::row`](super::lanes::row)), to the same film.
     #[inline(always)]
     fn row<const VARIANCE: bool, const JITTER: u8>(
         job: &Job<'_, Self>,
@@ -63,20 +66,15 @@ impl Trace for World {
     ) {
         let width = job.camera.width;
         let world = job.tracer;
+        #[cfg(target_arch = "x86_64")]
+        if let Some(set) = lanes::takes_lanes(world) {
+            return lanes::row::<VARIANCE, JITTER>(job, set, j, means, variances);
+        }
         for (i, mean) in means.iter_mut().enumerate() {
             let mut sampler = PixelSampler::new(job.seed, (j * width + i) as u64);
             let mut moments = None;
             for s in 0..job.spp {
-                let (ox, oy) = job.offsets::<JITTER>(&mut sampler, s);
-                let disk = if job.camera.defocus {
-                    sampler.in_unit_disk()
-                } else {
-                    (0.0, 0.0)
-                };
-                let mut ray = job.camera.ray_through(i as f64 + ox, j as f64 + oy, disk);
-                if world.moving {
-                    ray.time = sampler.next_f64();
-                }
+                let ray = job.sample_ray::<JITTER>(&mut sampler, (i, j), s, world.moving);
                 let mut colour = trace(world, &ray, &mut sampler);
                 if JITTER == 3 {
                     colour *= job.scale;

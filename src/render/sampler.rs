@@ -29,13 +29,13 @@ impl PixelSampler {
     }
 
     /// A uniform `f64` in `[0, 1)`: the top 53 bits of the next output times `2^-53`.
-    #[inline]
+    #[inline(always)]
     pub fn next_f64(&mut self) -> f64 {
         (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
     /// A uniform `f64` in `[lo, hi)`: `lo + (hi - lo) u`, the book's `random_double(min, max)`.
-    #[inline]
+    #[inline(always)]
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.next_f64()
     }
@@ -43,7 +43,7 @@ impl PixelSampler {
     /// A uniform point on the unit sphere (the course's `random_vec3_unit`, the book's
     /// `random_unit_vector`): a point of the cube `[-1, 1)^3` (x, y, then z), drawn again until
     /// its squared length lies in `(1e-160, 1]`, divided by its length. About 1.9 tries.
-    #[inline]
+    #[inline(always)]
     pub fn unit_vector(&mut self) -> DVec3 {
         loop {
             let p = DVec3::new(
@@ -72,7 +72,7 @@ impl PixelSampler {
     }
 
     /// A uniform point of the open unit disk, by rejection (as the book does).
-    #[inline]
+    #[inline(always)]
     pub fn in_unit_disk(&mut self) -> (f64, f64) {
         loop {
             let x = 2.0 * self.next_f64() - 1.0;

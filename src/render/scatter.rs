@@ -23,7 +23,7 @@ pub(crate) struct Scattered {
 /// `n + random_vec3_unit()`, or `n` itself when every component of that is below `1e-8` in
 /// magnitude: week 5's Lambertian and the book's `lambertian` (its `near_zero`). Not normalised:
 /// its length lies in `[0, 2]`.
-#[inline]
+#[inline(always)]
 pub fn normal_plus_unit(n: DVec3, sampler: &mut PixelSampler) -> DVec3 {
     let d = n + sampler.unit_vector();
     if d.abs().max_element() < 1e-8 { n } else { d }
@@ -31,13 +31,13 @@ pub fn normal_plus_unit(n: DVec3, sampler: &mut PixelSampler) -> DVec3 {
 
 /// Week 9's Lambertian: a cosine-distributed direction about `n`,
 /// `ONB.build_from_w(n).local(random_cosine_hemisphere_on_z())`, a unit vector.
-#[inline]
+#[inline(always)]
 pub fn cosine_about(n: DVec3, sampler: &mut PixelSampler) -> DVec3 {
     Onb::from_w(n).local(sampler.cosine_hemisphere())
 }
 
 /// The diffuse direction of the course's week (`sampling`).
-#[inline]
+#[inline(always)]
 fn diffuse(n: DVec3, sampling: DiffuseSampling, sampler: &mut PixelSampler) -> DVec3 {
     match sampling {
         DiffuseSampling::UnitSphere => normal_plus_unit(n, sampler),
@@ -55,7 +55,7 @@ fn diffuse(n: DVec3, sampling: DiffuseSampling, sampler: &mut PixelSampler) -> D
 ///   at ratio `1 / ior` on the front face and `ior` on the back, attenuated by the albedo.
 /// - Metal (week 7): `reflect(unit(d), n) + roughness random_vec3_unit()`; the attenuation is
 ///   zero when that direction's `. n` is at most `1e-8` (the ray still goes on).
-#[inline]
+#[inline(always)]
 pub(crate) fn course(
     world: &World,
     material: &Material,
@@ -107,7 +107,7 @@ pub(crate) fn course(
 ///   is white; a scene's albedo tints it).
 /// - diffuse light (book 2): emits, does not scatter. The course's BRDF materials are refused
 ///   by validation under this profile; they scatter as lambertians if a world is built by hand.
-#[inline]
+#[inline(always)]
 pub(crate) fn physical(
     world: &World,
     material: &Material,

@@ -43,7 +43,7 @@ pub fn sphere_uv(n: DVec3) -> (f64, f64) {
 
 impl Surface {
     /// The hit of object `object` at `t` along `ray` (found within `interval`).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn of(world: &World, ray: &Ray, t: f64, object: usize, interval: Interval) -> Self {
         let point = ray.at(t);
         let sphere = |s: Sphere| {
@@ -70,7 +70,7 @@ impl Surface {
 
     /// The record with the normal set to face `ray` from `outward`, as the course's
     /// `set_face_normal` does.
-    #[inline]
+    #[inline(always)]
     fn facing(ray: &Ray, point: DVec3, outward: DVec3, coordinates: Coordinates) -> Self {
         let front_face = ray.direction.dot(outward) < 0.0;
         Self {
@@ -91,7 +91,7 @@ impl Surface {
     }
 
     /// `texture`'s value here.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn texture(&self, world: &World, texture: &Texture, profile: Profile) -> DVec3 {
         match texture {
             Texture::Solid(c) => *c,
@@ -102,7 +102,7 @@ impl Surface {
     }
 
     /// The colour of `material` here: its albedo, or its texture's value.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn colour(&self, world: &World, material: &Material) -> DVec3 {
         match material {
             Material::Textured { texture } => self.texture(world, texture, world.profile),

@@ -38,6 +38,7 @@ pub use settings::{
     Background, COURSE_BACKGROUND, DEFAULT_MAX_DEPTH, DiffuseSampling, DirectTerm, Integrator,
     PixelSampling, RenderSettings,
 };
+pub(crate) use sphere_set::{LANES, RayLanes, SphereSet, has_lanes};
 pub use texture::{
     GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,
 };

@@ -62,7 +62,7 @@ struct Ball {
 
 /// The spheres of a scene of static spheres only.
 #[derive(Clone, Debug)]
-pub(super) struct SphereSet {
+pub(crate) struct SphereSet {
     balls: Vec<Ball>,
 }
 
@@ -151,6 +151,270 @@ impl SphereSet {
             }
         }
         Some(count)
+    }
+}
+
+/// How many rays [`SphereSet::closest_lanes`] and [`SphereSet::occluded_lanes`] take at once:
+/// four `f64` lanes, one AVX2 vector.
+pub(crate) const LANES: usize = 4;
+
+/// Up to [`LANES`] rays side by side (origins, directions, and `a = d . d`), for the lanes
+/// queries. A lane that is not `active` is ignored.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RayLanes {
+    ox: [f64; LANES],
+    oy: [f64; LANES],
+    oz: [f64; LANES],
+    dx: [f64; LANES],
+    dy: [f64; LANES],
+    dz: [f64; LANES],
+    a: [f64; LANES],
+    active: [u64; LANES],
+}
+
+impl RayLanes {
+    /// Puts the ray from `origin` along `direction` in lane `k`.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, k: usize, origin: DVec3, direction: DVec3) {
+        (self.ox[k], self.oy[k], self.oz[k]) = (origin.x, origin.y, origin.z);
+        (self.dx[k], self.dy[k], self.dz[k]) = (direction.x, direction.y, direction.z);
+        self.a[k] = direction.dot(direction);
+        self.active[k] = u64::MAX;
+    }
+}
+
+/// One ball against every lane: where each lane's ray has a root in `(min, max[k])` (the lane's
+/// root in `t`, the others unchanged), and the lanes whose intermediates over- or underflow.
+///
+/// Lane by lane these are [`SphereSet::root`]'s operations, in its order, in one AVX2 vector:
+/// the same `f`, `b'`, `c`, early outs ([`sure_miss`]), [`roots_of`] and [`pick_root`], so each
+/// lane decides as the scalar loop does, bit for bit (IEEE operations round alike in a vector
+/// lane; nothing is fused). Where the scalar code branches, both sides are computed and the
+/// lane's is selected. A ball every lane surely misses costs no division. The tests compare it
+/// with the scalar loop (`lanes_answer_as_the_scalar_loop_does`).
+///
+/// # Safety
+///
+/// The processor must have AVX2 (the caller checked [`has_lanes`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn ball_lanes(
+    ball: &Ball,
+    rays: &RayLanes,
+    min: f64,
+    max: &[f64; LANES],
+    t: &mut [f64; LANES],
+) -> (u32, u32) {
+    use std::arch::x86_64::*;
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the loads and
+    // the store read and write whole `[f64; 4]` arrays.
+    unsafe {
+        let load = |x: &[f64; LANES]| _mm256_loadu_pd(x.as_ptr());
+        let splat = |x: f64| _mm256_set1_pd(x);
+        let sign = splat(-0.0);
+        let (dx, dy, dz, a) = (
+            load(&rays.dx),
+            load(&rays.dy),
+            load(&rays.dz),
+            load(&rays.a),
+        );
+        let active = _mm256_castsi256_pd(_mm256_loadu_si256(rays.active.as_ptr().cast()));
+        let fx = _mm256_sub_pd(load(&rays.ox), splat(ball.center.x));
+        let fy = _mm256_sub_pd(load(&rays.oy), splat(ball.center.y));
+        let fz = _mm256_sub_pd(load(&rays.oz), splat(ball.center.z));
+        let r2 = splat(ball.r2);
+        let dot = |ux, uy, uz, vx, vy, vz| {
+            _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(ux, vx), _mm256_mul_pd(uy, vy)),
+                _mm256_mul_pd(uz, vz),
+            )
+        };
+        let half_b = dot(fx, fy, fz, dx, dy, dz);
+        let ff = dot(fx, fy, fz, fx, fy, fz);
+        let c = _mm256_sub_pd(ff, r2);
+        let finite =
+            |x| _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_andnot_pd(sign, x), splat(f64::INFINITY));
+        let zero = _mm256_setzero_pd();
+        // `a.is_normal() && a < 1e300` for `a = d . d`, which is never negative.
+        let a_sane = _mm256_and_pd(
+            _mm256_cmp_pd::<_CMP_GE_OQ>(a, splat(f64::MIN_POSITIVE)),
+            _mm256_cmp_pd::<_CMP_LT_OQ>(a, splat(1e300)),
+        );
+        let solvable = if ball.r2 < 1e300 {
+            _mm256_and_pd(_mm256_and_pd(a_sane, finite(c)), finite(half_b))
+        } else {
+            zero
+        };
+        let behind = if min >= 0.0 {
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_GT_OQ>(half_b, zero),
+                _mm256_cmp_pd::<_CMP_GT_OQ>(c, zero),
+            )
+        } else {
+            zero
+        };
+        let scale = _mm256_add_pd(ff, r2);
+        let in_range = |x| {
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_GE_OQ>(x, splat(PREFILTER_RANGE.start)),
+                _mm256_cmp_pd::<_CMP_LT_OQ>(x, splat(PREFILTER_RANGE.end)),
+            )
+        };
+        let naive = _mm256_sub_pd(_mm256_mul_pd(half_b, half_b), _mm256_mul_pd(a, c));
+        let margin = _mm256_xor_pd(
+            _mm256_mul_pd(_mm256_mul_pd(a, splat(PREFILTER_MARGIN)), scale),
+            sign,
+        );
+        let aside = _mm256_and_pd(
+            _mm256_and_pd(in_range(a), in_range(scale)),
+            _mm256_cmp_pd::<_CMP_LT_OQ>(naive, margin),
+        );
+        let sure = _mm256_and_pd(solvable, _mm256_or_pd(behind, aside));
+        let open = _mm256_andnot_pd(sure, active);
+        let mut unsolved = _mm256_andnot_pd(solvable, active);
+        if _mm256_movemask_pd(open) == 0 {
+            return (0, _mm256_movemask_pd(unsolved) as u32);
+        }
+        // `roots_of`, lane by lane.
+        let s = _mm256_div_pd(half_b, a);
+        let px = _mm256_sub_pd(fx, _mm256_mul_pd(dx, s));
+        let py = _mm256_sub_pd(fy, _mm256_mul_pd(dy, s));
+        let pz = _mm256_sub_pd(fz, _mm256_mul_pd(dz, s));
+        let disc = _mm256_mul_pd(a, _mm256_sub_pd(r2, dot(px, py, pz, px, py, pz)));
+        let disc_finite = finite(disc);
+        unsolved = _mm256_or_pd(unsolved, _mm256_andnot_pd(disc_finite, open));
+        let root = _mm256_sqrt_pd(disc);
+        // `sqrt(disc).copysign(half_b)`, then negated.
+        let signed = _mm256_or_pd(_mm256_andnot_pd(sign, root), _mm256_and_pd(sign, half_b));
+        let q = _mm256_xor_pd(_mm256_add_pd(half_b, signed), sign);
+        let t0 = _mm256_div_pd(c, q);
+        let t1 = _mm256_div_pd(q, a);
+        let double = _mm256_div_pd(_mm256_xor_pd(half_b, sign), a);
+        let ordered = _mm256_cmp_pd::<_CMP_LE_OQ>(t0, t1);
+        let near = _mm256_blendv_pd(t1, t0, ordered);
+        let far = _mm256_blendv_pd(t0, t1, ordered);
+        let tangent = _mm256_cmp_pd::<_CMP_EQ_OQ>(q, zero);
+        let near = _mm256_blendv_pd(near, double, tangent);
+        let far = _mm256_blendv_pd(far, double, tangent);
+        // `pick_root` against `(min, max[k])`.
+        let (lo, hi) = (splat(min), load(max));
+        let surrounds = |x| {
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_LT_OQ>(lo, x),
+                _mm256_cmp_pd::<_CMP_LT_OQ>(x, hi),
+            )
+        };
+        let (near_in, far_in) = (surrounds(near), surrounds(far));
+        let found = _mm256_and_pd(
+            _mm256_and_pd(open, disc_finite),
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_GE_OQ>(disc, zero),
+                _mm256_or_pd(near_in, far_in),
+            ),
+        );
+        let chosen = _mm256_blendv_pd(far, near, near_in);
+        let kept = _mm256_blendv_pd(load(t), chosen, found);
+        _mm256_storeu_pd(t.as_mut_ptr(), kept);
+        (
+            _mm256_movemask_pd(found) as u32,
+            _mm256_movemask_pd(unsolved) as u32,
+        )
+    }
+}
+
+/// Whether this processor runs the lanes queries ([`SphereSet::closest_lanes`],
+/// [`SphereSet::occluded_lanes`]): an x86-64 with AVX2. Elsewhere the renderer traces one ray at
+/// a time, to the same film.
+#[inline]
+pub(crate) fn has_lanes() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl SphereSet {
+    /// [`SphereSet::closest`] for each active lane of `rays` at once (an AVX2 vector of four
+    /// rays where the caller is compiled for it): lane `k`'s closest hit in `interval`, or
+    /// `Err(())` where the lane's ray must be decided by the scalar path (over- or underflow).
+    /// Inactive lanes answer `Ok(None)`.
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) unsafe fn closest_lanes(
+        &self,
+        rays: &RayLanes,
+        interval: Interval,
+    ) -> [Result<Option<(f64, usize)>, ()>; LANES] {
+        let mut closest = [interval.max; LANES];
+        let mut index = [usize::MAX; LANES];
+        let mut unsolved = 0;
+        for (me, ball) in self.balls.iter().enumerate() {
+            let max = closest;
+            // SAFETY: AVX2 is there (this function's contract).
+            let (hit, bad) = unsafe { ball_lanes(ball, rays, interval.min, &max, &mut closest) };
+            for (k, index) in index.iter_mut().enumerate() {
+                if hit & (1 << k) != 0 {
+                    *index = me;
+                }
+            }
+            unsolved |= bad;
+        }
+        let mut answers = [Ok(None); LANES];
+        for (k, answer) in answers.iter_mut().enumerate() {
+            if unsolved & (1 << k) != 0 {
+                *answer = Err(());
+            } else if index[k] != usize::MAX {
+                *answer = Ok(Some((closest[k], index[k])));
+            }
+        }
+        answers
+    }
+
+    /// The course's occlusion test ([`SphereSet::count_hits`] on `(min, max[k])`, limit 2, more
+    /// than one hit) for each active lane of `rays` at once: `Ok(occluded)`, or `Err(())` where
+    /// the lane's ray must be decided by the scalar path. Inactive lanes answer `Ok(false)`.
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) unsafe fn occluded_lanes(
+        &self,
+        rays: &RayLanes,
+        min: f64,
+        max: &[f64; LANES],
+    ) -> [Result<bool, ()>; LANES] {
+        let mut count = [0u32; LANES];
+        let mut unsolved = 0;
+        let mut t = [0.0; LANES];
+        for ball in &self.balls {
+            // SAFETY: AVX2 is there (this function's contract).
+            let (hit, bad) = unsafe { ball_lanes(ball, rays, min, max, &mut t) };
+            for (k, count) in count.iter_mut().enumerate() {
+                *count += (hit >> k) & 1;
+            }
+            unsolved |= bad;
+        }
+        let mut answers = [Ok(false); LANES];
+        for (k, answer) in answers.iter_mut().enumerate() {
+            *answer = if unsolved & (1 << k) != 0 {
+                Err(())
+            } else {
+                Ok(count[k] > 1)
+            };
+        }
+        answers
     }
 }
 

@@ -163,6 +163,21 @@ impl World {
         }
     }
 
+    /// The spheres side by side, when every object is a static sphere and there is no
+    /// hierarchy: the renderer then traces four paths at a time through their lanes queries.
+    #[inline(always)]
+    pub(crate) fn sphere_set(&self) -> Option<&SphereSet> {
+        self.spheres.as_ref()
+    }
+
+    /// A copy without the side-by-side spheres (the scene's own loop, one ray at a time), for
+    /// tests that compare the two.
+    #[cfg(test)]
+    pub(crate) fn without_sphere_set(mut self) -> Self {
+        self.spheres = None;
+        self
+    }
+
     /// A copy without the hierarchy (the linear scan), for tests that compare the two.
     #[cfg(test)]
     pub(crate) fn without_hierarchy(mut self) -> Self {
