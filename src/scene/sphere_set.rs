@@ -169,6 +169,12 @@ pub(crate) struct RayLanes {
     dy: [f64; LANES],
     dz: [f64; LANES],
     a: [f64; LANES],
+    /// `a * PREFILTER_MARGIN`, the pre-filter's margin before the sphere's scale.
+    a_margin: [f64; LANES],
+    /// All ones where `a.is_normal() && a < 1e300` (`roots_of`'s check of `a`).
+    a_sane: [u64; LANES],
+    /// All ones where `a` lies in the pre-filter's range.
+    a_in_range: [u64; LANES],
     active: [u64; LANES],
 }
 
@@ -178,7 +184,11 @@ impl RayLanes {
     pub(crate) fn set(&mut self, k: usize, origin: DVec3, direction: DVec3) {
         (self.ox[k], self.oy[k], self.oz[k]) = (origin.x, origin.y, origin.z);
         (self.dx[k], self.dy[k], self.dz[k]) = (direction.x, direction.y, direction.z);
-        self.a[k] = direction.dot(direction);
+        let a = direction.dot(direction);
+        self.a[k] = a;
+        self.a_margin[k] = a * PREFILTER_MARGIN;
+        self.a_sane[k] = if a.is_normal() && a < 1e300 { u64::MAX } else { 0 };
+        self.a_in_range[k] = if PREFILTER_RANGE.contains(&a) { u64::MAX } else { 0 };
         self.active[k] = u64::MAX;
     }
 }
@@ -219,7 +229,8 @@ unsafe fn ball_lanes(
             load(&rays.dz),
             load(&rays.a),
         );
-        let active = _mm256_castsi256_pd(_mm256_loadu_si256(rays.active.as_ptr().cast()));
+        let mask = |x: &[u64; LANES]| _mm256_castsi256_pd(_mm256_loadu_si256(x.as_ptr().cast()));
+        let active = mask(&rays.active);
         let fx = _mm256_sub_pd(load(&rays.ox), splat(ball.center.x));
         let fy = _mm256_sub_pd(load(&rays.oy), splat(ball.center.y));
         let fz = _mm256_sub_pd(load(&rays.oz), splat(ball.center.z));
@@ -236,13 +247,8 @@ unsafe fn ball_lanes(
         let finite =
             |x| _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_andnot_pd(sign, x), splat(f64::INFINITY));
         let zero = _mm256_setzero_pd();
-        // `a.is_normal() && a < 1e300` for `a = d . d`, which is never negative.
-        let a_sane = _mm256_and_pd(
-            _mm256_cmp_pd::<_CMP_GE_OQ>(a, splat(f64::MIN_POSITIVE)),
-            _mm256_cmp_pd::<_CMP_LT_OQ>(a, splat(1e300)),
-        );
         let solvable = if ball.r2 < 1e300 {
-            _mm256_and_pd(_mm256_and_pd(a_sane, finite(c)), finite(half_b))
+            _mm256_and_pd(_mm256_and_pd(mask(&rays.a_sane), finite(c)), finite(half_b))
         } else {
             zero
         };
@@ -262,12 +268,9 @@ unsafe fn ball_lanes(
             )
         };
         let naive = _mm256_sub_pd(_mm256_mul_pd(half_b, half_b), _mm256_mul_pd(a, c));
-        let margin = _mm256_xor_pd(
-            _mm256_mul_pd(_mm256_mul_pd(a, splat(PREFILTER_MARGIN)), scale),
-            sign,
-        );
+        let margin = _mm256_xor_pd(_mm256_mul_pd(load(&rays.a_margin), scale), sign);
         let aside = _mm256_and_pd(
-            _mm256_and_pd(in_range(a), in_range(scale)),
+            _mm256_and_pd(mask(&rays.a_in_range), in_range(scale)),
             _mm256_cmp_pd::<_CMP_LT_OQ>(naive, margin),
         );
         let sure = _mm256_and_pd(solvable, _mm256_or_pd(behind, aside));
@@ -290,7 +293,8 @@ unsafe fn ball_lanes(
         let q = _mm256_xor_pd(_mm256_add_pd(half_b, signed), sign);
         let t0 = _mm256_div_pd(c, q);
         let t1 = _mm256_div_pd(q, a);
-        let double = _mm256_div_pd(_mm256_xor_pd(half_b, sign), a);
+        // `-b' / a`: a negated quotient rounds to the same magnitude, so this is `-(b' / a)`.
+        let double = _mm256_xor_pd(s, sign);
         let ordered = _mm256_cmp_pd::<_CMP_LE_OQ>(t0, t1);
         let near = _mm256_blendv_pd(t1, t0, ordered);
         let far = _mm256_blendv_pd(t0, t1, ordered);
