@@ -77,7 +77,10 @@ pub(crate) fn read_cached(
     let bytes = std::fs::read(path).ok()?;
     let image = scene.fits(&bytes, path).ok()?;
     let record = GoldenRecord::of(&image);
-    (record.spp == Some(spp) && record.seed == Some(GOLDEN_SEED)).then_some((bytes, image))
+    // A render asked for `spp` samples takes whole passes over the course's strata in a
+    // jittered scene (`samples_taken`): its film, and so the golden, records those.
+    let taken = crate::render::samples_taken(&scene.description.scene(), spp).0;
+    (record.spp == Some(taken) && record.seed == Some(GOLDEN_SEED)).then_some((bytes, image))
 }
 
 /// Writes `bytes` to the cache file `path` atomically (a temporary file renamed into place, so

@@ -359,6 +359,25 @@ mod tests {
         assert!(first.image.attribute(ATTR_SCENE_TOML).is_none());
     }
 
+    /// A jittered scene asked for a count that is not a whole number of passes over its strata
+    /// (week 10's 200 spp take 14 x 14 = 196 a pass, so 20 000 take 20 188) records the samples
+    /// it took, and is found in the cache the next time, not rendered again.
+    #[test]
+    fn a_jittered_golden_of_more_samples_than_asked_is_found_in_the_cache() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut scene = GoldenScene::builtin("week10-moving").unwrap();
+        scene.description.image.width = 4;
+        let first = golden_of(&scene, 201, Some(dir.path()), false).unwrap();
+        assert!(first.rendered());
+        assert_eq!(GoldenRecord::of(&first.image).spp, Some(2 * 196));
+        let again = golden_of(&scene, 201, Some(dir.path()), false).unwrap();
+        assert_eq!(
+            again.origin,
+            GoldenOrigin::Cached(cache_file(dir.path(), &scene, 201))
+        );
+        assert_eq!(again.bytes, first.bytes);
+    }
+
     #[test]
     fn the_cache_renders_each_golden_once_even_when_asked_concurrently() {
         let dir = tempfile::tempdir().unwrap();

@@ -226,3 +226,241 @@ fn shadows_at(
     }
     shadows
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Sphere;
+    use crate::render::job::{PixelJitter, film_bits};
+    use crate::scene::{
+        Background, DiffuseSampling, DirectTerm, Material, Object, RenderSettings, Scene,
+        SceneObject, Texture, builtin,
+    };
+
+    /// Every material the integrators know, in both profiles' reach.
+    fn materials() -> Vec<Material> {
+        let c = |r, g, b| DVec3::new(r, g, b);
+        vec![
+            Material::Lambertian {
+                albedo: c(0.7, 0.3, 0.3),
+            },
+            Material::Mirror {
+                albedo: c(0.8, 0.8, 0.8),
+            },
+            Material::Dielectric {
+                albedo: c(1.0, 1.0, 1.0),
+                ior: 1.5,
+            },
+            Material::DiffuseLight {
+                emit: c(4.0, 4.0, 3.0),
+            },
+            Material::Phong {
+                albedo: c(0.7, 0.2, 0.4),
+                kd: 0.6,
+                ks: 0.9,
+                alpha: 8.0,
+            },
+            Material::Blinn {
+                albedo: c(0.2, 0.7, 0.4),
+                kd: 0.6,
+                ks: 0.9,
+                alpha: 30.0,
+            },
+            Material::Metal {
+                albedo: c(0.8, 0.6, 0.2),
+                roughness: 0.3,
+            },
+            Material::CookTorrance {
+                albedo: c(0.5, 0.5, 0.5),
+                kd: 0.4,
+                ks: 0.6,
+                alpha: 0.3,
+                ior: 1.5,
+            },
+            Material::Textured {
+                texture: Texture::Checker {
+                    scale: 0.32,
+                    even: c(0.2, 0.2, 0.2),
+                    odd: c(0.9, 0.9, 0.9),
+                },
+            },
+        ]
+    }
+
+    /// A ground sphere and `n` random spheres (some hollow, some tiny, some lights) around
+    /// week 6's view, of random materials.
+    fn random_scene(s: &mut PixelSampler, n: usize, lights: bool) -> Scene {
+        let materials = materials();
+        let pick = |s: &mut PixelSampler| loop {
+            let m = (s.next_f64() * materials.len() as f64) as usize;
+            if lights || !materials[m].is_light() {
+                return m;
+            }
+        };
+        let mut objects = vec![SceneObject {
+            shape: Object::Sphere(Sphere::new(DVec3::new(0.0, -100.5, -1.0), 100.0)),
+            material: pick(s),
+        }];
+        for _ in 0..n {
+            let center = DVec3::new(
+                s.uniform(-2.0, 2.0),
+                s.uniform(-0.5, 1.5),
+                s.uniform(-3.0, 0.5),
+            );
+            let radius = match (s.next_f64() * 4.0) as u32 {
+                0 => -s.uniform(0.1, 0.5),
+                1 => s.uniform(0.01, 0.05),
+                _ => s.uniform(0.2, 0.8),
+            };
+            let material = pick(s);
+            objects.push(SceneObject {
+                shape: Object::Sphere(Sphere::new(center, radius)),
+                material,
+            });
+            // A shell, as the book's hollow glass: paths between the two surfaces start inside
+            // the outer sphere and leave it.
+            if radius > 0.1 && s.next_f64() < 0.5 {
+                objects.push(SceneObject {
+                    shape: Object::Sphere(Sphere::new(center, -0.8 * radius)),
+                    material,
+                });
+            }
+        }
+        Scene { objects, materials }
+    }
+
+    /// The film bits of `world` through the lanes (the dispatch's path for a world of
+    /// spheres) and through the scalar loop, at week 6's camera `width` pixels wide.
+    fn both_films(
+        world: &World,
+        width: usize,
+        spp: u32,
+        seed: u64,
+        jitter: PixelJitter,
+    ) -> (Vec<u64>, Vec<u64>) {
+        let camera = builtin("week06-dielectric").unwrap().camera(Some(width));
+        assert!(
+            takes_lanes(world).is_some(),
+            "a world of spheres takes the lanes"
+        );
+        let lanes = film_bits(&Job::new(world, &camera, spp, seed, jitter));
+        let scalar_world = world.clone().without_sphere_set();
+        assert!(takes_lanes(&scalar_world).is_none());
+        let scalar = film_bits(&Job::new(&scalar_world, &camera, spp, seed, jitter));
+        (lanes, scalar)
+    }
+
+    /// On random scenes of spheres, every integrator and setting of both profiles, rows whose
+    /// width is and is not a multiple of four, every jitter: the lanes render the scalar
+    /// loop's film (means, variances, deviations) bit for bit.
+    #[test]
+    fn lanes_render_the_scalar_film() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
+            return;
+        }
+        let mut s = PixelSampler::new(17, 3);
+        let mut compared = 0;
+        for round in 0..36 {
+            let scene = random_scene(&mut s, 1 + round % 9, round % 3 != 0);
+            let mut settings = RenderSettings {
+                max_depth: 1 + (round % 7) as u32,
+                background: if round % 2 == 0 {
+                    Background::Sky
+                } else {
+                    Background::Flat
+                },
+                ..RenderSettings::default()
+            };
+            let (integrator, profile) = match round % 6 {
+                0 => (Integrator::Direct, Profile::Course),
+                1 => (Integrator::Brdf, Profile::Course),
+                2 => (Integrator::Albedo, Profile::Course),
+                3 => (Integrator::Direct, Profile::Course),
+                4 => (Integrator::Brdf, Profile::Course),
+                _ => (Integrator::Direct, Profile::Physical),
+            };
+            settings.integrator = integrator;
+            settings.direct_term = if round % 4 == 3 {
+                DirectTerm::Unclamped
+            } else {
+                DirectTerm::Clamped
+            };
+            settings.direct_light = round % 5 != 4;
+            settings.diffuse_sampling = if round % 3 == 1 {
+                DiffuseSampling::Cosine
+            } else {
+                DiffuseSampling::UnitSphere
+            };
+            let world = World::new(scene, profile, settings, Vec::new(), 10.0);
+            let jitter = [
+                PixelJitter::Uniform,
+                PixelJitter::Stratified,
+                PixelJitter::Centre,
+            ][round % 3];
+            let width = [13, 16, 21][round % 3];
+            let (lanes, scalar) = both_films(
+                &world,
+                width,
+                1 + (round % 4) as u32 * 3,
+                round as u64,
+                jitter,
+            );
+            assert!(lanes == scalar, "round {round}: {integrator:?} {profile:?}");
+            compared += 1;
+        }
+        assert_eq!(compared, 36);
+    }
+
+    /// A sphere too large for the lanes' arithmetic (its squared radius overflows) hands every
+    /// lane back to the scalar path, to the same film; so does a light among such spheres.
+    #[test]
+    fn lanes_hand_back_what_only_the_scalar_path_solves() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
+            return;
+        }
+        let mut s = PixelSampler::new(3, 9);
+        let mut scene = random_scene(&mut s, 4, true);
+        scene.objects.push(SceneObject {
+            shape: Object::Sphere(Sphere::new(DVec3::new(0.0, 0.0, 1e200), 1e160)),
+            material: 0,
+        });
+        scene.objects.push(SceneObject {
+            shape: Object::Sphere(Sphere::new(DVec3::new(0.5, 1.0, -1.0), 0.05)),
+            material: 3,
+        });
+        for integrator in [Integrator::Direct, Integrator::Brdf] {
+            let settings = RenderSettings {
+                integrator,
+                max_depth: 4,
+                ..RenderSettings::default()
+            };
+            let world = World::new(scene.clone(), Profile::Course, settings, Vec::new(), 10.0);
+            let (lanes, scalar) = both_films(&world, 6, 5, 1, PixelJitter::Uniform);
+            assert!(lanes == scalar, "{integrator:?}");
+        }
+    }
+
+    /// The built-in scenes of spheres (weeks 6 to 9 and the book's first two) render the same
+    /// film through the lanes as through the scalar loop.
+    #[test]
+    fn built_in_scenes_of_spheres_render_the_scalar_film() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
+            return;
+        }
+        let mut taken = 0;
+        for name in crate::scene::builtin_names() {
+            let description = builtin(name).unwrap();
+            let world = description.scene();
+            if takes_lanes(&world).is_none() {
+                continue;
+            }
+            let (lanes, scalar) = both_films(&world, 9, 3, 5, PixelJitter::Uniform);
+            assert!(lanes == scalar, "{name}");
+            taken += 1;
+        }
+        assert!(taken >= 8, "only {taken} built-in scenes take the lanes");
+    }
+}

@@ -187,8 +187,16 @@ impl RayLanes {
         let a = direction.dot(direction);
         self.a[k] = a;
         self.a_margin[k] = a * PREFILTER_MARGIN;
-        self.a_sane[k] = if a.is_normal() && a < 1e300 { u64::MAX } else { 0 };
-        self.a_in_range[k] = if PREFILTER_RANGE.contains(&a) { u64::MAX } else { 0 };
+        self.a_sane[k] = if a.is_normal() && a < 1e300 {
+            u64::MAX
+        } else {
+            0
+        };
+        self.a_in_range[k] = if PREFILTER_RANGE.contains(&a) {
+            u64::MAX
+        } else {
+            0
+        };
         self.active[k] = u64::MAX;
     }
 }

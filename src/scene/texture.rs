@@ -76,11 +76,7 @@ impl Texture {
                         (inv * p.x).floor() + (inv * p.y).floor() + (inv * p.z).floor()
                     }
                 };
-                if is_even(cells) {
-                    even
-                } else {
-                    odd
-                }
+                if is_even(cells) { even } else { odd }
             }
             Texture::Image { image, tint } => match images.get(image) {
                 Some(image) => tint * image.lookup(uv),
@@ -301,7 +297,14 @@ mod tests {
     /// and a million sums of three random floors.
     #[test]
     fn evenness_is_the_remainders() {
-        let mut values = vec![0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, f64::MAX];
+        let mut values = vec![
+            0.0,
+            -0.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MAX,
+        ];
         for k in -40i64..=40 {
             values.push(k as f64);
         }
