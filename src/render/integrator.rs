@@ -222,6 +222,28 @@ fn direct_term(world: &World, p: DVec3, shadows: Shadows) -> DVec3 {
     le
 }
 
+/// The opening of a course bounce (weeks 5 to 10), the same in both integrators: on a miss the
+/// path's colour with the background, at a light its colour with the light's; otherwise the hit's
+/// material, surface record and the scattered ray (drawn from `sampler`).
+#[inline(always)]
+fn course_bounce<'w>(
+    world: &'w World,
+    path: &Path,
+    hit: Option<(f64, usize)>,
+    sampler: &mut PixelSampler,
+) -> Result<(&'w Material, Surface, scatter::Scattered), DVec3> {
+    let ray = path.ray;
+    let Some((t, object)) = hit else {
+        return Err(path.total + path.weight * background(world, ray.direction));
+    };
+    let material = world.material_of(object);
+    let surface = Surface::of(world, &ray, t, object, Interval::CAMERA);
+    match scatter::course(world, material, &ray, &surface, sampler) {
+        Some(scattered) => Ok((material, surface, scattered)),
+        None => Err(path.total + path.weight * material.albedo()),
+    }
+}
+
 /// Weeks 5 to 7's `compute_scattering(ray, scene, depth)`: depth 0 is black; every hit in
 /// `(1e-6, f64::MAX)`; a light returns its emission; otherwise `Le a + Li a` (the clamped term)
 /// or `Le + a Li` (the unclamped one), `Li` the scattered ray's; a miss returns the background.
@@ -233,14 +255,9 @@ fn direct(
     shadows: Shadows,
     sampler: &mut PixelSampler,
 ) -> Option<DVec3> {
-    let ray = path.ray;
-    let Some((t, object)) = hit else {
-        return Some(path.total + path.weight * background(world, ray.direction));
-    };
-    let material = world.material_of(object);
-    let hit = Surface::of(world, &ray, t, object, Interval::CAMERA);
-    let Some(scattered) = scatter::course(world, material, &ray, &hit, sampler) else {
-        return Some(path.total + path.weight * material.albedo());
+    let (_, hit, scattered) = match course_bounce(world, path, hit, sampler) {
+        Ok(bounce) => bounce,
+        Err(colour) => return Some(colour),
     };
     let a = scattered.attenuation;
     let le = direct_term(world, hit.point, shadows);
@@ -319,13 +336,9 @@ fn brdf(
     sampler: &mut PixelSampler,
 ) -> Option<DVec3> {
     let ray = path.ray;
-    let Some((t, object)) = hit else {
-        return Some(path.total + path.weight * background(world, ray.direction));
-    };
-    let material = world.material_of(object);
-    let hit = Surface::of(world, &ray, t, object, Interval::CAMERA);
-    let Some(scattered) = scatter::course(world, material, &ray, &hit, sampler) else {
-        return Some(path.total + path.weight * material.albedo());
+    let (material, hit, scattered) = match course_bounce(world, path, hit, sampler) {
+        Ok(bounce) => bounce,
+        Err(colour) => return Some(colour),
     };
     let n = hit.normal;
     if world.settings.direct_light {
