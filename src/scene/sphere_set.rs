@@ -1,8 +1,11 @@
 //! The spheres of a scene made only of static spheres ([`SphereSet`]): their centres and
 //! squared radii side by side, tested in one tight loop with two exact early outs, for the
-//! closest hit and the course's occlusion count.
+//! closest hit and the course's occlusion count; and, on x86-64 with AVX2, the same two queries
+//! for four rays at once ([`SphereSet::closest_lanes`], [`SphereSet::occluded_lanes`]), which
+//! the renderer's lanes of paths use.
 //!
-//! It promises the answers of [`Scene::closest`] and [`Scene::count_hits`], bit for bit. Each
+//! It promises the answers of [`Scene::closest`] and [`Scene::count_hits`], bit for bit, one ray
+//! at a time and lane by lane (where a lane over- or underflows, it says so). Each
 //! sphere's roots are [`Sphere::roots`]'s (the same `f`, `b'`, `c` and [`roots_of`]), chosen as
 //! the scene's loop chooses them. A ray for which some sphere's intermediates over- or
 //! underflow, which only the scalar path's rescaling handles, is handed back (`None`). What it
