@@ -91,18 +91,23 @@ fn start<const JITTER: u8>(job: &Job<'_, World>, pixel: usize, j: usize) -> Lane
 }
 
 /// Renders row `j` of `job` (a world whose spheres are `set`, [`takes_lanes`]) into `means`
-/// (and `variances` when `VARIANCE`), four pixels at a time.
+/// (and `variances` when `VARIANCE`), four pixels at a time. A job of no sample renders nothing,
+/// as the scalar row.
 ///
-/// `set` must come from [`takes_lanes`], which checked that the processor has the lanes'
-/// instructions.
+/// # Safety
+///
+/// The processor must have AVX2: `set` comes from [`takes_lanes`], which checked it.
 #[inline(always)]
-pub(super) fn row<const VARIANCE: bool, const JITTER: u8>(
+pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
     job: &Job<'_, World>,
     set: &SphereSet,
     j: usize,
     means: &mut [DVec3],
     variances: &mut [Spread],
 ) {
+    if job.spp == 0 {
+        return;
+    }
     let world = job.tracer;
     let interval = hit_interval(world);
     let lights = shadowed_lights(world);
@@ -126,7 +131,7 @@ pub(super) fn row<const VARIANCE: bool, const JITTER: u8>(
         if !busy {
             return;
         }
-        // SAFETY: `takes_lanes` checked the processor (this function's contract).
+        // SAFETY: the processor has AVX2 (this function's contract).
         let answers = unsafe { set.closest_lanes(&rays, interval) };
         let mut hits = [None; LANES];
         for (k, hit) in hits.iter_mut().enumerate() {
@@ -136,7 +141,8 @@ pub(super) fn row<const VARIANCE: bool, const JITTER: u8>(
             };
         }
         let shadows = if lights > 0 {
-            shadows_at(world, set, &lanes, &hits, lights)
+            // SAFETY: the processor has AVX2 (this function's contract).
+            unsafe { shadows_at(world, set, &lanes, &hits, lights) }
         } else {
             [Shadows::UNKNOWN; LANES]
         };
@@ -180,8 +186,12 @@ pub(super) fn row<const VARIANCE: bool, const JITTER: u8>(
 /// The occlusion test of the first `lights` point lights at each lane's hit point, four lanes
 /// at a time: for the lanes whose ray hit something that is not a light (the others' steps read
 /// no shadow).
+///
+/// # Safety
+///
+/// The processor must have AVX2 ([`row`]'s contract).
 #[inline(always)]
-fn shadows_at(
+unsafe fn shadows_at(
     world: &World,
     set: &SphereSet,
     lanes: &[Option<Lane>; LANES],
@@ -211,7 +221,7 @@ fn shadows_at(
                 reach[k] = to_light.length();
             }
         }
-        // SAFETY: `takes_lanes` checked the processor (`row`'s contract).
+        // SAFETY: the processor has AVX2 (this function's contract).
         let answers = unsafe { set.occluded_lanes(&rays, 1e-6, &reach) };
         for (k, point) in points.iter().enumerate() {
             let Some(p) = *point else {

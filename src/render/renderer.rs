@@ -68,7 +68,8 @@ impl Trace for World {
         let world = job.tracer;
         #[cfg(target_arch = "x86_64")]
         if let Some(set) = lanes::takes_lanes(world) {
-            return lanes::row::<VARIANCE, JITTER>(job, set, j, means, variances);
+            // SAFETY: `takes_lanes` checked that the processor has AVX2.
+            return unsafe { lanes::row::<VARIANCE, JITTER>(job, set, j, means, variances) };
         }
         for (i, mean) in means.iter_mut().enumerate() {
             let mut sampler = PixelSampler::new(job.seed, (j * width + i) as u64);
