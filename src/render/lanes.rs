@@ -1,13 +1,13 @@
-//! Lanes of paths: in a scene of static spheres, the renderer traces four pixels' paths at a
-//! time, so that each closest-hit and shadow query tests one sphere against four rays in one
-//! vector (AVX2 where the processor has it: the caller, [`Job::row`](super::job), is compiled
+//! Lanes of paths: in a small scene of spheres, moving spheres and quads, the renderer traces
+//! four pixels' paths at a time, so that each closest-hit and shadow query tests one object
+//! against four rays in one vector (AVX2 where the processor has it: the caller, [`Job::row`](super::job), is compiled
 //! for it).
 //!
 //! It promises the film of the one-ray-at-a-time row, bit for bit. Each lane renders whole
 //! pixels, one after the other along the row, each from its own random stream, sample after
 //! sample in order; every bounce is the integrator's own [`step`], given the closest hit that
-//! [`SphereSet::closest_lanes`] finds for it (the scalar loop's answer, lane by lane) and the
-//! shadow tests [`SphereSet::occluded_lanes`] answered beforehand (pure functions of the hit
+//! [`ShapeSet::closest_lanes`] finds for it (the scalar loop's answer, lane by lane) and the
+//! shadow tests [`ShapeSet::occluded_lanes`] answered beforehand (pure functions of the hit
 //! point, which the step would otherwise compute itself). A lane whose numbers over- or
 //! underflow is answered by the scalar path. Only the order in which pixels are worked on
 //! changes, not what any pixel draws or computes.
@@ -17,7 +17,7 @@ use glam::DVec3;
 use super::PixelSampler;
 use super::integrator::{Path, Shadows, hit_interval, occluded, step};
 use super::job::{Job, Moments, Spread};
-use crate::scene::{Integrator, LANES, Profile, RayLanes, SphereSet, World, has_lanes};
+use crate::scene::{Integrator, LANES, Profile, RayLanes, ShapeSet, World, has_lanes};
 
 /// One lane's work: the pixel it renders, its random stream, the sample in flight and the
 /// pixel's sums so far.
@@ -29,15 +29,15 @@ struct Lane {
     path: Path,
 }
 
-/// The spheres to trace `world` through in lanes, when it takes them: a scene of static spheres
-/// (no hierarchy) whose paths have at least one bounce, on a processor with the lanes' vector
+/// The objects to trace `world` through in lanes, when it takes them: a scene of spheres,
+/// moving spheres and quads (no hierarchy) whose paths have at least one bounce, on a processor with the lanes' vector
 /// instructions ([`has_lanes`]).
 #[inline(always)]
-pub(super) fn takes_lanes(world: &World) -> Option<&SphereSet> {
+pub(super) fn takes_lanes(world: &World) -> Option<&ShapeSet> {
     let albedo =
         world.profile == Profile::Course && world.settings.integrator == Integrator::Albedo;
     if (albedo || world.settings.max_depth > 0) && has_lanes() {
-        world.sphere_set()
+        world.shape_set()
     } else {
         None
     }
@@ -100,7 +100,7 @@ fn start<const JITTER: u8>(job: &Job<'_, World>, pixel: usize, j: usize) -> Lane
 #[inline(always)]
 pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
     job: &Job<'_, World>,
-    set: &SphereSet,
+    set: &ShapeSet,
     j: usize,
     means: &mut [DVec3],
     variances: &mut [Spread],
@@ -124,7 +124,8 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
         let mut busy = false;
         for (k, lane) in lanes.iter().enumerate() {
             if let Some(lane) = lane {
-                rays.set(k, lane.path.ray.origin, lane.path.ray.direction);
+                let ray = &lane.path.ray;
+                rays.set(k, ray.origin, ray.direction, ray.time);
                 busy = true;
             }
         }
@@ -193,7 +194,7 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
 #[inline(always)]
 unsafe fn shadows_at(
     world: &World,
-    set: &SphereSet,
+    set: &ShapeSet,
     lanes: &[Option<Lane>; LANES],
     hits: &[Option<(f64, usize)>; LANES],
     lights: usize,
@@ -217,7 +218,8 @@ unsafe fn shadows_at(
         for (k, point) in points.iter().enumerate() {
             if let Some(p) = *point {
                 let to_light = light.center - p;
-                rays.set(k, p, to_light);
+                // Shadow rays carry time 0 (`occluded`'s `Ray::new`).
+                rays.set(k, p, to_light, 0.0);
                 reach[k] = to_light.length();
             }
         }
@@ -240,7 +242,7 @@ unsafe fn shadows_at(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Sphere;
+    use crate::geometry::{MovingSphere, Quad, Sphere};
     use crate::render::job::{PixelJitter, film_bits};
     use crate::scene::{
         Background, DiffuseSampling, DirectTerm, Material, Object, RenderSettings, Scene,
@@ -298,8 +300,9 @@ mod tests {
     }
 
     /// A ground sphere and `n` random spheres (some hollow, some tiny, some lights) around
-    /// week 6's view, of random materials.
-    fn random_scene(s: &mut PixelSampler, n: usize, lights: bool) -> Scene {
+    /// week 6's view, of random materials; when `mixed`, some of them move and a box of quads
+    /// (a floor, a back wall and a side wall, as week 5's, and a square light) is added.
+    fn random_scene(s: &mut PixelSampler, n: usize, lights: bool, mixed: bool) -> Scene {
         let materials = materials();
         let pick = |s: &mut PixelSampler| loop {
             let m = (s.next_f64() * materials.len() as f64) as usize;
@@ -323,10 +326,14 @@ mod tests {
                 _ => s.uniform(0.2, 0.8),
             };
             let material = pick(s);
-            objects.push(SceneObject {
-                shape: Object::Sphere(Sphere::new(center, radius)),
-                material,
-            });
+            let sphere = Sphere::new(center, radius);
+            let shape = if mixed && s.next_f64() < 0.4 {
+                let end = center + s.unit_vector() * s.uniform(0.0, 0.5);
+                Object::MovingSphere(MovingSphere::new(sphere, end))
+            } else {
+                Object::Sphere(sphere)
+            };
+            objects.push(SceneObject { shape, material });
             // A shell, as the book's hollow glass: paths between the two surfaces start inside
             // the outer sphere and leave it.
             if radius > 0.1 && s.next_f64() < 0.5 {
@@ -336,11 +343,25 @@ mod tests {
                 });
             }
         }
+        if mixed {
+            let c = DVec3::new;
+            for (q, u, v) in [
+                (c(-3.0, -0.5, -4.0), c(6.0, 0.0, 0.0), c(0.0, 0.0, 5.0)),
+                (c(-3.0, -0.5, -4.0), c(0.0, 4.0, 0.0), c(6.0, 0.0, 0.0)),
+                (c(-3.0, -0.5, -4.0), c(0.0, 0.0, 5.0), c(0.0, 4.0, 0.0)),
+                (c(-0.5, 2.5, -2.0), c(1.0, 0.0, 0.0), c(0.0, 0.0, 1.0)),
+            ] {
+                objects.push(SceneObject {
+                    shape: Object::Quad(Quad::new(q, u, v)),
+                    material: pick(s),
+                });
+            }
+        }
         Scene { objects, materials }
     }
 
     /// The film bits of `world` through the lanes (the dispatch's path for a world of
-    /// spheres) and through the scalar loop, at week 6's camera `width` pixels wide.
+    /// spheres and quads) and through the scalar loop, at week 6's camera `width` pixels wide.
     fn both_films(
         world: &World,
         width: usize,
@@ -351,18 +372,19 @@ mod tests {
         let camera = builtin("week06-dielectric").unwrap().camera(Some(width));
         assert!(
             takes_lanes(world).is_some(),
-            "a world of spheres takes the lanes"
+            "a world of spheres and quads takes the lanes"
         );
         let lanes = film_bits(&Job::new(world, &camera, spp, seed, jitter));
-        let scalar_world = world.clone().without_sphere_set();
+        let scalar_world = world.clone().without_shape_set();
         assert!(takes_lanes(&scalar_world).is_none());
         let scalar = film_bits(&Job::new(&scalar_world, &camera, spp, seed, jitter));
         (lanes, scalar)
     }
 
-    /// On random scenes of spheres, every integrator and setting of both profiles, rows whose
-    /// width is and is not a multiple of four, every jitter: the lanes render the scalar
-    /// loop's film (means, variances, deviations) bit for bit.
+    /// On random scenes of spheres (36), then of spheres, moving spheres and quads (36), every
+    /// integrator and setting of both profiles, rows whose width is and is not a multiple of
+    /// four, every jitter: the lanes render the scalar loop's film (means, variances,
+    /// deviations) bit for bit.
     #[test]
     fn lanes_render_the_scalar_film() {
         if !has_lanes() {
@@ -371,8 +393,14 @@ mod tests {
         }
         let mut s = PixelSampler::new(17, 3);
         let mut compared = 0;
-        for round in 0..36 {
-            let scene = random_scene(&mut s, 1 + round % 9, round % 3 != 0);
+        for round in 0..72 {
+            // A mixed scene of up to 15 objects, so that it takes no hierarchy.
+            let n = if round < 36 {
+                1 + round % 9
+            } else {
+                1 + round % 5
+            };
+            let scene = random_scene(&mut s, n, round % 3 != 0, round >= 36);
             let mut settings = RenderSettings {
                 max_depth: 1 + (round % 7) as u32,
                 background: if round % 2 == 0 {
@@ -419,7 +447,7 @@ mod tests {
             assert!(lanes == scalar, "round {round}: {integrator:?} {profile:?}");
             compared += 1;
         }
-        assert_eq!(compared, 36);
+        assert_eq!(compared, 72);
     }
 
     /// A sphere too large for the lanes' arithmetic (its squared radius overflows) hands every
@@ -431,7 +459,7 @@ mod tests {
             return;
         }
         let mut s = PixelSampler::new(3, 9);
-        let mut scene = random_scene(&mut s, 4, true);
+        let mut scene = random_scene(&mut s, 4, true, true);
         scene.objects.push(SceneObject {
             shape: Object::Sphere(Sphere::new(DVec3::new(0.0, 0.0, 1e200), 1e160)),
             material: 0,
@@ -452,10 +480,11 @@ mod tests {
         }
     }
 
-    /// The built-in scenes of spheres (weeks 6 to 9 and the book's first two) render the same
-    /// film through the lanes as through the scalar loop.
+    /// Every built-in scene without a hierarchy or a triangle (all of weeks 4 to 10, the book's
+    /// first two and the edge cases: spheres, moving spheres and quads) takes the lanes, and renders the same film through
+    /// them as through the scalar loop.
     #[test]
-    fn built_in_scenes_of_spheres_render_the_scalar_film() {
+    fn built_in_scenes_render_the_scalar_film() {
         if !has_lanes() {
             eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
             return;
@@ -464,13 +493,18 @@ mod tests {
         for name in crate::scene::builtin_names() {
             let description = builtin(name).unwrap();
             let world = description.scene();
-            if takes_lanes(&world).is_none() {
+            let triangles = world
+                .objects
+                .iter()
+                .any(|o| matches!(o.shape, Object::Triangle(_)));
+            if world.has_hierarchy() || triangles {
                 continue;
             }
+            assert!(takes_lanes(&world).is_some(), "{name} takes no lanes");
             let (lanes, scalar) = both_films(&world, 9, 3, 5, PixelJitter::Uniform);
             assert!(lanes == scalar, "{name}");
             taken += 1;
         }
-        assert!(taken >= 8, "only {taken} built-in scenes take the lanes");
+        assert!(taken >= 19, "only {taken} built-in scenes take the lanes");
     }
 }

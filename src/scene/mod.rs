@@ -15,7 +15,8 @@ mod material;
 mod object;
 mod profile;
 mod settings;
-mod sphere_set;
+mod shape_lanes;
+mod shape_set;
 mod texture;
 mod validate;
 mod world;
@@ -38,7 +39,8 @@ pub use settings::{
     Background, COURSE_BACKGROUND, DEFAULT_MAX_DEPTH, DiffuseSampling, DirectTerm, Integrator,
     PixelSampling, RenderSettings,
 };
-pub(crate) use sphere_set::{LANES, RayLanes, SphereSet, has_lanes};
+pub(crate) use shape_lanes::{LANES, RayLanes, has_lanes};
+pub(crate) use shape_set::ShapeSet;
 pub use texture::{
     GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,
 };

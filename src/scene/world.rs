@@ -1,12 +1,12 @@
 //! Everything a render reads ([`World`]): the objects and materials, the images of the textures
 //! prepared for the profile, the point lights, the settings, and, for the closest-hit and
-//! occlusion queries, a bounding volume hierarchy (large scenes) or the spheres side by side
-//! (small scenes of static spheres).
+//! occlusion queries, a bounding volume hierarchy (large scenes) or the objects side by side
+//! (small scenes of spheres, moving spheres and quads).
 
 use glam::DVec3;
 
 use super::bvh::{BVH_MIN_OBJECTS, Bvh};
-use super::sphere_set::SphereSet;
+use super::shape_set::ShapeSet;
 use super::{Material, Object, Profile, RenderSettings, Scene, TextureImage};
 use crate::geometry::{Interval, Ray};
 
@@ -40,9 +40,9 @@ pub struct World {
     /// division from it); 1 unless set.
     pub samples_per_pixel: u32,
     bvh: Option<Bvh>,
-    /// The spheres side by side, when every object is a static sphere and there is no
-    /// hierarchy.
-    spheres: Option<SphereSet>,
+    /// The objects side by side, when every object is a sphere, a moving sphere or a quad and
+    /// there is no hierarchy.
+    shapes: Option<ShapeSet>,
 }
 
 impl std::ops::Deref for World {
@@ -107,8 +107,8 @@ impl World {
         } else {
             None
         };
-        let spheres = if bvh.is_none() {
-            SphereSet::new(&scene)
+        let shapes = if bvh.is_none() {
+            ShapeSet::new(&scene)
         } else {
             None
         };
@@ -121,7 +121,7 @@ impl World {
             moving,
             samples_per_pixel: 1,
             bvh,
-            spheres,
+            shapes,
         }
     }
 
@@ -136,12 +136,13 @@ impl World {
     }
 
     /// The closest hit's `t` and object index: exactly [`Scene::closest`]'s answer, through the
-    /// hierarchy when there is one, or the side-by-side list of a scene of static spheres.
+    /// hierarchy when there is one, or the side-by-side list of a small scene of spheres and
+    /// quads.
     #[inline(always)]
     pub fn closest(&self, ray: &Ray, interval: Interval) -> Option<(f64, usize)> {
         match &self.bvh {
             Some(bvh) => bvh.closest(&self.scene, ray, interval),
-            None => match self.spheres.as_ref().and_then(|s| s.closest(ray, interval)) {
+            None => match self.shapes.as_ref().and_then(|s| s.closest(ray, interval)) {
                 Some(answer) => answer,
                 None => self.scene.closest(ray, interval),
             },
@@ -154,7 +155,7 @@ impl World {
     pub fn count_hits(&self, ray: &Ray, interval: Interval, limit: usize) -> usize {
         match &self.bvh {
             Some(bvh) => bvh.count_hits(&self.scene, ray, interval, limit),
-            None => match self.spheres.as_ref() {
+            None => match self.shapes.as_ref() {
                 Some(set) => set
                     .count_hits(ray, interval, limit)
                     .unwrap_or_else(|| self.scene.count_hits(ray, interval, limit)),
@@ -163,18 +164,19 @@ impl World {
         }
     }
 
-    /// The spheres side by side, when every object is a static sphere and there is no
-    /// hierarchy: the renderer then traces four paths at a time through their lanes queries.
+    /// The objects side by side, when every object is a sphere, a moving sphere or a quad and
+    /// there is no hierarchy: the renderer then traces four paths at a time through their lanes
+    /// queries.
     #[inline(always)]
-    pub(crate) fn sphere_set(&self) -> Option<&SphereSet> {
-        self.spheres.as_ref()
+    pub(crate) fn shape_set(&self) -> Option<&ShapeSet> {
+        self.shapes.as_ref()
     }
 
-    /// A copy without the side-by-side spheres (the scene's own loop, one ray at a time), for
+    /// A copy without the side-by-side objects (the scene's own loop, one ray at a time), for
     /// tests that compare the two.
     #[cfg(test)]
-    pub(crate) fn without_sphere_set(mut self) -> Self {
-        self.spheres = None;
+    pub(crate) fn without_shape_set(mut self) -> Self {
+        self.shapes = None;
         self
     }
 

@@ -1,0 +1,636 @@
+//! The two queries of a [`ShapeSet`] (the closest hit, the course's occlusion test) for four
+//! rays at once, on x86-64 with AVX2 ([`ShapeSet::closest_lanes`],
+//! [`ShapeSet::occluded_lanes`]): the renderer's lanes of paths ask them.
+//!
+//! It promises, lane by lane, the scalar set's answers, so [`Scene::closest`]'s and
+//! [`Scene::count_hits`]'s, bit for bit; where a lane's sphere arithmetic over- or underflows, it
+//! says so and the scalar path decides. Each object's test is the scalar test's operations, in
+//! its order, in one AVX2 vector (IEEE operations round alike in a vector lane; nothing is
+//! fused); where the scalar code branches, both sides are computed and the lane's is selected.
+//! Objects are taken in the scene's order, so ties go as the scene's loop sends them (a quad's
+//! closed test replaces an earlier object at the same `t`, a sphere's open one does not).
+//!
+//! The per-object tests are `#[inline(always)]` unsafe functions without a target feature of
+//! their own, so that they are compiled inside the two queries, which are compiled for AVX2:
+//! as separate functions (one call per object and ray packet, the vectors passed through
+//! memory) they took week 8's benchmark from 1.01x the C loop's speed to 0.72x.
+//!
+//! [`Scene::closest`]: super::Scene::closest
+//! [`Scene::count_hits`]: super::Scene::count_hits
+
+use glam::DVec3;
+
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
+
+#[cfg(target_arch = "x86_64")]
+use super::shape_set::{Ball, Member, ShapeSet};
+use super::shape_set::{PREFILTER_MARGIN, PREFILTER_RANGE};
+#[cfg(target_arch = "x86_64")]
+use crate::geometry::{Interval, PARALLEL_EPSILON, Quad};
+
+/// How many rays [`ShapeSet::closest_lanes`] and [`ShapeSet::occluded_lanes`] take at once:
+/// four `f64` lanes, one AVX2 vector.
+pub(crate) const LANES: usize = 4;
+
+/// Up to [`LANES`] rays side by side (origins, directions, times, and `a = d . d`), for the
+/// lanes queries. A lane that is not `active` is ignored.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RayLanes {
+    ox: [f64; LANES],
+    oy: [f64; LANES],
+    oz: [f64; LANES],
+    dx: [f64; LANES],
+    dy: [f64; LANES],
+    dz: [f64; LANES],
+    time: [f64; LANES],
+    a: [f64; LANES],
+    /// `a * PREFILTER_MARGIN`, the pre-filter's margin before the sphere's scale.
+    a_margin: [f64; LANES],
+    /// All ones where `a.is_normal() && a < 1e300` (`roots_of`'s check of `a`).
+    a_sane: [u64; LANES],
+    /// All ones where `a` lies in the pre-filter's range.
+    a_in_range: [u64; LANES],
+    active: [u64; LANES],
+}
+
+impl RayLanes {
+    /// Puts the ray from `origin` along `direction` at `time` in lane `k`.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, k: usize, origin: DVec3, direction: DVec3, time: f64) {
+        (self.ox[k], self.oy[k], self.oz[k]) = (origin.x, origin.y, origin.z);
+        (self.dx[k], self.dy[k], self.dz[k]) = (direction.x, direction.y, direction.z);
+        self.time[k] = time;
+        let a = direction.dot(direction);
+        self.a[k] = a;
+        self.a_margin[k] = a * PREFILTER_MARGIN;
+        self.a_sane[k] = if a.is_normal() && a < 1e300 {
+            u64::MAX
+        } else {
+            0
+        };
+        self.a_in_range[k] = if PREFILTER_RANGE.contains(&a) {
+            u64::MAX
+        } else {
+            0
+        };
+        self.active[k] = u64::MAX;
+    }
+}
+
+/// Whether this processor runs the lanes queries ([`ShapeSet::closest_lanes`],
+/// [`ShapeSet::occluded_lanes`]): an x86-64 with AVX2. Elsewhere the renderer traces one ray at
+/// a time, to the same film.
+#[inline]
+pub(crate) fn has_lanes() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Three coordinates, one vector each.
+#[cfg(target_arch = "x86_64")]
+type Vec3Lanes = [__m256d; 3];
+
+/// `u . v` lane by lane, in glam's order `(x x' + y y') + z z'`.
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn dot(u: Vec3Lanes, v: Vec3Lanes) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract).
+    unsafe {
+        _mm256_add_pd(
+            _mm256_add_pd(_mm256_mul_pd(u[0], v[0]), _mm256_mul_pd(u[1], v[1])),
+            _mm256_mul_pd(u[2], v[2]),
+        )
+    }
+}
+
+/// Where `x` is neither infinite nor NaN, lane by lane.
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn finite(x: __m256d) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract).
+    unsafe {
+        let magnitude = _mm256_andnot_pd(_mm256_set1_pd(-0.0), x);
+        _mm256_cmp_pd::<_CMP_LT_OQ>(magnitude, _mm256_set1_pd(f64::INFINITY))
+    }
+}
+
+/// The rays' origins, directions and active lanes, loaded.
+#[cfg(target_arch = "x86_64")]
+struct Loaded {
+    origin: Vec3Lanes,
+    direction: Vec3Lanes,
+    active: __m256d,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Loaded {
+    /// `rays`, loaded.
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2.
+    #[inline(always)]
+    unsafe fn new(rays: &RayLanes) -> Self {
+        // SAFETY: AVX2 is there (this function's contract); each load reads a whole `[_; 4]`.
+        unsafe {
+            let load = |x: &[f64; LANES]| _mm256_loadu_pd(x.as_ptr());
+            Self {
+                origin: [load(&rays.ox), load(&rays.oy), load(&rays.oz)],
+                direction: [load(&rays.dx), load(&rays.dy), load(&rays.dz)],
+                active: mask(&rays.active),
+            }
+        }
+    }
+}
+
+/// A lane mask of all ones or all zeros per lane, loaded.
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn mask(x: &[u64; LANES]) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract); the load reads the whole array.
+    unsafe { _mm256_castsi256_pd(_mm256_loadu_si256(x.as_ptr().cast())) }
+}
+
+/// One sphere (centre `center` lane by lane, squared radius `r2`) against every lane: where each
+/// lane's ray has a root in `(min, max[k])` (the lane's root in `t`, the others unchanged), and
+/// the lanes whose intermediates over- or underflow.
+///
+/// Lane by lane these are the scalar set's `root` operations, in its order: the same `f`, `b'`,
+/// `c`, early outs (`sure_miss`), then [`roots_lanes`]. A ball every lane surely misses costs
+/// no division. The tests compare it with the scene's loop
+/// (`lanes_answer_as_the_scene_loop_does`).
+///
+/// # Safety
+///
+/// The processor must have AVX2 (the caller checked [`has_lanes`]).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn ball_lanes(
+    center: Vec3Lanes,
+    r2: f64,
+    rays: &RayLanes,
+    loaded: &Loaded,
+    min: f64,
+    max: &[f64; LANES],
+    t: &mut [f64; LANES],
+) -> (u32, u32) {
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the loads read
+    // whole `[_; 4]` arrays.
+    unsafe {
+        let splat = |x: f64| _mm256_set1_pd(x);
+        let [o, d] = [loaded.origin, loaded.direction];
+        let f = [
+            _mm256_sub_pd(o[0], center[0]),
+            _mm256_sub_pd(o[1], center[1]),
+            _mm256_sub_pd(o[2], center[2]),
+        ];
+        let r2v = splat(r2);
+        let half_b = dot(f, d);
+        let ff = dot(f, f);
+        let c = _mm256_sub_pd(ff, r2v);
+        let zero = _mm256_setzero_pd();
+        let solvable = if r2 < 1e300 {
+            _mm256_and_pd(_mm256_and_pd(mask(&rays.a_sane), finite(c)), finite(half_b))
+        } else {
+            zero
+        };
+        let behind = if min >= 0.0 {
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_GT_OQ>(half_b, zero),
+                _mm256_cmp_pd::<_CMP_GT_OQ>(c, zero),
+            )
+        } else {
+            zero
+        };
+        let scale = _mm256_add_pd(ff, r2v);
+        let in_range = _mm256_and_pd(
+            _mm256_cmp_pd::<_CMP_GE_OQ>(scale, splat(PREFILTER_RANGE.start)),
+            _mm256_cmp_pd::<_CMP_LT_OQ>(scale, splat(PREFILTER_RANGE.end)),
+        );
+        let a = _mm256_loadu_pd(rays.a.as_ptr());
+        let naive = _mm256_sub_pd(_mm256_mul_pd(half_b, half_b), _mm256_mul_pd(a, c));
+        let margin = _mm256_mul_pd(_mm256_loadu_pd(rays.a_margin.as_ptr()), scale);
+        let margin = _mm256_xor_pd(margin, splat(-0.0));
+        let aside = _mm256_and_pd(
+            _mm256_and_pd(mask(&rays.a_in_range), in_range),
+            _mm256_cmp_pd::<_CMP_LT_OQ>(naive, margin),
+        );
+        let sure = _mm256_and_pd(solvable, _mm256_or_pd(behind, aside));
+        let open = _mm256_andnot_pd(sure, loaded.active);
+        let unsolved = _mm256_andnot_pd(solvable, loaded.active);
+        if _mm256_movemask_pd(open) == 0 {
+            return (0, _mm256_movemask_pd(unsolved) as u32);
+        }
+        let parts = Parts {
+            f,
+            a,
+            half_b,
+            r2: r2v,
+            c,
+        };
+        let (found, overflow) = roots_lanes(&parts, d, open, min, max, t);
+        (found, _mm256_movemask_pd(unsolved) as u32 | overflow)
+    }
+}
+
+/// One sphere's parts for the lanes' rays: `f = o - center`, `a = d . d`, `b' = f . d`,
+/// `r^2` and `c = f . f - r^2`.
+#[cfg(target_arch = "x86_64")]
+struct Parts {
+    f: Vec3Lanes,
+    a: __m256d,
+    half_b: __m256d,
+    r2: __m256d,
+    c: __m256d,
+}
+
+/// `roots_of` then `pick_root` against `(min, max[k])`, for the `open` lanes: where a lane
+/// finds a root, it is stored in `t`. Returns the lanes that found one, and those whose
+/// discriminant over- or underflowed.
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn roots_lanes(
+    parts: &Parts,
+    d: Vec3Lanes,
+    open: __m256d,
+    min: f64,
+    max: &[f64; LANES],
+    t: &mut [f64; LANES],
+) -> (u32, u32) {
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the load and
+    // the store read and write whole `[f64; 4]` arrays.
+    unsafe {
+        let &Parts {
+            f,
+            a,
+            half_b,
+            r2,
+            c,
+        } = parts;
+        let sign = _mm256_set1_pd(-0.0);
+        let zero = _mm256_setzero_pd();
+        let s = _mm256_div_pd(half_b, a);
+        let p = [
+            _mm256_sub_pd(f[0], _mm256_mul_pd(d[0], s)),
+            _mm256_sub_pd(f[1], _mm256_mul_pd(d[1], s)),
+            _mm256_sub_pd(f[2], _mm256_mul_pd(d[2], s)),
+        ];
+        let disc = _mm256_mul_pd(a, _mm256_sub_pd(r2, dot(p, p)));
+        let disc_finite = finite(disc);
+        let overflow = _mm256_andnot_pd(disc_finite, open);
+        let root = _mm256_sqrt_pd(disc);
+        // `sqrt(disc).copysign(half_b)`, then negated.
+        let signed = _mm256_or_pd(_mm256_andnot_pd(sign, root), _mm256_and_pd(sign, half_b));
+        let q = _mm256_xor_pd(_mm256_add_pd(half_b, signed), sign);
+        let t0 = _mm256_div_pd(c, q);
+        let t1 = _mm256_div_pd(q, a);
+        // `-b' / a`: a negated quotient rounds to the same magnitude, so this is `-(b' / a)`.
+        let double = _mm256_xor_pd(s, sign);
+        let ordered = _mm256_cmp_pd::<_CMP_LE_OQ>(t0, t1);
+        let near = _mm256_blendv_pd(t1, t0, ordered);
+        let far = _mm256_blendv_pd(t0, t1, ordered);
+        let tangent = _mm256_cmp_pd::<_CMP_EQ_OQ>(q, zero);
+        let near = _mm256_blendv_pd(near, double, tangent);
+        let far = _mm256_blendv_pd(far, double, tangent);
+        // `pick_root` against `(min, max[k])`.
+        let (lo, hi) = (_mm256_set1_pd(min), _mm256_loadu_pd(max.as_ptr()));
+        let surrounds = |x| {
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_LT_OQ>(lo, x),
+                _mm256_cmp_pd::<_CMP_LT_OQ>(x, hi),
+            )
+        };
+        let (near_in, far_in) = (surrounds(near), surrounds(far));
+        let found = _mm256_and_pd(
+            _mm256_and_pd(open, disc_finite),
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_GE_OQ>(disc, zero),
+                _mm256_or_pd(near_in, far_in),
+            ),
+        );
+        let chosen = _mm256_blendv_pd(far, near, near_in);
+        let kept = _mm256_blendv_pd(_mm256_loadu_pd(t.as_ptr()), chosen, found);
+        _mm256_storeu_pd(t.as_mut_ptr(), kept);
+        (
+            _mm256_movemask_pd(found) as u32,
+            _mm256_movemask_pd(overflow) as u32,
+        )
+    }
+}
+
+/// One quad against every lane: where each lane's ray hits it within `[min, max[k]]` (closed,
+/// the course's `contains`; the lane's `t` stored in `t`).
+///
+/// Lane by lane these are [`Quad::solve_from`]'s operations, in its order: `denom = n . d`,
+/// `t = (D - n . o) / denom`, refused when `|denom| < 1e-8` or NaN, `t` not finite or outside
+/// the interval; then `planar = o + d t - Q` and `alpha = w . (planar x v)`,
+/// `beta = w . (u x planar)` (glam's cross product, term by term), both in `[0, 1]`. A quad
+/// whose plane no lane meets within its interval costs no more than the division.
+///
+/// # Safety
+///
+/// The processor must have AVX2 (the caller checked [`has_lanes`]).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn quad_lanes(
+    quad: &Quad,
+    loaded: &Loaded,
+    min: f64,
+    max: &[f64; LANES],
+    t: &mut [f64; LANES],
+) -> u32 {
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the load and
+    // the store read and write whole `[f64; 4]` arrays.
+    unsafe {
+        let splat = |x: f64| _mm256_set1_pd(x);
+        let splat3 = |v: DVec3| [splat(v.x), splat(v.y), splat(v.z)];
+        let [o, d] = [loaded.origin, loaded.direction];
+        let n = splat3(quad.normal);
+        let denom = dot(n, d);
+        let offset = _mm256_sub_pd(splat(quad.d), dot(n, o));
+        let at = _mm256_div_pd(offset, denom);
+        let magnitude = _mm256_andnot_pd(splat(-0.0), denom);
+        let plane = _mm256_and_pd(
+            _mm256_and_pd(
+                loaded.active,
+                _mm256_cmp_pd::<_CMP_GE_OQ>(magnitude, splat(PARALLEL_EPSILON)),
+            ),
+            _mm256_and_pd(
+                finite(at),
+                _mm256_and_pd(
+                    _mm256_cmp_pd::<_CMP_LE_OQ>(splat(min), at),
+                    _mm256_cmp_pd::<_CMP_LE_OQ>(at, _mm256_loadu_pd(max.as_ptr())),
+                ),
+            ),
+        );
+        if _mm256_movemask_pd(plane) == 0 {
+            return 0;
+        }
+        // `ray.at(t) - q`.
+        let p = [0, 1, 2].map(|i| {
+            let point = _mm256_add_pd(o[i], _mm256_mul_pd(d[i], at));
+            _mm256_sub_pd(point, splat(quad.q[i]))
+        });
+        let (u, v, w) = (splat3(quad.u), splat3(quad.v), splat3(quad.w));
+        // glam's `a x b`: `(a.y b.z - b.y a.z, a.z b.x - b.z a.x, a.x b.y - b.x a.y)`.
+        let cross = |a: Vec3Lanes, b: Vec3Lanes| {
+            let term = |i: usize, j: usize| {
+                _mm256_sub_pd(_mm256_mul_pd(a[i], b[j]), _mm256_mul_pd(b[i], a[j]))
+            };
+            [term(1, 2), term(2, 0), term(0, 1)]
+        };
+        let alpha = dot(w, cross(p, v));
+        let beta = dot(w, cross(u, p));
+        let unit = |x| {
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_LE_OQ>(_mm256_setzero_pd(), x),
+                _mm256_cmp_pd::<_CMP_LE_OQ>(x, splat(1.0)),
+            )
+        };
+        let found = _mm256_and_pd(plane, _mm256_and_pd(unit(alpha), unit(beta)));
+        let kept = _mm256_blendv_pd(_mm256_loadu_pd(t.as_ptr()), at, found);
+        _mm256_storeu_pd(t.as_mut_ptr(), kept);
+        _mm256_movemask_pd(found) as u32
+    }
+}
+
+/// Member `member` against every lane: the lanes that found a root in the interval (stored in
+/// `t`) and those that must be decided by the scalar path.
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn member_lanes(
+    member: &Member,
+    rays: &RayLanes,
+    loaded: &Loaded,
+    min: f64,
+    max: &[f64; LANES],
+    t: &mut [f64; LANES],
+) -> (u32, u32) {
+    // SAFETY: AVX2 is there (this function's contract); the load reads a whole `[f64; 4]`.
+    unsafe {
+        let splat = |x: f64| _mm256_set1_pd(x);
+        match member {
+            Member::Ball(Ball { center, r2 }) => {
+                let center = [splat(center.x), splat(center.y), splat(center.z)];
+                ball_lanes(center, *r2, rays, loaded, min, max, t)
+            }
+            Member::Moving { ball, travel } => {
+                // `center + travel * time`, lane by lane.
+                let time = _mm256_loadu_pd(rays.time.as_ptr());
+                let center = [0, 1, 2].map(|i| {
+                    _mm256_add_pd(splat(ball.center[i]), _mm256_mul_pd(splat(travel[i]), time))
+                });
+                ball_lanes(center, ball.r2, rays, loaded, min, max, t)
+            }
+            Member::Quad(quad) => (quad_lanes(quad, loaded, min, max, t), 0),
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl ShapeSet {
+    /// [`ShapeSet::closest`] for each active lane of `rays` at once: lane `k`'s closest hit in
+    /// `interval`, or `Err(())` where the lane's ray must be decided by the scalar path (over-
+    /// or underflow). Inactive lanes answer `Ok(None)`.
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) unsafe fn closest_lanes(
+        &self,
+        rays: &RayLanes,
+        interval: Interval,
+    ) -> [Result<Option<(f64, usize)>, ()>; LANES] {
+        let mut closest = [interval.max; LANES];
+        let mut index = [usize::MAX; LANES];
+        let mut unsolved = 0;
+        // SAFETY: AVX2 is there (this function's contract).
+        let loaded = unsafe { Loaded::new(rays) };
+        for (me, member) in self.members.iter().enumerate() {
+            let max = closest;
+            // SAFETY: AVX2 is there (this function's contract).
+            let (hit, bad) =
+                unsafe { member_lanes(member, rays, &loaded, interval.min, &max, &mut closest) };
+            for (k, index) in index.iter_mut().enumerate() {
+                if hit & (1 << k) != 0 {
+                    *index = me;
+                }
+            }
+            unsolved |= bad;
+        }
+        let mut answers = [Ok(None); LANES];
+        for (k, answer) in answers.iter_mut().enumerate() {
+            if unsolved & (1 << k) != 0 {
+                *answer = Err(());
+            } else if index[k] != usize::MAX {
+                *answer = Ok(Some((closest[k], index[k])));
+            }
+        }
+        answers
+    }
+
+    /// The course's occlusion test ([`ShapeSet::count_hits`] on `[min, max[k]]`, limit 2, more
+    /// than one hit) for each active lane of `rays` at once: `Ok(occluded)`, or `Err(())` where
+    /// the lane's ray must be decided by the scalar path. Inactive lanes answer `Ok(false)`.
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) unsafe fn occluded_lanes(
+        &self,
+        rays: &RayLanes,
+        min: f64,
+        max: &[f64; LANES],
+    ) -> [Result<bool, ()>; LANES] {
+        let mut count = [0u32; LANES];
+        let mut unsolved = 0;
+        let mut t = [0.0; LANES];
+        // SAFETY: AVX2 is there (this function's contract).
+        let loaded = unsafe { Loaded::new(rays) };
+        for member in &self.members {
+            // SAFETY: AVX2 is there (this function's contract).
+            let (hit, bad) = unsafe { member_lanes(member, rays, &loaded, min, max, &mut t) };
+            for (k, count) in count.iter_mut().enumerate() {
+                *count += (hit >> k) & 1;
+            }
+            unsolved |= bad;
+        }
+        let mut answers = [Ok(false); LANES];
+        for (k, answer) in answers.iter_mut().enumerate() {
+            *answer = if unsolved & (1 << k) != 0 {
+                Err(())
+            } else {
+                Ok(count[k] > 1)
+            };
+        }
+        answers
+    }
+}
+
+#[cfg(test)]
+#[cfg(target_arch = "x86_64")]
+mod tests {
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::render::PixelSampler;
+    use crate::scene::shape_set::tests::{intervals, random_ray, random_scene};
+
+    /// On 300 random scenes of spheres, then 300 of spheres, moving spheres and quads, 250
+    /// packets of four rays each (some lanes idle), under the camera's interval, a shadow ray's
+    /// and the book's: each lane's closest object and `t` bits are the scene loop's, and its
+    /// occlusion (on its own reach) is the scene's count above one.
+    #[test]
+    fn lanes_answer_as_the_scene_loop_does() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+            return;
+        }
+        let mut s = PixelSampler::new(29, 7);
+        let mut compared = 0;
+        for scene_number in 0..600 {
+            let scene = random_scene(&mut s, 1 + scene_number % 12, scene_number >= 300);
+            let set = ShapeSet::new(&scene).expect("spheres and quads only");
+            for _ in 0..250 {
+                let mut rays = RayLanes::default();
+                let mut packet: [Option<(Ray, [Interval; 3])>; LANES] = [None; LANES];
+                for (k, lane) in packet.iter_mut().enumerate() {
+                    let ray = random_ray(&mut s, &scene);
+                    let asked = intervals(&mut s, &ray);
+                    if s.next_f64() < 0.85 {
+                        rays.set(k, ray.origin, ray.direction, ray.time);
+                        *lane = Some((ray, asked));
+                    }
+                }
+                for which in 0..3 {
+                    let interval = |k: usize| packet[k].map(|(_, i)| i[which]);
+                    let shared = interval(0).unwrap_or(Interval::CAMERA);
+                    // SAFETY: the processor has AVX2 (checked above).
+                    let closest = unsafe { set.closest_lanes(&rays, shared) };
+                    let reach = [0, 1, 2, 3].map(|k| interval(k).map_or(0.0, |i| i.max));
+                    // SAFETY: as above.
+                    let dark = unsafe { set.occluded_lanes(&rays, shared.min, &reach) };
+                    for (k, lane) in packet.iter().enumerate() {
+                        let Some((ray, _)) = lane else {
+                            assert_eq!(closest[k], Ok(None));
+                            assert_eq!(dark[k], Ok(false));
+                            continue;
+                        };
+                        let slow = scene.closest(ray, shared);
+                        assert_eq!(
+                            closest[k].map(|a| a.map(|(t, k)| (t.to_bits(), k))),
+                            Ok(slow.map(|(t, k)| (t.to_bits(), k))),
+                            "{ray:?} {shared:?}"
+                        );
+                        let own = Interval::new(shared.min, reach[k]);
+                        assert_eq!(dark[k], Ok(scene.count_hits(ray, own, 2) > 1), "{ray:?}");
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared > 600 * 250 * 3 * 3, "{compared}");
+    }
+
+    /// A lane whose sphere arithmetic overflows is handed back (`Err`), alone: the other lanes
+    /// are answered.
+    #[test]
+    fn an_overflowing_lane_is_handed_back_alone() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+            return;
+        }
+        let mut s = PixelSampler::new(3, 1);
+        let scene = random_scene(&mut s, 6, true);
+        let set = ShapeSet::new(&scene).unwrap();
+        let mut rays = RayLanes::default();
+        let plain = Ray::new(DVec3::new(0.0, 0.0, 9.0), -DVec3::Z);
+        rays.set(0, plain.origin, plain.direction, 0.0);
+        rays.set(
+            2,
+            DVec3::new(-1e300, 0.0, 0.0),
+            DVec3::new(1e300, 0.0, 0.0),
+            0.0,
+        );
+        // SAFETY: the processor has AVX2 (checked above).
+        let answers = unsafe { set.closest_lanes(&rays, Interval::CAMERA) };
+        assert_eq!(
+            answers[0].map(|a| a.map(|(t, k)| (t.to_bits(), k))),
+            Ok(scene
+                .closest(&plain, Interval::CAMERA)
+                .map(|(t, k)| (t.to_bits(), k)))
+        );
+        assert_eq!((answers[1], answers[3]), (Ok(None), Ok(None)));
+        assert_eq!(answers[2], Err(()));
+    }
+}
