@@ -105,8 +105,10 @@ impl Sphere {
 /// underflowed (then [`Sphere::roots`] rescales). [`Sphere::roots`] and the renderer's
 /// fixed-origin fast path (which computes `f`, `r2` and `c` once per render) both call it, so
 /// they agree bit for bit. The fast path's ray packets repeat these operations lane by lane,
-/// without branches (`PreparedSphere::hit_lanes` in `render::fixed_origin`): a change here must be
-/// made there too, which the renderer's bit-for-bit tests check.
+/// without branches (`PreparedSphere::hit_lanes` in `render::fixed_origin`), and so do the
+/// four-ray queries of the later weeks' lanes of paths (`ball_lanes` and `roots_lanes` in
+/// `scene::shape_lanes`): a change here must be made in both, which the renderer's and the
+/// lanes' bit-for-bit tests check.
 #[inline(always)]
 #[allow(clippy::result_unit_err)]
 pub(crate) fn roots_of(
@@ -171,7 +173,9 @@ impl MovingSphere {
         Self { sphere, end }
     }
 
-    /// Where the sphere is at `time`: centre `center + (end - center) * time`.
+    /// Where the sphere is at `time`: centre `center + (end - center) * time`. The lanes of
+    /// paths (`scene::shape_lanes`, and `scene::shape_set`'s scalar loop) compute the same
+    /// centre from a precomputed `end - center`: a change here must be made there too.
     #[inline]
     pub fn at(&self, time: f64) -> Sphere {
         let c = self.sphere.center;

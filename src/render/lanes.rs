@@ -301,7 +301,7 @@ mod tests {
 
     /// A ground sphere and `n` random spheres (some hollow, some tiny, some lights) around
     /// week 6's view, of random materials; when `mixed`, some of them move and a box of quads
-    /// (a floor, a back wall and a side wall, as week 5's, and a square light) is added.
+    /// (a floor, a back wall, a side wall and a square light) is added.
     fn random_scene(s: &mut PixelSampler, n: usize, lights: bool, mixed: bool) -> Scene {
         let materials = materials();
         let pick = |s: &mut PixelSampler| loop {

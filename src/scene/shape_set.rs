@@ -12,7 +12,7 @@
 //! handed back (`None`). What it skips, it skips only where the roots would lie outside the
 //! interval ([`sure_miss`]).
 //!
-//! The course's scenes from week 5 on are made of a handful of spheres and quads; the general
+//! The course's scenes are made of a handful of spheres and quads; the general
 //! loop over [`Object`]s pays for every shape's match and a record twice the size of a
 //! sphere's, and computes a division for every sphere (the robust roots start with `b' / a`).
 //!
