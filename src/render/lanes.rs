@@ -1,7 +1,7 @@
 //! Lanes of paths: in a small scene of spheres, moving spheres and quads, the renderer traces
 //! four pixels' paths at a time, so that each closest-hit and shadow query tests one object
-//! against four rays in one vector (AVX2 where the processor has it: the caller, [`Job::row`](super::job), is compiled
-//! for it).
+//! against four rays in one vector (AVX2 where the processor has it: the caller,
+//! [`Job::row`](super::job), is compiled for it).
 //!
 //! It promises the film of the one-ray-at-a-time row, bit for bit. Each lane renders whole
 //! pixels, one after the other along the row, each from its own random stream, sample after
@@ -30,8 +30,8 @@ struct Lane {
 }
 
 /// The objects to trace `world` through in lanes, when it takes them: a scene of spheres,
-/// moving spheres and quads (no hierarchy) whose paths have at least one bounce, on a processor with the lanes' vector
-/// instructions ([`has_lanes`]).
+/// moving spheres and quads (no hierarchy) whose paths have at least one bounce, on a
+/// processor with the lanes' vector instructions ([`has_lanes`]).
 #[inline(always)]
 pub(super) fn takes_lanes(world: &World) -> Option<&ShapeSet> {
     let albedo =
@@ -90,7 +90,7 @@ fn start<const JITTER: u8>(job: &Job<'_, World>, pixel: usize, j: usize) -> Lane
     lane
 }
 
-/// Renders row `j` of `job` (a world whose spheres are `set`, [`takes_lanes`]) into `means`
+/// Renders row `j` of `job` (a world whose objects are `set`, [`takes_lanes`]) into `means`
 /// (and `variances` when `VARIANCE`), four pixels at a time. A job of no sample renders nothing,
 /// as the scalar row.
 ///
@@ -481,8 +481,8 @@ mod tests {
     }
 
     /// Every built-in scene without a hierarchy or a triangle (all of weeks 4 to 10, the book's
-    /// first two and the edge cases: spheres, moving spheres and quads) takes the lanes, and renders the same film through
-    /// them as through the scalar loop.
+    /// first two and the edge cases: spheres, moving spheres and quads) takes the lanes, and
+    /// renders the same film through them as through the scalar loop.
     #[test]
     fn built_in_scenes_render_the_scalar_film() {
         if !has_lanes() {

@@ -55,8 +55,8 @@ pub enum RenderError {
 
 impl Trace for World {
     /// Each sample's ray ([`Job::sample_ray`]) through the world's integrator ([`trace`]), times
-    /// the job's scale; in a scene of static spheres, four paths at a time
-    /// ([`lanes::row`](super::lanes::row)), to the same film.
+    /// the job's scale; in a small scene of spheres, moving spheres and quads, four paths at a
+    /// time ([`lanes::row`](super::lanes::row)), to the same film.
     #[inline(always)]
     fn row<const VARIANCE: bool, const JITTER: u8>(
         job: &Job<'_, Self>,
