@@ -868,7 +868,32 @@ fn gaming_batch() -> &'static GamingBatch {
             }
             None => false,
         };
-        let output = run_in(&root, &["grade", "--batch", "subs", "--out", "out"]);
+        // The built-in rubric, with ten minutes instead of one for each render: these renders
+        // are the submissions' own Python, and the suite runs them beside every other test on
+        // the machine's cores, where an honest render of week04-quad has taken over a minute.
+        // What this batch tests is the points of each kind of work, not the time limit (tested
+        // on its own: `a_render_that_raises_hangs_returns_nan_or_the_wrong_size_scores_0_with_the_reason`).
+        let printed = run_in(&root, &["grade", "--print-rubric", "week04"]);
+        assert!(printed.status.success(), "{printed:?}");
+        let built_in = String::from_utf8(printed.stdout).unwrap();
+        assert_eq!(built_in.matches("render_seconds = 60\n").count(), 2);
+        std::fs::write(
+            root.join("rubric.toml"),
+            built_in.replace("render_seconds = 60\n", "render_seconds = 600\n"),
+        )
+        .unwrap();
+        let output = run_in(
+            &root,
+            &[
+                "grade",
+                "--batch",
+                "subs",
+                "--rubric",
+                "rubric.toml",
+                "--out",
+                "out",
+            ],
+        );
         // The same batch with the uploads judged, as a rubric with `source = "upload"` does:
         // where the copy checks of uploads decide the points.
         std::fs::write(
