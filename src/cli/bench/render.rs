@@ -99,9 +99,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => outln!("machine: {cores} cores, vector instructions {vector}")?,
     }
     let counts: Vec<usize> = if cores > 1 { vec![1, cores] } else { vec![1] };
-    let mut timings = time_scenes(&scenes, &counts, args.runs)?.into_iter();
+    let baseline = CBaseline::build(&args.cc);
+    let (timings, c) = time_scenes(&scenes, &counts, args.runs, &baseline)?;
+    let mut timings = timings.into_iter();
     let one = timings.next().expect("one thread timed");
-    let c = time_c_loop(&scenes, &one, &args.cc, args.runs);
     outln!()?;
     one_thread(&scenes, &one, &c, &args.cc)?;
     outln!()?;
@@ -282,14 +283,17 @@ fn same_means(a: Option<&Film>, b: Option<&Film>) -> bool {
     }
 }
 
-/// Renders each scene `runs` times on a pool of each of the `threads` counts and keeps the best
-/// times per count. The counts take turns within each run, so a burst of load elsewhere on the
-/// machine hits them alike.
+/// Renders each scene `runs` times on a pool of each of the `threads` counts and with the C
+/// loop (on this thread, when it was built), and keeps the best times of each: per scene, its
+/// renders take turns within each run, so a change in the machine's speed (a burst of load
+/// elsewhere, a slower hour of a virtual machine) hits rtoracle and the C loop alike. The C
+/// loop's result holds how many pixels of its film differ from the reference's one-thread film.
 fn time_scenes(
     scenes: &[Prepared],
     threads: &[usize],
     runs: u32,
-) -> anyhow::Result<Vec<Vec<Timing>>> {
+    baseline: &Result<CBaseline, String>,
+) -> anyhow::Result<(Vec<Vec<Timing>>, Vec<CTiming>)> {
     let pools = threads
         .iter()
         .map(|&n| {
@@ -312,9 +316,18 @@ fn time_scenes(
                 .collect()
         })
         .collect();
+    let mut c: Vec<CTiming> = scenes
+        .iter()
+        .map(|scene| {
+            baseline.as_ref().map_err(Clone::clone)?;
+            scene.c.as_ref().map_err(Clone::clone)?;
+            Ok((Duration::MAX, 0))
+        })
+        .collect();
     for _ in 0..runs {
-        for (pool, per_scene) in pools.iter().zip(&mut timings) {
-            for (scene, timing) in scenes.iter().zip(per_scene.iter_mut()) {
+        for (k, scene) in scenes.iter().enumerate() {
+            for (pool, per_scene) in pools.iter().zip(&mut timings) {
+                let timing = &mut per_scene[k];
                 let options = RenderOptions {
                     samples_per_pixel: scene.spp,
                     ..Default::default()
@@ -325,34 +338,23 @@ fn time_scenes(
                 timing.cpu = timing.cpu.min(process_cpu_time().saturating_sub(cpu));
                 timing.film = Some(film);
             }
+            if let (Ok(baseline), Ok(cscene), Ok((best, differing))) =
+                (baseline, &scene.c, &mut c[k])
+            {
+                match baseline.render(cscene, scene.spp, 0) {
+                    Ok((film, cpu)) => {
+                        *best = (*best).min(cpu);
+                        *differing = timings[0][k]
+                            .film
+                            .as_ref()
+                            .map_or(usize::MAX, |f| pixels_differing(f, &film));
+                    }
+                    Err(why) => c[k] = Err(why),
+                }
+            }
         }
     }
-    Ok(timings)
-}
-
-/// Builds the C loop and renders each scene `runs` times on this thread: per scene, the best
-/// CPU time and how many pixels differ from the reference's one-thread film, or why not.
-fn time_c_loop(scenes: &[Prepared], one: &[Timing], cc: &str, runs: u32) -> Vec<CTiming> {
-    let baseline = CBaseline::build(cc);
-    scenes
-        .iter()
-        .zip(one)
-        .map(|(scene, ours)| {
-            let baseline = baseline.as_ref().map_err(Clone::clone)?;
-            let c = scene.c.as_ref().map_err(Clone::clone)?;
-            let mut best = Duration::MAX;
-            let mut differing = 0;
-            for _ in 0..runs {
-                let (film, cpu) = baseline.render(c, scene.spp, 0)?;
-                best = best.min(cpu);
-                differing = ours
-                    .film
-                    .as_ref()
-                    .map_or(usize::MAX, |f| pixels_differing(f, &film));
-            }
-            Ok((best, differing))
-        })
-        .collect()
+    Ok((timings, c))
 }
 
 /// Peak memory of `rtoracle render` of the quad scene at `width` x `width` (1 spp: memory does
