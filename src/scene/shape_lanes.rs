@@ -36,8 +36,8 @@ use crate::geometry::{Interval, PARALLEL_EPSILON, Quad};
 /// four `f64` lanes, one AVX2 vector.
 pub(crate) const LANES: usize = 4;
 
-/// Up to [`LANES`] rays side by side (origins, directions, times, and `a = d . d`), for the
-/// lanes queries. A lane that is not `active` is ignored.
+/// Up to [`LANES`] rays side by side (origins, directions and times), for the lanes queries. A
+/// lane that is not `active` is ignored.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct RayLanes {
     ox: [f64; LANES],
@@ -47,13 +47,6 @@ pub(crate) struct RayLanes {
     dy: [f64; LANES],
     dz: [f64; LANES],
     time: [f64; LANES],
-    a: [f64; LANES],
-    /// `a * PREFILTER_MARGIN`, the pre-filter's margin before the sphere's scale.
-    a_margin: [f64; LANES],
-    /// All ones where `a.is_normal() && a < 1e300` (`roots_of`'s check of `a`).
-    a_sane: [u64; LANES],
-    /// All ones where `a` lies in the pre-filter's range.
-    a_in_range: [u64; LANES],
     active: [u64; LANES],
 }
 
@@ -64,19 +57,6 @@ impl RayLanes {
         (self.ox[k], self.oy[k], self.oz[k]) = (origin.x, origin.y, origin.z);
         (self.dx[k], self.dy[k], self.dz[k]) = (direction.x, direction.y, direction.z);
         self.time[k] = time;
-        let a = direction.dot(direction);
-        self.a[k] = a;
-        self.a_margin[k] = a * PREFILTER_MARGIN;
-        self.a_sane[k] = if a.is_normal() && a < 1e300 {
-            u64::MAX
-        } else {
-            0
-        };
-        self.a_in_range[k] = if PREFILTER_RANGE.contains(&a) {
-            u64::MAX
-        } else {
-            0
-        };
         self.active[k] = u64::MAX;
     }
 }
@@ -199,12 +179,20 @@ unsafe fn between<const OPEN: bool>(lo: __m256d, x: __m256d, hi: __m256d) -> __m
     }
 }
 
-/// The rays' origins, directions and active lanes, loaded.
+/// The rays' origins, directions and active lanes, loaded, with what every object's test reads
+/// of a ray alone: `a = d . d` (glam's order, `(x x + y y) + z z`), the pre-filter's margin
+/// `a PREFILTER_MARGIN`, where `a` is sane for `roots_of` (`a.is_normal() && a < 1e300`, which
+/// for a sum of squares is `MIN_POSITIVE <= a < 1e300`: false for 0, subnormals, infinity and
+/// NaN alike) and where it lies in the pre-filter's range.
 #[cfg(target_arch = "x86_64")]
 struct Loaded {
     origin: Vec3Lanes,
     direction: Vec3Lanes,
     active: __m256d,
+    a: __m256d,
+    a_margin: __m256d,
+    a_sane: __m256d,
+    a_in_range: __m256d,
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -218,18 +206,30 @@ impl Loaded {
     unsafe fn new(rays: &RayLanes) -> Self {
         // SAFETY: AVX2 is there (this function's contract); each load reads a whole `[_; 4]`.
         unsafe {
+            let direction = [
+                _mm256_loadu_pd(rays.dx.as_ptr()),
+                _mm256_loadu_pd(rays.dy.as_ptr()),
+                _mm256_loadu_pd(rays.dz.as_ptr()),
+            ];
+            let a = dot(direction, direction);
             Self {
                 origin: [
                     _mm256_loadu_pd(rays.ox.as_ptr()),
                     _mm256_loadu_pd(rays.oy.as_ptr()),
                     _mm256_loadu_pd(rays.oz.as_ptr()),
                 ],
-                direction: [
-                    _mm256_loadu_pd(rays.dx.as_ptr()),
-                    _mm256_loadu_pd(rays.dy.as_ptr()),
-                    _mm256_loadu_pd(rays.dz.as_ptr()),
-                ],
+                direction,
                 active: mask(&rays.active),
+                a,
+                a_margin: _mm256_mul_pd(a, splat(PREFILTER_MARGIN)),
+                a_sane: _mm256_and_pd(
+                    _mm256_cmp_pd::<_CMP_GE_OQ>(a, splat(f64::MIN_POSITIVE)),
+                    _mm256_cmp_pd::<_CMP_LT_OQ>(a, splat(1e300)),
+                ),
+                a_in_range: _mm256_and_pd(
+                    _mm256_cmp_pd::<_CMP_GE_OQ>(a, splat(PREFILTER_RANGE.start)),
+                    _mm256_cmp_pd::<_CMP_LT_OQ>(a, splat(PREFILTER_RANGE.end)),
+                ),
             }
         }
     }
@@ -264,14 +264,12 @@ unsafe fn mask(x: &[u64; LANES]) -> __m256d {
 unsafe fn ball_lanes(
     center: Vec3Lanes,
     r2: f64,
-    rays: &RayLanes,
     loaded: &Loaded,
     min: f64,
     max: &[f64; LANES],
     t: &mut [f64; LANES],
 ) -> (u32, u32) {
-    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the loads read
-    // whole `[_; 4]` arrays.
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract).
     unsafe {
         let [o, d] = [loaded.origin, loaded.direction];
         let f = [
@@ -285,7 +283,7 @@ unsafe fn ball_lanes(
         let c = _mm256_sub_pd(ff, r2v);
         let zero = _mm256_setzero_pd();
         let solvable = if r2 < 1e300 {
-            _mm256_and_pd(_mm256_and_pd(mask(&rays.a_sane), finite(c)), finite(half_b))
+            _mm256_and_pd(_mm256_and_pd(loaded.a_sane, finite(c)), finite(half_b))
         } else {
             zero
         };
@@ -302,12 +300,12 @@ unsafe fn ball_lanes(
             _mm256_cmp_pd::<_CMP_GE_OQ>(scale, splat(PREFILTER_RANGE.start)),
             _mm256_cmp_pd::<_CMP_LT_OQ>(scale, splat(PREFILTER_RANGE.end)),
         );
-        let a = _mm256_loadu_pd(rays.a.as_ptr());
+        let a = loaded.a;
         let naive = _mm256_sub_pd(_mm256_mul_pd(half_b, half_b), _mm256_mul_pd(a, c));
-        let margin = _mm256_mul_pd(_mm256_loadu_pd(rays.a_margin.as_ptr()), scale);
+        let margin = _mm256_mul_pd(loaded.a_margin, scale);
         let margin = _mm256_xor_pd(margin, splat(-0.0));
         let aside = _mm256_and_pd(
-            _mm256_and_pd(mask(&rays.a_in_range), in_range),
+            _mm256_and_pd(loaded.a_in_range, in_range),
             _mm256_cmp_pd::<_CMP_LT_OQ>(naive, margin),
         );
         let sure = _mm256_and_pd(solvable, _mm256_or_pd(behind, aside));
@@ -498,7 +496,7 @@ unsafe fn member_lanes(
     unsafe {
         match member {
             Member::Ball(Ball { center, r2 }) => {
-                ball_lanes(splat3(*center), *r2, rays, loaded, min, max, t)
+                ball_lanes(splat3(*center), *r2, loaded, min, max, t)
             }
             Member::Moving { ball, travel } => {
                 // `center + travel * time`, lane by lane.
@@ -509,7 +507,7 @@ unsafe fn member_lanes(
                     _mm256_add_pd(c[1], _mm256_mul_pd(travel[1], time)),
                     _mm256_add_pd(c[2], _mm256_mul_pd(travel[2], time)),
                 ];
-                ball_lanes(center, ball.r2, rays, loaded, min, max, t)
+                ball_lanes(center, ball.r2, loaded, min, max, t)
             }
             Member::Quad(quad) => (quad_lanes(quad, loaded, min, max, t), 0),
         }
@@ -752,6 +750,67 @@ mod tests {
             "{hit:?} {dark}"
         );
         assert_eq!(scene.closest(&rising, Interval::CAMERA), hit);
+    }
+
+    /// Rays whose `a = d . d` lies at the edges of what `roots_of` accepts (a normal number below
+    /// 1e300) are handed back exactly where the scalar set hands them back, and answered as it
+    /// answers the rest: a sphere of radius 1 seen from 2 away along `-z`, the direction scaled
+    /// so that `a` is 0, subnormal (1e-320), about `f64::MIN_POSITIVE`, 1e-300, 1e298, about
+    /// 1e300, 1.21e300 (finite, refused) and infinite. The subnormal and the 1.21e300 lanes have
+    /// finite roots, so a lane that took them would answer where the scalar set does not.
+    #[test]
+    fn rays_at_the_edges_of_a_sane_length_are_handed_back_as_the_scalar_set_does() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+            return;
+        }
+        let scene = Scene {
+            objects: vec![crate::scene::SceneObject {
+                shape: Object::Sphere(crate::geometry::Sphere::new(DVec3::ZERO, 1.0)),
+                material: 0,
+            }],
+            materials: vec![],
+        };
+        let set = ShapeSet::new(&scene).unwrap();
+        let scales = [
+            0.0,
+            1e-160,
+            f64::MIN_POSITIVE.sqrt(),
+            f64::MIN_POSITIVE.sqrt() * (1.0 + f64::EPSILON),
+            1e-150,
+            1e149,
+            1e150,
+            1e150 * (1.0 + f64::EPSILON),
+            1.1e150,
+            1e155,
+        ];
+        let mut handed_back = 0;
+        for packet in scales.chunks(LANES) {
+            let mut rays = RayLanes::default();
+            let mut plain = Vec::new();
+            for (k, &scale) in packet.iter().enumerate() {
+                let ray = Ray::new(DVec3::new(0.0, 0.0, 2.0), DVec3::new(0.0, 0.0, -scale));
+                rays.set(k, ray.origin, ray.direction, 0.0);
+                plain.push(ray);
+            }
+            // SAFETY: the processor has AVX2 (checked above).
+            let answers = unsafe { set.closest_lanes(&rays, Interval::CAMERA) };
+            for (k, ray) in plain.iter().enumerate() {
+                let scalar = set.closest(ray, Interval::CAMERA).ok_or(());
+                let bits = |a: Result<Option<(f64, usize)>, ()>| {
+                    a.map(|a| a.map(|(t, i)| (t.to_bits(), i)))
+                };
+                assert_eq!(
+                    bits(answers[k]),
+                    bits(scalar),
+                    "direction scale {:e}",
+                    ray.direction.z
+                );
+                handed_back += usize::from(scalar.is_err());
+            }
+        }
+        // 0, the subnormal, below MIN_POSITIVE, 1.21e300 and infinity at least.
+        assert!(handed_back >= 4, "{handed_back}");
     }
 
     /// A lane whose sphere arithmetic overflows is handed back (`Err`), alone: the other lanes
