@@ -48,16 +48,11 @@ fn batch() -> &'static Batch {
             rtoracle::grade::rubric::week04_uploads_toml(),
         )
         .unwrap();
-        let output = run_in(
+        let output = grade_batch(
             &root,
+            "upload.toml",
+            "out",
             &[
-                "grade",
-                "--batch",
-                "subs",
-                "--rubric",
-                "upload.toml",
-                "--out",
-                "out",
                 "--case-timeout-ms",
                 "1000",
                 "--vectors",
@@ -882,18 +877,7 @@ fn gaming_batch() -> &'static GamingBatch {
             built_in.replace("render_seconds = 60\n", "render_seconds = 600\n"),
         )
         .unwrap();
-        let output = run_in(
-            &root,
-            &[
-                "grade",
-                "--batch",
-                "subs",
-                "--rubric",
-                "rubric.toml",
-                "--out",
-                "out",
-            ],
-        );
+        let output = grade_batch(&root, "rubric.toml", "out", &[]);
         // The same batch with the uploads judged, as a rubric with `source = "upload"` does:
         // where the copy checks of uploads decide the points.
         std::fs::write(
@@ -901,18 +885,7 @@ fn gaming_batch() -> &'static GamingBatch {
             rtoracle::grade::rubric::week04_uploads_toml(),
         )
         .unwrap();
-        let uploads_output = run_in(
-            &root,
-            &[
-                "grade",
-                "--batch",
-                "subs",
-                "--rubric",
-                "uploads.toml",
-                "--out",
-                "uploads",
-            ],
-        );
+        let uploads_output = grade_batch(&root, "uploads.toml", "uploads", &[]);
         assert!(
             uploads_output.status.code().is_some_and(|c| c <= 1),
             "{uploads_output:?}"
@@ -924,6 +897,13 @@ fn gaming_batch() -> &'static GamingBatch {
             skeleton,
         }
     })
+}
+
+/// `rtoracle grade --batch subs --rubric RUBRIC --out OUT` in `root`, with `extra` arguments.
+fn grade_batch(root: &Path, rubric: &str, out: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["grade", "--batch", "subs", "--rubric", rubric, "--out", out];
+    args.extend_from_slice(extra);
+    run_in(root, &args)
 }
 
 fn check<'a>(report: &'a Value, id: &str) -> &'a Value {
