@@ -20,7 +20,8 @@ pub fn sky(direction: DVec3) -> DVec3 {
 }
 
 /// The sky's height coordinate along `direction`: `a = 0.5 (unit(d).y + 1)`, computing
-/// `unit_vector(direction).y` without the two divisions whose results are not used.
+/// `unit_vector(direction).y` without the two divisions whose results are not used. The lanes'
+/// `RayLanes::unit_y` computes `d.y / |d|` with the same operations.
 #[inline(always)]
 pub(crate) fn sky_height(direction: DVec3) -> f64 {
     0.5 * (direction.y / direction.length() + 1.0)
@@ -42,11 +43,16 @@ pub fn radiance(scene: &Scene, ray: &Ray) -> DVec3 {
     }
 }
 
-/// The background seen along `direction`.
+/// The background seen along `direction`; `unit_y`, when given, is `direction`'s unit vector's
+/// `y` computed beforehand (`d.y / |d|`, with the same operations: the lanes compute four of
+/// them in one vector).
 #[inline]
-fn background(world: &World, direction: DVec3) -> DVec3 {
+fn background(world: &World, direction: DVec3, unit_y: Option<f64>) -> DVec3 {
     match world.settings.background {
-        Background::Sky => sky(direction),
+        Background::Sky => match unit_y {
+            Some(y) => sky_at(0.5 * (y + 1.0)),
+            None => sky(direction),
+        },
         Background::Flat => DVec3::from(world.settings.background_color),
     }
 }
@@ -64,7 +70,7 @@ pub fn trace(world: &World, ray: &Ray, sampler: &mut PixelSampler) -> DVec3 {
     let interval = hit_interval(world);
     loop {
         let hit = world.closest(&path.ray, interval);
-        if let Some(colour) = step(world, &mut path, hit, Shadows::UNKNOWN, sampler) {
+        if let Some(colour) = step(world, &mut path, hit, Shadows::UNKNOWN, None, sampler) {
             return colour;
         }
     }
@@ -148,27 +154,30 @@ impl Shadows {
 }
 
 /// One bounce of `path`, whose ray's closest hit in [`hit_interval`] is `hit`: the path's colour
-/// when it ends here, `None` when it goes on (with its next ray in `path.ray`).
+/// when it ends here, `None` when it goes on (with its next ray in `path.ray`). `shadows` and
+/// `unit_y` are what the caller computed beforehand of the step's shadow tests and of the
+/// background's `unit(d).y` (see [`Shadows`] and `background`); they change no result.
 #[inline(always)]
 pub(crate) fn step(
     world: &World,
     path: &mut Path,
     hit: Option<(f64, usize)>,
     shadows: Shadows,
+    unit_y: Option<f64>,
     sampler: &mut PixelSampler,
 ) -> Option<DVec3> {
     match (world.profile, world.settings.integrator) {
-        (Profile::Physical, _) => physical(world, path, hit, sampler),
-        (Profile::Course, Integrator::Albedo) => Some(albedo(world, &path.ray, hit)),
-        (Profile::Course, Integrator::Direct) => direct(world, path, hit, shadows, sampler),
-        (Profile::Course, Integrator::Brdf) => brdf(world, path, hit, shadows, sampler),
+        (Profile::Physical, _) => physical(world, path, hit, unit_y, sampler),
+        (Profile::Course, Integrator::Albedo) => Some(albedo(world, &path.ray, hit, unit_y)),
+        (Profile::Course, Integrator::Direct) => direct(world, path, hit, shadows, unit_y, sampler),
+        (Profile::Course, Integrator::Brdf) => brdf(world, path, hit, shadows, unit_y, sampler),
     }
 }
 
 /// Week 4: the colour of the closest hit in `(1e-6, f64::MAX)` (a texture's value there), the
 /// background on a miss.
 #[inline(always)]
-fn albedo(world: &World, ray: &Ray, hit: Option<(f64, usize)>) -> DVec3 {
+fn albedo(world: &World, ray: &Ray, hit: Option<(f64, usize)>, unit_y: Option<f64>) -> DVec3 {
     match hit {
         Some((t, object)) => {
             let material = world.material_of(object);
@@ -179,7 +188,7 @@ fn albedo(world: &World, ray: &Ray, hit: Option<(f64, usize)>) -> DVec3 {
                 other => other.albedo(),
             }
         }
-        None => background(world, ray.direction),
+        None => background(world, ray.direction, unit_y),
     }
 }
 
@@ -230,11 +239,12 @@ fn course_bounce<'w>(
     world: &'w World,
     path: &Path,
     hit: Option<(f64, usize)>,
+    unit_y: Option<f64>,
     sampler: &mut PixelSampler,
 ) -> Result<(&'w Material, Surface, scatter::Scattered), DVec3> {
     let ray = path.ray;
     let Some((t, object)) = hit else {
-        return Err(path.total + path.weight * background(world, ray.direction));
+        return Err(path.total + path.weight * background(world, ray.direction, unit_y));
     };
     let material = world.material_of(object);
     let surface = Surface::of(world, &ray, t, object, Interval::CAMERA);
@@ -253,9 +263,10 @@ fn direct(
     path: &mut Path,
     hit: Option<(f64, usize)>,
     shadows: Shadows,
+    unit_y: Option<f64>,
     sampler: &mut PixelSampler,
 ) -> Option<DVec3> {
-    let (_, hit, scattered) = match course_bounce(world, path, hit, sampler) {
+    let (_, hit, scattered) = match course_bounce(world, path, hit, unit_y, sampler) {
         Ok(bounce) => bounce,
         Err(colour) => return Some(colour),
     };
@@ -333,10 +344,11 @@ fn brdf(
     path: &mut Path,
     hit: Option<(f64, usize)>,
     shadows: Shadows,
+    unit_y: Option<f64>,
     sampler: &mut PixelSampler,
 ) -> Option<DVec3> {
     let ray = path.ray;
-    let (material, hit, scattered) = match course_bounce(world, path, hit, sampler) {
+    let (material, hit, scattered) = match course_bounce(world, path, hit, unit_y, sampler) {
         Ok(bounce) => bounce,
         Err(colour) => return Some(colour),
     };
@@ -366,11 +378,12 @@ fn physical(
     world: &World,
     path: &mut Path,
     hit: Option<(f64, usize)>,
+    unit_y: Option<f64>,
     sampler: &mut PixelSampler,
 ) -> Option<DVec3> {
     let ray = path.ray;
     let Some((t, object)) = hit else {
-        return Some(path.weight * background(world, ray.direction));
+        return Some(path.weight * background(world, ray.direction, unit_y));
     };
     let material = world.material_of(object);
     if let Material::DiffuseLight { emit } = *material {

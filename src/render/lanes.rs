@@ -8,7 +8,9 @@
 //! sample in order; every bounce is the integrator's own [`step`], given the closest hit that
 //! [`ShapeSet::closest_lanes`] finds for it (the scalar loop's answer, lane by lane) and the
 //! shadow tests [`ShapeSet::occluded_lanes`] answered beforehand (pure functions of the hit
-//! point, which the step would otherwise compute itself). A lane whose numbers over- or
+//! point, which the step would otherwise compute itself), and, under the sky, the `unit(d).y` of
+//! the four rays its colour reads on a miss ([`RayLanes::unit_y`], one vector square root and
+//! division, whose time then hides under the hit query's). A lane whose numbers over- or
 //! underflow is answered by the scalar path. Only the order in which pixels are worked on
 //! changes, not what any pixel draws or computes.
 
@@ -17,7 +19,7 @@ use glam::DVec3;
 use super::PixelSampler;
 use super::integrator::{Path, Shadows, hit_interval, occluded, step};
 use super::job::{Job, Moments, Spread};
-use crate::scene::{Integrator, LANES, Profile, RayLanes, ShapeSet, World, has_lanes};
+use crate::scene::{Background, Integrator, LANES, Profile, RayLanes, ShapeSet, World, has_lanes};
 
 /// One lane's work: the pixel it renders, its random stream, the sample in flight and the
 /// pixel's sums so far.
@@ -111,6 +113,7 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
     let world = job.tracer;
     let interval = hit_interval(world);
     let lights = shadowed_lights(world);
+    let sky = world.settings.background == Background::Sky;
     let mut next = 0;
     let mut lanes: [Option<Lane>; LANES] = [None, None, None, None];
     for lane in &mut lanes {
@@ -132,6 +135,14 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
         if !busy {
             return;
         }
+        // The sky's `unit(d).y` of all four rays in one vector, before it is known which miss:
+        // its square root and division then take no time of their own.
+        let unit_y = if sky {
+            // SAFETY: the processor has AVX2 (this function's contract).
+            Some(unsafe { rays.unit_y() })
+        } else {
+            None
+        };
         // SAFETY: the processor has AVX2 (this function's contract).
         let answers = unsafe { set.closest_lanes(&rays, interval) };
         let mut hits = [None; LANES];
@@ -156,6 +167,7 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
                 &mut lane.path,
                 hits[k],
                 shadows[k],
+                unit_y.map(|y| y[k]),
                 &mut lane.sampler,
             ) else {
                 continue;

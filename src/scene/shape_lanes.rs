@@ -235,6 +235,34 @@ impl Loaded {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+impl RayLanes {
+    /// Each lane's `d.y / |d|`, the `y` of its direction's unit vector, with the scalar
+    /// `direction.y / direction.length()`'s operations (`|d| = sqrt((x x + y y) + z z)`, each
+    /// rounded once), so bit for bit its value. A lane never set holds NaN (`0 / 0`).
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) unsafe fn unit_y(&self) -> [f64; LANES] {
+        let mut y = [0.0; LANES];
+        // SAFETY: AVX2 is there (this function's contract); the loads and the store read and
+        // write whole `[f64; 4]` arrays.
+        unsafe {
+            let d = [
+                _mm256_loadu_pd(self.dx.as_ptr()),
+                _mm256_loadu_pd(self.dy.as_ptr()),
+                _mm256_loadu_pd(self.dz.as_ptr()),
+            ];
+            let length = _mm256_sqrt_pd(dot(d, d));
+            _mm256_storeu_pd(y.as_mut_ptr(), _mm256_div_pd(d[1], length));
+        }
+        y
+    }
+}
+
 /// A lane mask of all ones or all zeros per lane, loaded.
 ///
 /// # Safety
@@ -811,6 +839,63 @@ mod tests {
         }
         // 0, the subnormal, below MIN_POSITIVE, 1.21e300 and infinity at least.
         assert!(handed_back >= 4, "{handed_back}");
+    }
+
+    /// `unit_y` is the scalar `d.y / d.length()` bit for bit, for random directions of scales
+    /// 2^-600 to 2^600 and for the edges: a zero direction (NaN), a subnormal one, lengths whose
+    /// square under- or overflows (a `y` of 0 over an infinite length), infinite components.
+    #[test]
+    fn unit_y_is_the_scalar_unit_vectors_y_bit_for_bit() {
+        if !has_lanes() {
+            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+            return;
+        }
+        let mut s = PixelSampler::new(11, 4);
+        let mut directions = vec![
+            DVec3::ZERO,
+            DVec3::new(0.0, 5e-324, 0.0),
+            DVec3::new(1e-170, -3e-170, 2e-170),
+            DVec3::new(1e160, 2e160, -1e160),
+            DVec3::new(0.0, f64::INFINITY, 0.0),
+            DVec3::new(f64::INFINITY, 1.0, 0.0),
+            DVec3::new(0.0, -1.0, 0.0),
+            DVec3::new(3.0, 4.0, 12.0),
+        ];
+        for _ in 0..4000 {
+            let scale = (s.uniform(-600.0, 600.0)).exp2();
+            directions.push(
+                DVec3::new(
+                    s.uniform(-1.0, 1.0),
+                    s.uniform(-1.0, 1.0),
+                    s.uniform(-1.0, 1.0),
+                ) * scale,
+            );
+        }
+        for packet in directions.chunks(LANES) {
+            let mut rays = RayLanes::default();
+            for (k, d) in packet.iter().enumerate() {
+                rays.set(k, DVec3::ZERO, *d, 0.0);
+            }
+            // SAFETY: the processor has AVX2 (checked above).
+            let y = unsafe { rays.unit_y() };
+            for (k, d) in packet.iter().enumerate() {
+                let scalar = d.y / d.length();
+                assert!(
+                    y[k].to_bits() == scalar.to_bits() || (y[k].is_nan() && scalar.is_nan()),
+                    "{d}: {} against {scalar}",
+                    y[k]
+                );
+            }
+        }
+        // Closed forms: (3, 4, 12) has length 13 exactly, so y = 4 / 13 rounded once.
+        let mut rays = RayLanes::default();
+        rays.set(0, DVec3::ZERO, DVec3::new(3.0, 4.0, 12.0), 0.0);
+        rays.set(1, DVec3::ZERO, DVec3::new(0.0, -1e-170, 0.0), 0.0);
+        // SAFETY: the processor has AVX2 (checked above).
+        let y = unsafe { rays.unit_y() };
+        assert_eq!(y[0], 4.0 / 13.0);
+        // (1e-170)^2 underflows to 0: -1e-170 / 0 is -infinity, as the scalar code computes it.
+        assert_eq!(y[1], f64::NEG_INFINITY);
     }
 
     /// A lane whose sphere arithmetic overflows is handed back (`Err`), alone: the other lanes
