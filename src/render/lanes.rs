@@ -258,7 +258,7 @@ mod tests {
     use crate::render::job::{PixelJitter, film_bits};
     use crate::scene::{
         Background, DiffuseSampling, DirectTerm, Material, Object, RenderSettings, Scene,
-        SceneObject, Texture, builtin,
+        SceneObject, Texture, builtin, skipped_without_lanes,
     };
 
     /// Every material the integrators know, in both profiles' reach.
@@ -399,8 +399,7 @@ mod tests {
     /// deviations) bit for bit.
     #[test]
     fn lanes_render_the_scalar_film() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
+        if skipped_without_lanes("the renderer takes no lanes") {
             return;
         }
         let mut s = PixelSampler::new(17, 3);
@@ -466,8 +465,7 @@ mod tests {
     /// lane back to the scalar path, to the same film; so does a light among such spheres.
     #[test]
     fn lanes_hand_back_what_only_the_scalar_path_solves() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
+        if skipped_without_lanes("the renderer takes no lanes") {
             return;
         }
         let mut s = PixelSampler::new(3, 9);
@@ -497,8 +495,7 @@ mod tests {
     /// renders the same film through them as through the scalar loop.
     #[test]
     fn built_in_scenes_render_the_scalar_film() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so the renderer takes no lanes");
+        if skipped_without_lanes("the renderer takes no lanes") {
             return;
         }
         let mut taken = 0;

@@ -39,6 +39,8 @@ pub use settings::{
     Background, COURSE_BACKGROUND, DEFAULT_MAX_DEPTH, DiffuseSampling, DirectTerm, Integrator,
     PixelSampling, RenderSettings,
 };
+#[cfg(test)]
+pub(crate) use shape_lanes::skipped_without_lanes;
 pub(crate) use shape_lanes::{LANES, RayLanes, has_lanes};
 pub(crate) use shape_set::ShapeSet;
 pub use texture::{

@@ -76,6 +76,17 @@ pub(crate) fn has_lanes() -> bool {
     }
 }
 
+/// For the tests of the lanes: whether this processor has none (no AVX2), in which case it says
+/// so on stderr, with `what` the test would have checked, so that `cargo test` shows the skip.
+#[cfg(test)]
+pub(crate) fn skipped_without_lanes(what: &str) -> bool {
+    let skipped = !has_lanes();
+    if skipped {
+        eprintln!("skipped: this processor has no AVX2, so {what}");
+    }
+    skipped
+}
+
 /// Three coordinates, one vector each.
 #[cfg(target_arch = "x86_64")]
 type Vec3Lanes = [__m256d; 3];
@@ -641,8 +652,7 @@ mod tests {
     /// occlusion (on its own reach) is the scene's count above one.
     #[test]
     fn lanes_answer_as_the_scene_loop_does() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+        if skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(29, 7);
@@ -713,8 +723,7 @@ mod tests {
     /// loop's.
     #[test]
     fn quads_at_the_ends_of_the_interval_and_nearly_parallel_rays() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+        if skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let c = DVec3::new;
@@ -788,8 +797,7 @@ mod tests {
     /// finite roots, so a lane that took them would answer where the scalar set does not.
     #[test]
     fn rays_at_the_edges_of_a_sane_length_are_handed_back_as_the_scalar_set_does() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+        if skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let scene = Scene {
@@ -846,8 +854,7 @@ mod tests {
     /// square under- or overflows (a `y` of 0 over an infinite length), infinite components.
     #[test]
     fn unit_y_is_the_scalar_unit_vectors_y_bit_for_bit() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+        if skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(11, 4);
@@ -902,8 +909,7 @@ mod tests {
     /// are answered.
     #[test]
     fn an_overflowing_lane_is_handed_back_alone() {
-        if !has_lanes() {
-            eprintln!("skipped: this processor has no AVX2, so there are no lanes to check");
+        if skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(3, 1);
