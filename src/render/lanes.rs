@@ -7,7 +7,7 @@
 //! pixels, one after the other along the row, each from its own random stream, sample after
 //! sample in order; every bounce is the integrator's own [`step`], given the closest hit that
 //! [`ShapeSet::closest_lanes`] finds for it (the scalar loop's answer, lane by lane) and the
-//! shadow tests [`ShapeSet::occluded_lanes`] answered beforehand (pure functions of the hit
+//! shadow tests [`ShapeSet::shadowed_lanes`] answered beforehand (pure functions of the hit
 //! point, which the step would otherwise compute itself), and, under the sky, the `unit(d).y` of
 //! the four rays its colour reads on a miss ([`RayLanes::unit_y`], one vector square root and
 //! division, whose time then hides under the hit query's). A lane whose numbers over- or
@@ -113,6 +113,10 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
     let world = job.tracer;
     let interval = hit_interval(world);
     let lights = shadowed_lights(world);
+    // The spheres each point light's shadow rays are aimed at the centre of.
+    let aimed: Vec<u64> = (world.point_lights.iter().take(lights))
+        .map(|light| set.centred_at(light.center))
+        .collect();
     let sky = world.settings.background == Background::Sky;
     let mut next = 0;
     let mut lanes: [Option<Lane>; LANES] = [None, None, None, None];
@@ -154,7 +158,7 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
         }
         let shadows = if lights > 0 {
             // SAFETY: the processor has AVX2 (this function's contract).
-            unsafe { shadows_at(world, set, &lanes, &hits, lights) }
+            unsafe { shadows_at(world, set, &lanes, &hits, &aimed) }
         } else {
             [Shadows::UNKNOWN; LANES]
         };
@@ -196,9 +200,10 @@ pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
     }
 }
 
-/// The occlusion test of the first `lights` point lights at each lane's hit point, four lanes
-/// at a time: for the lanes whose ray hit something that is not a light (the others' steps read
-/// no shadow).
+/// The occlusion test of the first point lights (one per entry of `aimed`, which holds the
+/// [`ShapeSet::centred_at`] of each light's centre) at each lane's hit point, four lanes at a
+/// time: for the lanes whose ray hit something that is not a light (the others' steps read no
+/// shadow).
 ///
 /// # Safety
 ///
@@ -209,7 +214,7 @@ unsafe fn shadows_at(
     set: &ShapeSet,
     lanes: &[Option<Lane>; LANES],
     hits: &[Option<(f64, usize)>; LANES],
-    lights: usize,
+    aimed: &[u64],
 ) -> [Shadows; LANES] {
     let mut points = [None; LANES];
     for k in 0..LANES {
@@ -223,20 +228,17 @@ unsafe fn shadows_at(
     if points.iter().all(Option::is_none) {
         return shadows;
     }
-    for (l, light) in world.point_lights.iter().take(lights).enumerate() {
+    for (l, (light, &aimed)) in world.point_lights.iter().zip(aimed).enumerate() {
         // `occluded`'s shadow ray: from the point to the light's centre, on `(1e-6, |c - p|)`.
         let mut rays = RayLanes::default();
-        let mut reach = [0.0; LANES];
         for (k, point) in points.iter().enumerate() {
             if let Some(p) = *point {
-                let to_light = light.center - p;
                 // Shadow rays carry time 0 (`occluded`'s `Ray::new`).
-                rays.set(k, p, to_light, 0.0);
-                reach[k] = to_light.length();
+                rays.set(k, p, light.center - p, 0.0);
             }
         }
         // SAFETY: the processor has AVX2 (this function's contract).
-        let answers = unsafe { set.occluded_lanes(&rays, 1e-6, &reach) };
+        let answers = unsafe { set.shadowed_lanes(&rays, 1e-6, aimed) };
         for (k, point) in points.iter().enumerate() {
             let Some(p) = *point else {
                 continue;

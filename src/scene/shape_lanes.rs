@@ -1,6 +1,7 @@
 //! The two queries of a [`ShapeSet`] (the closest hit, the course's occlusion test) for four
-//! rays at once, on x86-64 with AVX2 ([`ShapeSet::closest_lanes`],
-//! [`ShapeSet::occluded_lanes`]): the renderer's lanes of paths ask them.
+//! rays at once, on x86-64 with AVX2 ([`ShapeSet::closest_lanes`], and
+//! [`ShapeSet::shadowed_lanes`] for shadow rays to a point light): the renderer's lanes of
+//! paths ask them.
 //!
 //! It promises, lane by lane, the scalar set's answers, so [`Scene::closest`]'s and
 //! [`Scene::count_hits`]'s, bit for bit; where a lane's sphere arithmetic over- or underflows, it
@@ -9,6 +10,12 @@
 //! fused); where the scalar code branches, both sides are computed and the lane's is selected.
 //! Objects are taken in the scene's order, so ties go as the scene's loop sends them (a quad's
 //! closed test replaces an earlier object at the same `t`, a sphere's open one does not).
+//!
+//! Work is skipped only where its answer is known without it, as the scalar set skips it (a
+//! sphere behind the ray, beside it, or left by a ray starting on its surface: `sure_miss` in
+//! `scene::shape_set`), and, for shadow rays, the light's own sphere, which a ray aimed at its
+//! centre from far enough surely hits (`aimed_ball_lanes`, with the exact arithmetic that
+//! proves it).
 //!
 //! The per-object tests are `#[inline(always)]` unsafe functions without a target feature of
 //! their own, so that they are compiled inside the two queries, which are compiled for AVX2:
@@ -28,11 +35,11 @@ use std::arch::x86_64::*;
 
 #[cfg(target_arch = "x86_64")]
 use super::shape_set::{Ball, Member, ShapeSet};
-use super::shape_set::{PREFILTER_MARGIN, PREFILTER_RANGE};
+use super::shape_set::{LEAVING_MIN, LEAVING_SLOPE, PREFILTER_MARGIN, PREFILTER_RANGE};
 #[cfg(target_arch = "x86_64")]
 use crate::geometry::{Interval, PARALLEL_EPSILON, Quad};
 
-/// How many rays [`ShapeSet::closest_lanes`] and [`ShapeSet::occluded_lanes`] take at once:
+/// How many rays [`ShapeSet::closest_lanes`] and [`ShapeSet::shadowed_lanes`] take at once:
 /// four `f64` lanes, one AVX2 vector.
 pub(crate) const LANES: usize = 4;
 
@@ -62,7 +69,7 @@ impl RayLanes {
 }
 
 /// Whether this processor runs the lanes queries ([`ShapeSet::closest_lanes`],
-/// [`ShapeSet::occluded_lanes`]): an x86-64 with AVX2. Elsewhere the renderer traces one ray at
+/// [`ShapeSet::shadowed_lanes`]): an x86-64 with AVX2. Elsewhere the renderer traces one ray at
 /// a time, to the same film.
 #[inline]
 pub(crate) fn has_lanes() -> bool {
@@ -196,6 +203,7 @@ unsafe fn between<const OPEN: bool>(lo: __m256d, x: __m256d, hi: __m256d) -> __m
 /// for a sum of squares is `MIN_POSITIVE <= a < 1e300`: false for 0, subnormals, infinity and
 /// NaN alike) and where it lies in the pre-filter's range.
 #[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
 struct Loaded {
     origin: Vec3Lanes,
     direction: Vec3Lanes,
@@ -326,11 +334,9 @@ unsafe fn ball_lanes(
         } else {
             zero
         };
+        let receding = _mm256_cmp_pd::<_CMP_GT_OQ>(half_b, zero);
         let behind = if min >= 0.0 {
-            _mm256_and_pd(
-                _mm256_cmp_pd::<_CMP_GT_OQ>(half_b, zero),
-                _mm256_cmp_pd::<_CMP_GT_OQ>(c, zero),
-            )
+            _mm256_and_pd(receding, _mm256_cmp_pd::<_CMP_GT_OQ>(c, zero))
         } else {
             zero
         };
@@ -339,15 +345,23 @@ unsafe fn ball_lanes(
             _mm256_cmp_pd::<_CMP_GE_OQ>(scale, splat(PREFILTER_RANGE.start)),
             _mm256_cmp_pd::<_CMP_LT_OQ>(scale, splat(PREFILTER_RANGE.end)),
         );
+        let both_in_range = _mm256_and_pd(loaded.a_in_range, in_range);
+        let leaving = if min >= LEAVING_MIN {
+            // `c >= -(LEAVING_SLOPE b')`, as `sure_miss` computes it.
+            let bound = _mm256_xor_pd(_mm256_mul_pd(splat(LEAVING_SLOPE), half_b), splat(-0.0));
+            _mm256_and_pd(
+                _mm256_and_pd(receding, both_in_range),
+                _mm256_cmp_pd::<_CMP_GE_OQ>(c, bound),
+            )
+        } else {
+            zero
+        };
         let a = loaded.a;
         let naive = _mm256_sub_pd(_mm256_mul_pd(half_b, half_b), _mm256_mul_pd(a, c));
         let margin = _mm256_mul_pd(loaded.a_margin, scale);
         let margin = _mm256_xor_pd(margin, splat(-0.0));
-        let aside = _mm256_and_pd(
-            _mm256_and_pd(loaded.a_in_range, in_range),
-            _mm256_cmp_pd::<_CMP_LT_OQ>(naive, margin),
-        );
-        let sure = _mm256_and_pd(solvable, _mm256_or_pd(behind, aside));
+        let aside = _mm256_and_pd(both_in_range, _mm256_cmp_pd::<_CMP_LT_OQ>(naive, margin));
+        let sure = _mm256_and_pd(solvable, _mm256_or_pd(_mm256_or_pd(behind, leaving), aside));
         let open = _mm256_andnot_pd(sure, loaded.active);
         let unsolved = _mm256_andnot_pd(solvable, loaded.active);
         if _mm256_movemask_pd(open) == 0 {
@@ -362,6 +376,61 @@ unsafe fn ball_lanes(
         };
         let (found, overflow) = roots_lanes(&parts, d, open, min, max, t);
         (found, _mm256_movemask_pd(unsolved) as u32 | overflow)
+    }
+}
+
+/// [`ball_lanes`] for a ball centred exactly on the point every lane's ray is aimed at (each
+/// direction computed as `center - origin`, as a shadow ray to a point light): where a lane's
+/// answer is sure without arithmetic, it is given so (a hit), and the other lanes are solved
+/// by [`ball_lanes`].
+///
+/// With `d = center - o`, the parts are exact: `f = o - center = -d` bit for bit (a difference
+/// changes sign exactly with its operands), so `b' = f . d = -a` and `f . f = a` (the same
+/// products and sums, signs flipped), `b' / a = -1`, `perp = f - d (-1) = 0` and
+/// `disc = a r^2`. Then `q = a + sqrt(a r^2)` and the roots are `t0 = (a - r^2) / q` and
+/// `t1 = q / a >= 1`. Where `a` lies in `PREFILTER_RANGE` and `a >= 2 r^2`, every part is
+/// finite and sane for `roots_of`, `a - r^2 >= a / 2` and `q <= 2 a` (so `1/4 <= t0 <= 1`, each
+/// bound surviving rounding, which is monotone); so `t0`, the near root, lies in
+/// `(min, max)` whenever `min < 1/4` and `max > 1`: a hit. (The course's point light at distance
+/// above 1 and more than 1.42 radii from its centre: its own sphere, counted by the occlusion
+/// test, costs no division.)
+///
+/// # Safety
+///
+/// The processor must have AVX2 (the caller checked [`has_lanes`]).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn aimed_ball_lanes(
+    ball: &Ball,
+    loaded: &Loaded,
+    min: f64,
+    max: &[f64; LANES],
+    t: &mut [f64; LANES],
+) -> (u32, u32) {
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the load
+    // reads a whole `[f64; 4]`.
+    unsafe {
+        let sure = if min < 0.25 {
+            _mm256_and_pd(
+                _mm256_and_pd(loaded.active, loaded.a_in_range),
+                _mm256_and_pd(
+                    _mm256_cmp_pd::<_CMP_GE_OQ>(loaded.a, splat(2.0 * ball.r2)),
+                    _mm256_cmp_pd::<_CMP_GT_OQ>(_mm256_loadu_pd(max.as_ptr()), splat(1.0)),
+                ),
+            )
+        } else {
+            _mm256_setzero_pd()
+        };
+        let sure_hits = _mm256_movemask_pd(sure) as u32;
+        let rest = Loaded {
+            active: _mm256_andnot_pd(sure, loaded.active),
+            ..*loaded
+        };
+        if _mm256_movemask_pd(rest.active) == 0 {
+            return (sure_hits, 0);
+        }
+        let (found, bad) = ball_lanes(splat3(ball.center), ball.r2, &rest, min, max, t);
+        (found | sure_hits, bad)
     }
 }
 
@@ -604,6 +673,7 @@ impl ShapeSet {
     /// # Safety
     ///
     /// The processor must have AVX2 ([`has_lanes`]).
+    #[cfg(test)]
     #[target_feature(enable = "avx2")]
     #[inline]
     pub(crate) unsafe fn occluded_lanes(
@@ -612,14 +682,71 @@ impl ShapeSet {
         min: f64,
         max: &[f64; LANES],
     ) -> [Result<bool, ()>; LANES] {
+        // SAFETY: AVX2 is there (this function's contract).
+        unsafe {
+            let loaded = Loaded::new(rays);
+            self.count_lanes(rays, &loaded, min, max, 0)
+        }
+    }
+
+    /// The course's occlusion test of shadow rays to one point, for each active lane of `rays`
+    /// at once: every active lane's direction is `point - origin` (computed so), its ray is
+    /// tested on `(min, |direction|)` (`occluded`'s interval, the length computed as
+    /// `DVec3::length` does, in one vector), and `aimed` is [`ShapeSet::centred_at`]`(point)`.
+    /// The answers are the course's occlusion test's on those intervals (as `occluded_lanes`,
+    /// the general query the tests ask, answers it); the spheres centred at
+    /// `point` (a point light's own) are decided without their roots where they can be
+    /// (`aimed_ball_lanes`).
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(crate) unsafe fn shadowed_lanes(
+        &self,
+        rays: &RayLanes,
+        min: f64,
+        aimed: u64,
+    ) -> [Result<bool, ()>; LANES] {
+        let mut reach = [0.0; LANES];
+        // SAFETY: AVX2 is there (this function's contract); the store writes a whole array.
+        unsafe {
+            let loaded = Loaded::new(rays);
+            // `|d| = sqrt((x x + y y) + z z)`, glam's `length`, from the loaded `a`.
+            _mm256_storeu_pd(reach.as_mut_ptr(), _mm256_sqrt_pd(loaded.a));
+            self.count_lanes(rays, &loaded, min, &reach, aimed)
+        }
+    }
+
+    /// The occlusion count of the loaded `rays` on `(min, max[k])`, the members `aimed` marks
+    /// tested by `aimed_ball_lanes` (see [`ShapeSet::shadowed_lanes`]).
+    ///
+    /// # Safety
+    ///
+    /// The processor must have AVX2 ([`has_lanes`]).
+    #[inline(always)]
+    unsafe fn count_lanes(
+        &self,
+        rays: &RayLanes,
+        loaded: &Loaded,
+        min: f64,
+        max: &[f64; LANES],
+        aimed: u64,
+    ) -> [Result<bool, ()>; LANES] {
         let mut count = [0u32; LANES];
         let mut unsolved = 0;
         let mut t = [0.0; LANES];
-        // SAFETY: AVX2 is there (this function's contract).
-        let loaded = unsafe { Loaded::new(rays) };
-        for member in &self.members {
+        for (me, member) in self.members.iter().enumerate() {
             // SAFETY: AVX2 is there (this function's contract).
-            let (hit, bad) = unsafe { member_lanes(member, rays, &loaded, min, max, &mut t) };
+            let (hit, bad) = unsafe {
+                match member {
+                    Member::Ball(ball) if me < 64 && aimed & (1 << me) != 0 => {
+                        aimed_ball_lanes(ball, loaded, min, max, &mut t)
+                    }
+                    _ => member_lanes(member, rays, loaded, min, max, &mut t),
+                }
+            };
             for (k, count) in count.iter_mut().enumerate() {
                 *count += (hit >> k) & 1;
             }
@@ -934,5 +1061,131 @@ mod tests {
         );
         assert_eq!((answers[1], answers[3]), (Ok(None), Ok(None)));
         assert_eq!(answers[2], Err(()));
+    }
+
+    /// Shadow rays to a point light (a small sphere's centre, or a point no sphere is centred
+    /// on) from points on the scene's objects and in space, at distances from 0.01 to 30 (so
+    /// inside the light's sphere, within 1 of its centre, across `a = 2 r^2` and far), radii
+    /// from 1e-3 to 2, scales of the whole scene from 2^-40 to 2^40: `shadowed_lanes` answers
+    /// the scene loop's `count_hits(ray, (1e-6, |c - p|), 2) > 1` lane by lane, and lanes both
+    /// inside and outside the aimed sphere's sure case occur.
+    #[test]
+    fn shadow_rays_to_a_light_answer_as_the_scene_loop_does() {
+        if skipped_without_lanes("there are no lanes to check") {
+            return;
+        }
+        let mut s = PixelSampler::new(53, 4);
+        let (mut sure, mut solved) = (0, 0);
+        for scene_number in 0..400 {
+            let scale = 2f64.powi((s.next_f64() * 81.0) as i32 - 40);
+            let mut scene = random_scene(&mut s, 1 + scene_number % 8, scene_number >= 200);
+            let light = DVec3::new(
+                s.uniform(-2.0, 2.0),
+                s.uniform(-2.0, 2.0),
+                s.uniform(-2.0, 2.0),
+            );
+            let radius = 10f64.powf(s.uniform(-3.0, 0.3));
+            if scene_number % 5 != 4 {
+                // The light's own sphere, anywhere in the list.
+                let at = (s.next_f64() * (scene.objects.len() + 1) as f64) as usize;
+                scene.objects.insert(
+                    at,
+                    crate::scene::SceneObject {
+                        shape: Object::Sphere(crate::geometry::Sphere::new(light, radius)),
+                        material: 0,
+                    },
+                );
+            }
+            for object in &mut scene.objects {
+                object.shape = scaled(object.shape, scale);
+            }
+            let light = light * scale;
+            let set = ShapeSet::new(&scene).expect("spheres and quads only");
+            let aimed = set.centred_at(light);
+            assert_eq!(aimed != 0, scene_number % 5 != 4);
+            for _ in 0..100 {
+                let mut rays = RayLanes::default();
+                let mut points = [None; LANES];
+                for (k, point) in points.iter_mut().enumerate() {
+                    let p = if s.next_f64() < 0.5 {
+                        random_ray(&mut s, &scene).origin
+                    } else {
+                        light + s.unit_vector() * (10f64.powf(s.uniform(-2.0, 1.5)) * scale)
+                    };
+                    if s.next_f64() < 0.9 && p != light {
+                        rays.set(k, p, light - p, 0.0);
+                        *point = Some(p);
+                    }
+                }
+                // SAFETY: the processor has AVX2 (checked above).
+                let dark = unsafe { set.shadowed_lanes(&rays, 1e-6, aimed) };
+                // The aimed sphere's shortcut finds, lane by lane, what its roots find.
+                let reach = points.map(|p| p.map_or(0.0, |p| (light - p).length()));
+                for (me, member) in set.members.iter().enumerate() {
+                    let Member::Ball(ball) = member else {
+                        continue;
+                    };
+                    if me >= 64 || aimed & (1 << me) == 0 {
+                        continue;
+                    }
+                    // At the shadow rays' `min`, and at one above the shortcut's bound.
+                    for min in [1e-6, 0.5] {
+                        let (mut t, mut u) = ([0.0; LANES], [0.0; LANES]);
+                        // SAFETY: as above.
+                        let (quick, full) = unsafe {
+                            let loaded = Loaded::new(&rays);
+                            let center = splat3(ball.center);
+                            (
+                                aimed_ball_lanes(ball, &loaded, min, &reach, &mut t),
+                                ball_lanes(center, ball.r2, &loaded, min, &reach, &mut u),
+                            )
+                        };
+                        assert_eq!(quick, full, "{min} {points:?} {light}");
+                    }
+                }
+                for (k, point) in points.iter().enumerate() {
+                    let Some(p) = *point else {
+                        assert_eq!(dark[k], Ok(false));
+                        continue;
+                    };
+                    let to_light = light - p;
+                    let ray = Ray::new(p, to_light);
+                    let reach = Interval::new(1e-6, to_light.length());
+                    assert_eq!(
+                        dark[k],
+                        Ok(scene.count_hits(&ray, reach, 2) > 1),
+                        "{p} {light}"
+                    );
+                    let a = to_light.dot(to_light);
+                    if aimed != 0
+                        && PREFILTER_RANGE.contains(&a)
+                        && a >= 2.0 * (radius * scale).powi(2)
+                        && reach.max > 1.0
+                    {
+                        sure += 1;
+                    } else {
+                        solved += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            sure > 20_000 && solved > 20_000,
+            "{sure} sure, {solved} solved"
+        );
+    }
+
+    /// `shape` with every length multiplied by `k` (a power of two: exactly).
+    fn scaled(shape: Object, k: f64) -> Object {
+        use crate::geometry::{MovingSphere, Sphere};
+        let ball = |b: Sphere| Sphere::new(b.center * k, b.radius * k);
+        match shape {
+            Object::Sphere(b) => Object::Sphere(ball(b)),
+            Object::MovingSphere(m) => {
+                Object::MovingSphere(MovingSphere::new(ball(m.sphere), m.end * k))
+            }
+            Object::Quad(q) => Object::Quad(Quad::new(q.q * k, q.u * k, q.v * k)),
+            Object::Triangle(t) => Object::Triangle(t),
+        }
     }
 }

@@ -42,6 +42,13 @@ pub(super) const PREFILTER_MARGIN: f64 = 1e-12;
 /// Where the pre-filter trusts `a` and `|f|^2 + r^2`.
 pub(super) const PREFILTER_RANGE: std::ops::Range<f64> = 1e-100..1e100;
 
+/// The *leaving* early out's bound on `-c / b'` (see [`sure_miss`]).
+pub(super) const LEAVING_SLOPE: f64 = 1e-7;
+
+/// The least `interval.min` for which the *leaving* early out holds: ten times
+/// [`LEAVING_SLOPE`], well above the root it rules out.
+pub(super) const LEAVING_MIN: f64 = 1e-6;
+
 /// Whether a sphere whose roots [`roots_of`] would find from these parts (it checked them:
 /// no over- or underflow) certainly has none inside `interval`.
 ///
@@ -49,6 +56,15 @@ pub(super) const PREFILTER_RANGE: std::ops::Range<f64> = 1e-100..1e100;
 ///   Then `q = -(b' + sqrt(disc)) < 0`, so both roots, `c / q` and `q / a`, are negative or
 ///   `-0`: neither lies above a `min` of 0 or more. The signs are those of the very `b'` and `c`
 ///   the roots are computed from, so this is exact.
+/// - *Leaving*: `b' > 0` and `-LEAVING_SLOPE b' <= c <= 0` (a ray starting on the sphere, or
+///   a rounding error inside it, and moving outwards: every ray scattered from a sphere's
+///   outside, and every shadow ray from its lit side, meets its own sphere so), with
+///   `interval.min >= LEAVING_MIN` and `a` and `f . f + r^2` in [`PREFILTER_RANGE`]. In that range
+///   `disc = a (r^2 - |p|^2)` is finite (`|p| <= 2 |f|`), so `roots_of` computes both roots: with
+///   `sqrt(disc) >= 0`, `|q| = b' + sqrt(disc) >= b'` after rounding, so `t1 = q / a < 0` and
+///   `|t0| = |c| / |q| <= |c| / b' <= LEAVING_SLOPE` (rounding is monotone, and the bound
+///   `LEAVING_SLOPE b'` is rounded once), well below `min`: no root lies in the interval. Exact
+///   in the same sense as *behind*: it reasons on the very `b'` and `c` the roots come from.
 /// - *Aside*: the naive discriminant below the margin ([`PREFILTER_MARGIN`]).
 #[inline(always)]
 fn sure_miss(a: f64, half_b: f64, ff: f64, r2: f64, c: f64, interval: Interval) -> bool {
@@ -56,9 +72,11 @@ fn sure_miss(a: f64, half_b: f64, ff: f64, r2: f64, c: f64, interval: Interval) 
         return true;
     }
     let scale = ff + r2;
-    PREFILTER_RANGE.contains(&a)
-        && PREFILTER_RANGE.contains(&scale)
-        && half_b * half_b - a * c < -(a * PREFILTER_MARGIN * scale)
+    let in_range = PREFILTER_RANGE.contains(&a) && PREFILTER_RANGE.contains(&scale);
+    if in_range && interval.min >= LEAVING_MIN && half_b > 0.0 && c >= -(LEAVING_SLOPE * half_b) {
+        return true;
+    }
+    in_range && half_b * half_b - a * c < -(a * PREFILTER_MARGIN * scale)
 }
 
 /// One sphere: its centre and squared radius.
@@ -119,6 +137,19 @@ impl ShapeSet {
             })
             .collect::<Option<Vec<_>>>()?;
         (!members.is_empty()).then_some(Self { members })
+    }
+
+    /// The static spheres (among the first 64 objects) centred exactly at `point`, bit `i`
+    /// for object `i`: the lanes' occlusion test decides them for rays aimed at `point`
+    /// without their roots (`ShapeSet::shadowed_lanes`).
+    pub(crate) fn centred_at(&self, point: DVec3) -> u64 {
+        let bits = |v: DVec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+        self.members
+            .iter()
+            .take(64)
+            .enumerate()
+            .filter(|(_, m)| matches!(m, Member::Ball(b) if bits(b.center) == bits(point)))
+            .fold(0, |mask, (i, _)| mask | 1 << i)
     }
 
     /// Whether an object moves (its rays' times matter).
@@ -439,5 +470,88 @@ pub(super) mod tests {
         });
         assert!(ShapeSet::new(&triangle).is_none());
         assert!(ShapeSet::new(&Scene::default()).is_none());
+    }
+
+    /// Rays leaving a sphere from its surface (a hit point, or a point put on it) or from just
+    /// inside it (`|c|` from 1e-15 to 1e-5 of `r^2`, across the *leaving* bound), outwards, at
+    /// radii and lengths from 1e-3 to 1e3: wherever `sure_miss` calls the sphere a miss under
+    /// `(1e-6, MAX)` or `(0.001, inf)`, the robust roots have none there; and it calls most of
+    /// the rays from the surface misses (those the *behind* test alone left to the roots too).
+    #[test]
+    fn a_ray_leaving_a_sphere_is_a_sure_miss_only_where_no_root_is_in_the_interval() {
+        let mut s = PixelSampler::new(41, 2);
+        let (mut leaving, mut asked) = (0, 0);
+        for round in 0..200_000 {
+            let radius = 10f64.powf(s.uniform(-3.0, 3.0));
+            let center = DVec3::new(s.uniform(-5.0, 5.0), s.uniform(-5.0, 5.0), 0.0) * radius;
+            let u = s.unit_vector();
+            let origin = match round % 3 {
+                // A hit point: the camera ray's `at(t)`, as the renderer computes it.
+                0 => {
+                    let from = center + u * radius * s.uniform(2.0, 10.0);
+                    let ray = Ray::new(from, (center - from) * s.uniform(0.01, 100.0));
+                    match Sphere::new(center, radius).hit_t(&ray, Interval::CAMERA) {
+                        Some(t) => ray.at(t),
+                        None => continue,
+                    }
+                }
+                1 => center + u * radius,
+                _ => center + u * (radius * (1.0 - 10f64.powf(s.uniform(-15.0, -5.0)))),
+            };
+            // Outwards: any direction on the normal's side.
+            let mut d = s.unit_vector();
+            if d.dot(origin - center) < 0.0 {
+                d = -d;
+            }
+            let d = d * 10f64.powf(s.uniform(-3.0, 3.0));
+            let f = origin - center;
+            let (a, half_b, ff, r2) = (d.dot(d), f.dot(d), f.dot(f), radius * radius);
+            let c = ff - r2;
+            for interval in [Interval::CAMERA, Interval::new(0.001, f64::INFINITY)] {
+                asked += 1;
+                if !(half_b > 0.0 && c <= 0.0 && sure_miss(a, half_b, ff, r2, c, interval)) {
+                    continue;
+                }
+                leaving += 1;
+                let roots = roots_of(f, d, a, half_b, r2, c).expect("in range");
+                assert_eq!(
+                    roots.and_then(|r| pick_root(r, interval)),
+                    None,
+                    "{origin} {d}"
+                );
+            }
+        }
+        assert!(leaving * 4 > asked, "{leaving} of {asked}");
+    }
+
+    /// `centred_at` marks exactly the static spheres whose centre has the point's bits (not
+    /// `-0` for `0`, not a moving sphere or a quad), among the first 64 objects.
+    #[test]
+    fn centred_at_marks_the_spheres_with_that_centre_bit_for_bit() {
+        let c = DVec3::new(0.0, 1.0, -2.0);
+        let ball = |center, r| SceneObject {
+            shape: Object::Sphere(Sphere::new(center, r)),
+            material: 0,
+        };
+        let mut objects = vec![
+            ball(c, 0.1),
+            ball(DVec3::new(-0.0, 1.0, -2.0), 0.1),
+            ball(c + DVec3::X * 1e-15, 0.1),
+            SceneObject {
+                shape: Object::MovingSphere(MovingSphere::new(Sphere::new(c, 0.1), c)),
+                material: 0,
+            },
+            ball(c, -0.5),
+        ];
+        objects.extend((0..70).map(|_| ball(DVec3::ZERO, 1.0)));
+        objects.push(ball(c, 0.2));
+        let set = ShapeSet::new(&Scene {
+            objects,
+            materials: vec![],
+        })
+        .unwrap();
+        assert_eq!(set.centred_at(c), 0b10001);
+        assert_eq!(set.centred_at(DVec3::ZERO), !0 << 5);
+        assert_eq!(set.centred_at(DVec3::new(9.0, 9.0, 9.0)), 0);
     }
 }
