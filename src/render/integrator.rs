@@ -365,8 +365,13 @@ fn brdf(
         }
         path.total += path.weight * le;
     }
-    let w = scattered.ray.direction;
-    path.weight *= brdf_of(world, material, ray.direction, w, &hit) * cutoff(n.dot(w));
+    // On the last bounce nothing reads the weight again (`next` returns the total whatever
+    // it is), so its BRDF, a `pow` for Phong and Blinn, is not evaluated; the scattered ray was
+    // drawn all the same, so the pixel's random stream goes on as the course's does.
+    if path.left > 1 {
+        let w = scattered.ray.direction;
+        path.weight *= brdf_of(world, material, ray.direction, w, &hit) * cutoff(n.dot(w));
+    }
     path.next(scattered.ray)
 }
 
