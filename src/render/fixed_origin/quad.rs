@@ -1,9 +1,14 @@
-//! A quad's hit for a packet of lanes.
+//! A quad's hit for a packet of lanes: portable code the compiler vectorizes
+//! ([`quad_hit_lanes`]), and on x86-64 with AVX2 every quad of a packet in one vector per
+//! coordinate ([`quads_hit_avx2`]), to the same bits.
 
 use glam::DVec3;
 
 use crate::geometry::{PARALLEL_EPSILON, Quad};
 use crate::render::packet::{Directions, Lanes, WIDTH};
+
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
 
 /// `Quad::solve_from` for each lane's direction from `origin`, against each lane's interval
 /// `[min, closest[k]]`: where it hits, `closest[k]` becomes its `t` and `index[k]` becomes `me`.
@@ -58,5 +63,154 @@ pub(super) fn quad_hit_lanes(
             & (0.0..=1.0).contains(&beta);
         closest[k] = if hit { t } else { closest[k] };
         index[k] = if hit { me } else { index[k] };
+    }
+}
+
+/// [`quad_hit_lanes`] for every quad of `quads` that `candidates` holds (bit `me`, every quad
+/// from the 64th), in order, in AVX2 vectors: the same operations in the same order lane by
+/// lane (IEEE operations round alike in a vector lane; nothing is fused), so the same `closest`
+/// and `index`, bit for bit. The compiler turns [`quad_hit_lanes`]'s four lanes into two-lane
+/// vectors and scalar compares; written with the intrinsics, the packet is one vector.
+///
+/// The directions are read in halves of two lanes: they were just written, and a 32-byte load
+/// is not served from the smaller stores that wrote them (see `scene::shape_lanes`).
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn quads_hit_avx2(
+    quads: &[(Quad, f64)],
+    candidates: u64,
+    origin: DVec3,
+    d: &Directions,
+    min: f64,
+    closest: &mut Lanes,
+    index: &mut [u64; WIDTH],
+) {
+    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); each load and
+    // store reads or writes two or four elements of an array of four.
+    unsafe {
+        let (dx, dy, dz) = (halves(&d.x), halves(&d.y), halves(&d.z));
+        let (ox, oy, oz) = (splat(origin.x), splat(origin.y), splat(origin.z));
+        let (lo, zero, one) = (splat(min), _mm256_setzero_pd(), splat(1.0));
+        let mut best = _mm256_loadu_pd(closest.as_ptr());
+        let mut which = _mm256_castsi256_pd(_mm256_loadu_si256(index.as_ptr().cast()));
+        for (me, (quad, offset)) in quads.iter().enumerate() {
+            if me < 64 && (candidates >> me) & 1 == 0 {
+                continue;
+            }
+            let (n, q, u, v, w) = (quad.normal, quad.q, quad.u, quad.v, quad.w);
+            // `n.x d.x + n.y d.y + n.z d.z`, left to right.
+            let denom = _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(splat(n.x), dx), _mm256_mul_pd(splat(n.y), dy)),
+                _mm256_mul_pd(splat(n.z), dz),
+            );
+            let t = _mm256_div_pd(splat(*offset), denom);
+            let in_time = _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_LE_OQ>(lo, t),
+                _mm256_cmp_pd::<_CMP_LE_OQ>(t, best),
+            );
+            if _mm256_movemask_pd(in_time) == 0 {
+                continue;
+            }
+            // `ray.at(t) - q`.
+            let px = _mm256_sub_pd(_mm256_add_pd(ox, _mm256_mul_pd(dx, t)), splat(q.x));
+            let py = _mm256_sub_pd(_mm256_add_pd(oy, _mm256_mul_pd(dy, t)), splat(q.y));
+            let pz = _mm256_sub_pd(_mm256_add_pd(oz, _mm256_mul_pd(dz, t)), splat(q.z));
+            // `w . (planar x v)` and `w . (u x planar)`, term by term as the scalar code.
+            let alpha = _mm256_add_pd(
+                _mm256_add_pd(
+                    _mm256_mul_pd(
+                        splat(w.x),
+                        _mm256_sub_pd(_mm256_mul_pd(py, splat(v.z)), _mm256_mul_pd(splat(v.y), pz)),
+                    ),
+                    _mm256_mul_pd(
+                        splat(w.y),
+                        _mm256_sub_pd(_mm256_mul_pd(pz, splat(v.x)), _mm256_mul_pd(splat(v.z), px)),
+                    ),
+                ),
+                _mm256_mul_pd(
+                    splat(w.z),
+                    _mm256_sub_pd(_mm256_mul_pd(px, splat(v.y)), _mm256_mul_pd(splat(v.x), py)),
+                ),
+            );
+            let beta = _mm256_add_pd(
+                _mm256_add_pd(
+                    _mm256_mul_pd(
+                        splat(w.x),
+                        _mm256_sub_pd(_mm256_mul_pd(splat(u.y), pz), _mm256_mul_pd(py, splat(u.z))),
+                    ),
+                    _mm256_mul_pd(
+                        splat(w.y),
+                        _mm256_sub_pd(_mm256_mul_pd(splat(u.z), px), _mm256_mul_pd(pz, splat(u.x))),
+                    ),
+                ),
+                _mm256_mul_pd(
+                    splat(w.z),
+                    _mm256_sub_pd(_mm256_mul_pd(splat(u.x), py), _mm256_mul_pd(px, splat(u.y))),
+                ),
+            );
+            let magnitude = _mm256_andnot_pd(splat(-0.0), denom);
+            let finite =
+                _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_andnot_pd(splat(-0.0), t), splat(f64::INFINITY));
+            let hit = _mm256_and_pd(
+                _mm256_and_pd(
+                    _mm256_cmp_pd::<_CMP_GE_OQ>(magnitude, splat(PARALLEL_EPSILON)),
+                    _mm256_and_pd(finite, in_time),
+                ),
+                _mm256_and_pd(within(alpha, zero, one), within(beta, zero, one)),
+            );
+            best = _mm256_blendv_pd(best, t, hit);
+            which = _mm256_blendv_pd(
+                which,
+                _mm256_castsi256_pd(_mm256_set1_epi64x(me as i64)),
+                hit,
+            );
+        }
+        _mm256_storeu_pd(closest.as_mut_ptr(), best);
+        _mm256_storeu_si256(index.as_mut_ptr().cast(), _mm256_castpd_si256(which));
+    }
+}
+
+/// The four lanes of `x`, read as two halves (see [`quads_hit_avx2`]).
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn halves(x: &Lanes) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract); each load reads two of the four.
+    unsafe { _mm256_set_m128d(_mm_loadu_pd(x.as_ptr().add(2)), _mm_loadu_pd(x.as_ptr())) }
+}
+
+/// `x` in every lane.
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn splat(x: f64) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract).
+    unsafe { _mm256_set1_pd(x) }
+}
+
+/// Where `zero <= x <= one`, lane by lane (`RangeInclusive::contains`).
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn within(x: __m256d, zero: __m256d, one: __m256d) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract).
+    unsafe {
+        _mm256_and_pd(
+            _mm256_cmp_pd::<_CMP_LE_OQ>(zero, x),
+            _mm256_cmp_pd::<_CMP_LE_OQ>(x, one),
+        )
     }
 }
