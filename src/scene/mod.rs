@@ -42,6 +42,8 @@ pub use settings::{
 #[cfg(test)]
 pub(crate) use shape_lanes::skipped_without_lanes;
 pub(crate) use shape_lanes::{LANES, RayLanes, has_lanes};
+#[cfg(target_arch = "x86_64")]
+pub(crate) use shape_lanes::{between as lanes_between, splat as lanes_splat};
 pub(crate) use shape_set::ShapeSet;
 pub use texture::{
     GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,

@@ -138,7 +138,7 @@ unsafe fn finite(x: __m256d) -> __m256d {
 /// The processor must have AVX2.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn splat(x: f64) -> __m256d {
+pub(crate) unsafe fn splat(x: f64) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
     unsafe { _mm256_set1_pd(x) }
 }
@@ -181,7 +181,7 @@ unsafe fn cross(a: Vec3Lanes, b: Vec3Lanes) -> Vec3Lanes {
 /// The processor must have AVX2.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn between<const OPEN: bool>(lo: __m256d, x: __m256d, hi: __m256d) -> __m256d {
+pub(crate) unsafe fn between<const OPEN: bool>(lo: __m256d, x: __m256d, hi: __m256d) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
     unsafe {
         if OPEN {

@@ -8,6 +8,8 @@ use crate::geometry::{PARALLEL_EPSILON, Quad};
 use crate::render::packet::{Directions, Lanes, WIDTH};
 
 #[cfg(target_arch = "x86_64")]
+use crate::scene::{lanes_between, lanes_splat};
+#[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
 /// `Quad::solve_from` for each lane's direction from `origin`, against each lane's interval
@@ -93,8 +95,12 @@ pub(super) unsafe fn quads_hit_avx2(
     // store reads or writes two or four elements of an array of four.
     unsafe {
         let (dx, dy, dz) = (halves(&d.x), halves(&d.y), halves(&d.z));
-        let (ox, oy, oz) = (splat(origin.x), splat(origin.y), splat(origin.z));
-        let (lo, zero, one) = (splat(min), _mm256_setzero_pd(), splat(1.0));
+        let (ox, oy, oz) = (
+            lanes_splat(origin.x),
+            lanes_splat(origin.y),
+            lanes_splat(origin.z),
+        );
+        let (lo, zero, one) = (lanes_splat(min), _mm256_setzero_pd(), lanes_splat(1.0));
         let mut best = _mm256_loadu_pd(closest.as_ptr());
         let mut which = _mm256_castsi256_pd(_mm256_loadu_si256(index.as_ptr().cast()));
         for (me, (quad, offset)) in quads.iter().enumerate() {
@@ -104,10 +110,13 @@ pub(super) unsafe fn quads_hit_avx2(
             let (n, q, u, v, w) = (quad.normal, quad.q, quad.u, quad.v, quad.w);
             // `n.x d.x + n.y d.y + n.z d.z`, left to right.
             let denom = _mm256_add_pd(
-                _mm256_add_pd(_mm256_mul_pd(splat(n.x), dx), _mm256_mul_pd(splat(n.y), dy)),
-                _mm256_mul_pd(splat(n.z), dz),
+                _mm256_add_pd(
+                    _mm256_mul_pd(lanes_splat(n.x), dx),
+                    _mm256_mul_pd(lanes_splat(n.y), dy),
+                ),
+                _mm256_mul_pd(lanes_splat(n.z), dz),
             );
-            let t = _mm256_div_pd(splat(*offset), denom);
+            let t = _mm256_div_pd(lanes_splat(*offset), denom);
             let in_time = _mm256_and_pd(
                 _mm256_cmp_pd::<_CMP_LE_OQ>(lo, t),
                 _mm256_cmp_pd::<_CMP_LE_OQ>(t, best),
@@ -116,51 +125,74 @@ pub(super) unsafe fn quads_hit_avx2(
                 continue;
             }
             // `ray.at(t) - q`.
-            let px = _mm256_sub_pd(_mm256_add_pd(ox, _mm256_mul_pd(dx, t)), splat(q.x));
-            let py = _mm256_sub_pd(_mm256_add_pd(oy, _mm256_mul_pd(dy, t)), splat(q.y));
-            let pz = _mm256_sub_pd(_mm256_add_pd(oz, _mm256_mul_pd(dz, t)), splat(q.z));
+            let px = _mm256_sub_pd(_mm256_add_pd(ox, _mm256_mul_pd(dx, t)), lanes_splat(q.x));
+            let py = _mm256_sub_pd(_mm256_add_pd(oy, _mm256_mul_pd(dy, t)), lanes_splat(q.y));
+            let pz = _mm256_sub_pd(_mm256_add_pd(oz, _mm256_mul_pd(dz, t)), lanes_splat(q.z));
             // `w . (planar x v)` and `w . (u x planar)`, term by term as the scalar code.
             let alpha = _mm256_add_pd(
                 _mm256_add_pd(
                     _mm256_mul_pd(
-                        splat(w.x),
-                        _mm256_sub_pd(_mm256_mul_pd(py, splat(v.z)), _mm256_mul_pd(splat(v.y), pz)),
+                        lanes_splat(w.x),
+                        _mm256_sub_pd(
+                            _mm256_mul_pd(py, lanes_splat(v.z)),
+                            _mm256_mul_pd(lanes_splat(v.y), pz),
+                        ),
                     ),
                     _mm256_mul_pd(
-                        splat(w.y),
-                        _mm256_sub_pd(_mm256_mul_pd(pz, splat(v.x)), _mm256_mul_pd(splat(v.z), px)),
+                        lanes_splat(w.y),
+                        _mm256_sub_pd(
+                            _mm256_mul_pd(pz, lanes_splat(v.x)),
+                            _mm256_mul_pd(lanes_splat(v.z), px),
+                        ),
                     ),
                 ),
                 _mm256_mul_pd(
-                    splat(w.z),
-                    _mm256_sub_pd(_mm256_mul_pd(px, splat(v.y)), _mm256_mul_pd(splat(v.x), py)),
+                    lanes_splat(w.z),
+                    _mm256_sub_pd(
+                        _mm256_mul_pd(px, lanes_splat(v.y)),
+                        _mm256_mul_pd(lanes_splat(v.x), py),
+                    ),
                 ),
             );
             let beta = _mm256_add_pd(
                 _mm256_add_pd(
                     _mm256_mul_pd(
-                        splat(w.x),
-                        _mm256_sub_pd(_mm256_mul_pd(splat(u.y), pz), _mm256_mul_pd(py, splat(u.z))),
+                        lanes_splat(w.x),
+                        _mm256_sub_pd(
+                            _mm256_mul_pd(lanes_splat(u.y), pz),
+                            _mm256_mul_pd(py, lanes_splat(u.z)),
+                        ),
                     ),
                     _mm256_mul_pd(
-                        splat(w.y),
-                        _mm256_sub_pd(_mm256_mul_pd(splat(u.z), px), _mm256_mul_pd(pz, splat(u.x))),
+                        lanes_splat(w.y),
+                        _mm256_sub_pd(
+                            _mm256_mul_pd(lanes_splat(u.z), px),
+                            _mm256_mul_pd(pz, lanes_splat(u.x)),
+                        ),
                     ),
                 ),
                 _mm256_mul_pd(
-                    splat(w.z),
-                    _mm256_sub_pd(_mm256_mul_pd(splat(u.x), py), _mm256_mul_pd(px, splat(u.y))),
+                    lanes_splat(w.z),
+                    _mm256_sub_pd(
+                        _mm256_mul_pd(lanes_splat(u.x), py),
+                        _mm256_mul_pd(px, lanes_splat(u.y)),
+                    ),
                 ),
             );
-            let magnitude = _mm256_andnot_pd(splat(-0.0), denom);
-            let finite =
-                _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_andnot_pd(splat(-0.0), t), splat(f64::INFINITY));
+            let magnitude = _mm256_andnot_pd(lanes_splat(-0.0), denom);
+            let finite = _mm256_cmp_pd::<_CMP_LT_OQ>(
+                _mm256_andnot_pd(lanes_splat(-0.0), t),
+                lanes_splat(f64::INFINITY),
+            );
             let hit = _mm256_and_pd(
                 _mm256_and_pd(
-                    _mm256_cmp_pd::<_CMP_GE_OQ>(magnitude, splat(PARALLEL_EPSILON)),
+                    _mm256_cmp_pd::<_CMP_GE_OQ>(magnitude, lanes_splat(PARALLEL_EPSILON)),
                     _mm256_and_pd(finite, in_time),
                 ),
-                _mm256_and_pd(within(alpha, zero, one), within(beta, zero, one)),
+                _mm256_and_pd(
+                    lanes_between::<false>(zero, alpha, one),
+                    lanes_between::<false>(zero, beta, one),
+                ),
             );
             best = _mm256_blendv_pd(best, t, hit);
             which = _mm256_blendv_pd(
@@ -184,33 +216,4 @@ pub(super) unsafe fn quads_hit_avx2(
 unsafe fn halves(x: &Lanes) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract); each load reads two of the four.
     unsafe { _mm256_set_m128d(_mm_loadu_pd(x.as_ptr().add(2)), _mm_loadu_pd(x.as_ptr())) }
-}
-
-/// `x` in every lane.
-///
-/// # Safety
-///
-/// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn splat(x: f64) -> __m256d {
-    // SAFETY: AVX2 is there (this function's contract).
-    unsafe { _mm256_set1_pd(x) }
-}
-
-/// Where `zero <= x <= one`, lane by lane (`RangeInclusive::contains`).
-///
-/// # Safety
-///
-/// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn within(x: __m256d, zero: __m256d, one: __m256d) -> __m256d {
-    // SAFETY: AVX2 is there (this function's contract).
-    unsafe {
-        _mm256_and_pd(
-            _mm256_cmp_pd::<_CMP_LE_OQ>(zero, x),
-            _mm256_cmp_pd::<_CMP_LE_OQ>(x, one),
-        )
-    }
 }
