@@ -332,16 +332,97 @@ fn packets_with_an_overflowing_lane_agree_with_the_scene() {
     }
 }
 
+/// A quad near the origin: half of them axis-aligned with whole-number corners, half with random
+/// edges from 1e-2 to 6 long (slivers among them).
+#[cfg(target_arch = "x86_64")]
+fn random_quad(s: &mut PixelSampler) -> Quad {
+    let q = DVec3::new(
+        s.uniform(-3.0, 3.0),
+        s.uniform(-3.0, 3.0),
+        s.uniform(-3.0, 3.0),
+    );
+    if s.next_f64() < 0.5 {
+        let (a, b) = (s.uniform(0.5, 6.0).round(), s.uniform(0.5, 6.0).round());
+        match (s.next_f64() * 3.0) as u32 {
+            0 => Quad::new(q.round(), DVec3::X * a, DVec3::Z * b),
+            1 => Quad::new(q.round(), DVec3::Y * a, DVec3::X * b),
+            _ => Quad::new(q.round(), DVec3::Z * a, DVec3::Y * b),
+        }
+    } else {
+        let u = s.unit_vector() * 10f64.powf(s.uniform(-2.0, 0.8));
+        let v = s.unit_vector() * 10f64.powf(s.uniform(-2.0, 0.8));
+        Quad::new(q, u, v)
+    }
+}
+
+/// A direction from `origin` aimed at one of `quads`: a corner, an edge, a centre or a point
+/// around it, sometimes pushed nearly into the quad's plane, sometimes anywhere.
+#[cfg(target_arch = "x86_64")]
+fn aimed_direction(s: &mut PixelSampler, quads: &[(Quad, f64)], origin: DVec3) -> DVec3 {
+    let (quad, _) = quads[(s.next_f64() * quads.len() as f64) as usize];
+    let (a, b) = match (s.next_f64() * 4.0) as u32 {
+        0 => (s.next_f64().round(), s.next_f64().round()),
+        1 => (s.next_f64().round(), s.next_f64()),
+        2 => (s.uniform(-0.2, 1.2), s.uniform(-0.2, 1.2)),
+        _ => (0.5, 0.5),
+    };
+    let mut target = quad.q + a * quad.u + b * quad.v;
+    if s.next_f64() < 0.1 {
+        // Nearly in the quad's plane.
+        target +=
+            (target - origin).cross(quad.normal) * 10.0 + quad.normal * s.uniform(-1e-9, 1e-9);
+    }
+    if s.next_f64() < 0.1 {
+        target = origin + s.unit_vector();
+    }
+    target - origin
+}
+
+/// Both forms of the quad packet test on the same packet, which must agree bit for bit (each
+/// lane's `t` and index); returns the indices.
+#[cfg(target_arch = "x86_64")]
+fn both_quad_forms(
+    quads: &[(Quad, f64)],
+    candidates: u64,
+    origin: DVec3,
+    d: &Directions,
+    min: f64,
+    start: Lanes,
+) -> [u64; WIDTH] {
+    use super::quad::{quad_hit_lanes, quads_hit_avx2};
+    let (mut t, mut index) = (start, [NO_HIT; WIDTH]);
+    for (me, (quad, offset)) in quads.iter().enumerate() {
+        if is_candidate(candidates, me) {
+            quad_hit_lanes(quad, *offset, origin, d, min, &mut t, &mut index, me as u64);
+        }
+    }
+    let (mut t_avx, mut index_avx) = (start, [NO_HIT; WIDTH]);
+    // SAFETY: the processor has AVX2 (the caller checked it).
+    unsafe {
+        quads_hit_avx2(
+            quads,
+            candidates,
+            origin,
+            d,
+            min,
+            &mut t_avx,
+            &mut index_avx,
+        )
+    };
+    assert_eq!(t.map(f64::to_bits), t_avx.map(f64::to_bits), "{d:?} {min}");
+    assert_eq!(index, index_avx, "{d:?} {min}");
+    index
+}
+
 /// The quad packets' AVX2 form (`quads_hit_avx2`) against the portable one (`quad_hit_lanes`
 /// over the same quads), bit for bit: each lane's closest `t` and index, on 2000 sets of up to
-/// 70 quads (axis-aligned ones with whole-number corners, and random ones down to slivers),
-/// packets aimed at their corners, edges and centres and at random, rays nearly in a quad's
-/// plane, every candidate mask, intervals starting at 1e-6 and at 0.5, and packets that already
-/// hold a hit.
+/// 70 quads (`random_quad`), packets aimed at their corners, edges and centres and at random
+/// (`aimed_direction`), rays nearly in a quad's plane, grazing rays about the parallel bound,
+/// every candidate mask, intervals starting at 1e-6 and at 0.5, and packets that already hold a
+/// hit.
 #[cfg(target_arch = "x86_64")]
 #[test]
 fn quad_packets_in_vectors_answer_as_the_portable_lanes() {
-    use super::quad::{quad_hit_lanes, quads_hit_avx2};
     if crate::scene::skipped_without_lanes("the AVX2 quad packets are not checked") {
         return;
     }
@@ -354,43 +435,20 @@ fn quad_packets_in_vectors_answer_as_the_portable_lanes() {
             s.uniform(-4.0, 12.0),
         );
         let count = 1 + (s.next_f64() * if set % 10 == 0 { 70.0 } else { 8.0 }) as usize;
-        let quads: Vec<(Quad, f64)> = (0..count)
-            .map(|_| {
-                let q = DVec3::new(
-                    s.uniform(-3.0, 3.0),
-                    s.uniform(-3.0, 3.0),
-                    s.uniform(-3.0, 3.0),
-                );
-                let quad = if s.next_f64() < 0.5 {
-                    let (a, b) = (s.uniform(0.5, 6.0).round(), s.uniform(0.5, 6.0).round());
-                    match (s.next_f64() * 3.0) as u32 {
-                        0 => Quad::new(q.round(), DVec3::X * a, DVec3::Z * b),
-                        1 => Quad::new(q.round(), DVec3::Y * a, DVec3::X * b),
-                        _ => Quad::new(q.round(), DVec3::Z * a, DVec3::Y * b),
-                    }
-                } else {
-                    let u = s.unit_vector() * 10f64.powf(s.uniform(-2.0, 0.8));
-                    let v = s.unit_vector() * 10f64.powf(s.uniform(-2.0, 0.8));
-                    Quad::new(q, u, v)
-                };
-                (quad, quad.d - quad.normal.dot(origin))
-            })
-            .collect();
+        let shapes: Vec<Quad> = (0..count).map(|_| random_quad(&mut s)).collect();
         // One set in four: the eye within about 1e-8 of the first quad's plane, and half the
         // lanes along that plane, tilted to meet it near the quad at `t` between 1/2 and 2,
         // with `|n . d|` about the parallel bound (1e-8), on either side of it.
         let graze = set % 4 == 3;
-        let mut offsets = quads.iter().map(|(_, offset)| *offset).collect::<Vec<_>>();
-        let (first, _) = quads[0];
+        let first = shapes[0];
         let height = s.uniform(0.5e-8, 2e-8) * if s.next_f64() < 0.5 { -1.0 } else { 1.0 };
         if graze {
             origin = first.q + first.u * s.uniform(-1.0, 2.0) - first.v * s.uniform(0.5, 3.0)
                 + first.normal * height;
-            for (offset, (quad, _)) in offsets.iter_mut().zip(&quads) {
-                *offset = quad.d - quad.normal.dot(origin);
-            }
         }
-        let quads: Vec<(Quad, f64)> = quads.iter().map(|(q, _)| *q).zip(offsets).collect();
+        let quads: Vec<(Quad, f64)> = (shapes.iter())
+            .map(|quad| (*quad, quad.d - quad.normal.dot(origin)))
+            .collect();
         let candidates = if s.next_f64() < 0.5 {
             ALL_CANDIDATES
         } else {
@@ -399,23 +457,7 @@ fn quad_packets_in_vectors_answer_as_the_portable_lanes() {
         for _ in 0..20 {
             let mut d = Directions::default();
             for k in 0..WIDTH {
-                let (quad, _) = quads[(s.next_f64() * count as f64) as usize];
-                let (a, b) = match (s.next_f64() * 4.0) as u32 {
-                    0 => (s.next_f64().round(), s.next_f64().round()),
-                    1 => (s.next_f64().round(), s.next_f64()),
-                    2 => (s.uniform(-0.2, 1.2), s.uniform(-0.2, 1.2)),
-                    _ => (0.5, 0.5),
-                };
-                let mut target = quad.q + a * quad.u + b * quad.v;
-                if s.next_f64() < 0.1 {
-                    // Nearly in the quad's plane.
-                    target += (target - origin).cross(quad.normal) * 10.0
-                        + quad.normal * s.uniform(-1e-9, 1e-9);
-                }
-                if s.next_f64() < 0.1 {
-                    target = origin + s.unit_vector();
-                }
-                let mut direction = target - origin;
+                let mut direction = aimed_direction(&mut s, &quads, origin);
                 if graze && k % 2 == 0 {
                     let inside = first.q + first.u * s.next_f64() + first.v * s.next_f64();
                     let along = inside - origin;
@@ -431,29 +473,7 @@ fn quad_packets_in_vectors_answer_as_the_portable_lanes() {
             } else {
                 [0, 1, 2, 3].map(|_| s.uniform(0.0, 20.0))
             };
-            let (mut t, mut index) = (start, [NO_HIT; WIDTH]);
-            for (me, (quad, offset)) in quads.iter().enumerate() {
-                if is_candidate(candidates, me) {
-                    quad_hit_lanes(
-                        quad, *offset, origin, &d, min, &mut t, &mut index, me as u64,
-                    );
-                }
-            }
-            let (mut t_avx, mut index_avx) = (start, [NO_HIT; WIDTH]);
-            // SAFETY: the processor has AVX2 (checked above).
-            unsafe {
-                quads_hit_avx2(
-                    &quads,
-                    candidates,
-                    origin,
-                    &d,
-                    min,
-                    &mut t_avx,
-                    &mut index_avx,
-                )
-            };
-            assert_eq!(t.map(f64::to_bits), t_avx.map(f64::to_bits), "{d:?} {min}");
-            assert_eq!(index, index_avx, "{d:?} {min}");
+            let index = both_quad_forms(&quads, candidates, origin, &d, min, start);
             hits += index.iter().filter(|&&i| i != NO_HIT).count();
         }
     }
