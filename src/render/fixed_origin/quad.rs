@@ -129,56 +129,10 @@ pub(super) unsafe fn quads_hit_avx2(
             let py = _mm256_sub_pd(_mm256_add_pd(oy, _mm256_mul_pd(dy, t)), lanes_splat(q.y));
             let pz = _mm256_sub_pd(_mm256_add_pd(oz, _mm256_mul_pd(dz, t)), lanes_splat(q.z));
             // `w . (planar x v)` and `w . (u x planar)`, term by term as the scalar code.
-            let alpha = _mm256_add_pd(
-                _mm256_add_pd(
-                    _mm256_mul_pd(
-                        lanes_splat(w.x),
-                        _mm256_sub_pd(
-                            _mm256_mul_pd(py, lanes_splat(v.z)),
-                            _mm256_mul_pd(lanes_splat(v.y), pz),
-                        ),
-                    ),
-                    _mm256_mul_pd(
-                        lanes_splat(w.y),
-                        _mm256_sub_pd(
-                            _mm256_mul_pd(pz, lanes_splat(v.x)),
-                            _mm256_mul_pd(lanes_splat(v.z), px),
-                        ),
-                    ),
-                ),
-                _mm256_mul_pd(
-                    lanes_splat(w.z),
-                    _mm256_sub_pd(
-                        _mm256_mul_pd(px, lanes_splat(v.y)),
-                        _mm256_mul_pd(lanes_splat(v.x), py),
-                    ),
-                ),
-            );
-            let beta = _mm256_add_pd(
-                _mm256_add_pd(
-                    _mm256_mul_pd(
-                        lanes_splat(w.x),
-                        _mm256_sub_pd(
-                            _mm256_mul_pd(lanes_splat(u.y), pz),
-                            _mm256_mul_pd(py, lanes_splat(u.z)),
-                        ),
-                    ),
-                    _mm256_mul_pd(
-                        lanes_splat(w.y),
-                        _mm256_sub_pd(
-                            _mm256_mul_pd(lanes_splat(u.z), px),
-                            _mm256_mul_pd(pz, lanes_splat(u.x)),
-                        ),
-                    ),
-                ),
-                _mm256_mul_pd(
-                    lanes_splat(w.z),
-                    _mm256_sub_pd(
-                        _mm256_mul_pd(lanes_splat(u.x), py),
-                        _mm256_mul_pd(px, lanes_splat(u.y)),
-                    ),
-                ),
-            );
+            let p = [px, py, pz];
+            let u = [lanes_splat(u.x), lanes_splat(u.y), lanes_splat(u.z)];
+            let v = [lanes_splat(v.x), lanes_splat(v.y), lanes_splat(v.z)];
+            let (alpha, beta) = (dot_cross(w, p, v), dot_cross(w, u, p));
             let magnitude = _mm256_andnot_pd(lanes_splat(-0.0), denom);
             let finite = _mm256_cmp_pd::<_CMP_LT_OQ>(
                 _mm256_andnot_pd(lanes_splat(-0.0), t),
@@ -216,4 +170,29 @@ pub(super) unsafe fn quads_hit_avx2(
 unsafe fn halves(x: &Lanes) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract); each load reads two of the four.
     unsafe { _mm256_set_m128d(_mm_loadu_pd(x.as_ptr().add(2)), _mm_loadu_pd(x.as_ptr())) }
+}
+
+/// `w . (a x b)` lane by lane, as the scalar quad test computes it (glam's cross product term by
+/// term, `w.x (a.y b.z - a.z b.y) + w.y (a.z b.x - a.x b.z) + w.z (a.x b.y - a.y b.x)`; a
+/// product's operands commute exactly).
+///
+/// # Safety
+///
+/// The processor must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn dot_cross(w: DVec3, a: [__m256d; 3], b: [__m256d; 3]) -> __m256d {
+    // SAFETY: AVX2 is there (this function's contract).
+    unsafe {
+        let x = _mm256_sub_pd(_mm256_mul_pd(a[1], b[2]), _mm256_mul_pd(a[2], b[1]));
+        let y = _mm256_sub_pd(_mm256_mul_pd(a[2], b[0]), _mm256_mul_pd(a[0], b[2]));
+        let z = _mm256_sub_pd(_mm256_mul_pd(a[0], b[1]), _mm256_mul_pd(a[1], b[0]));
+        _mm256_add_pd(
+            _mm256_add_pd(
+                _mm256_mul_pd(lanes_splat(w.x), x),
+                _mm256_mul_pd(lanes_splat(w.y), y),
+            ),
+            _mm256_mul_pd(lanes_splat(w.z), z),
+        )
+    }
 }
