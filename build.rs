@@ -10,9 +10,11 @@
 //!   resolved when the crate compiles. No absolute path is written: two clones sharing one
 //!   `CARGO_TARGET_DIR` share this script's output (its `OUT_DIR`), and each must read its own
 //!   files.
-//! - One cfg, so that the tests needing the course's published images show as ignored, with the
-//!   reason, in `cargo test`'s own output when `RTORACLE_COURSE_FIXTURES` is not set (a test that
-//!   returns early would show as passed, its "skipped" line swallowed by libtest).
+//! - Two cfgs, so that the tests needing the course's published images
+//!   (`RTORACLE_COURSE_FIXTURES`, cfg `rtoracle_course_fixtures`) or the course's real code of
+//!   weeks 4 to 10 (`RTORACLE_COURSE_CODE`, cfg `rtoracle_course_code`) show as ignored, with
+//!   the reason, in `cargo test`'s own output when the variable is not set (a test that returns
+//!   early would show as passed, its "skipped" line swallowed by libtest).
 
 /// The folders under `tests/fixtures/` whose `.py` and `.toml` files are embedded.
 const EMBEDDED: [&str; 5] = [
@@ -26,11 +28,16 @@ const EMBEDDED: [&str; 5] = [
 
 fn main() {
     embed_fixtures();
-    println!("cargo::rerun-if-env-changed=RTORACLE_COURSE_FIXTURES");
     println!("cargo::rerun-if-changed=build.rs");
-    println!("cargo::rustc-check-cfg=cfg(rtoracle_course_fixtures)");
-    if std::env::var_os("RTORACLE_COURSE_FIXTURES").is_some_and(|v| !v.is_empty()) {
-        println!("cargo::rustc-cfg=rtoracle_course_fixtures");
+    for (variable, cfg) in [
+        ("RTORACLE_COURSE_FIXTURES", "rtoracle_course_fixtures"),
+        ("RTORACLE_COURSE_CODE", "rtoracle_course_code"),
+    ] {
+        println!("cargo::rerun-if-env-changed={variable}");
+        println!("cargo::rustc-check-cfg=cfg({cfg})");
+        if std::env::var_os(variable).is_some_and(|v| !v.is_empty()) {
+            println!("cargo::rustc-cfg={cfg}");
+        }
     }
 }
 

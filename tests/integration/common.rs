@@ -39,6 +39,88 @@ pub fn course_fixtures(test: &str) -> Option<PathBuf> {
     }
 }
 
+/// The course's real code (`RTORACLE_COURSE_CODE`: a folder of `weekNN/skeleton` and
+/// `weekNN/solution`, weeks 4 to 10), or `None` after saying the test is skipped. Tests that
+/// need it are also marked `#[cfg_attr(not(rtoracle_course_code), ignore = "...")]`, so that
+/// `cargo test` lists them as ignored when the variable is unset.
+pub fn course_code(test: &str) -> Option<PathBuf> {
+    match std::env::var_os("RTORACLE_COURSE_CODE") {
+        Some(dir) if !dir.is_empty() => {
+            let dir = PathBuf::from(dir);
+            Some(if dir.is_absolute() {
+                dir
+            } else {
+                // Relative paths are taken from the crate root, where `.ci/run` sets it.
+                Path::new(env!("CARGO_MANIFEST_DIR")).join(dir)
+            })
+        }
+        _ => {
+            eprintln!("skipped {test}: RTORACLE_COURSE_CODE is not set");
+            None
+        }
+    }
+}
+
+/// Which of a week's two folders of the course's code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CourseTree {
+    /// What a student of the week is handed.
+    Skeleton,
+    /// The instructor's solution of the week.
+    Solution,
+}
+
+/// A writable copy of week `week`'s skeleton or solution (the course's folders are read-only in
+/// CI, and `main.py` writes its pictures into the working folder), in a temporary folder that
+/// is removed when the returned guard drops; `None` (after saying so) when
+/// `RTORACLE_COURSE_CODE` is unset. The copy is at `guard.path().join("weekNN-kind")`.
+pub fn course_week_copy(
+    test: &str,
+    week: u8,
+    tree: CourseTree,
+) -> Option<(tempfile::TempDir, PathBuf)> {
+    let root = course_code(test)?;
+    let kind = match tree {
+        CourseTree::Skeleton => "skeleton",
+        CourseTree::Solution => "solution",
+    };
+    let from = root.join(format!("week{week:02}")).join(kind);
+    assert!(
+        from.is_dir(),
+        "{} is not a folder: RTORACLE_COURSE_CODE must name the course's code (weekNN/skeleton, weekNN/solution)",
+        from.display()
+    );
+    let tmp = tempfile::tempdir().expect("a temporary folder");
+    let to = tmp.path().join(format!("week{week:02}-{kind}"));
+    copy_tree(&from, &to);
+    Some((tmp, to))
+}
+
+/// Copies the regular files and folders under `from` to `to` (made), leaving out Python's
+/// caches; files are made writable.
+pub fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create the copy's folder");
+    for entry in std::fs::read_dir(from).expect("read the folder") {
+        let entry = entry.expect("a folder entry");
+        let path = entry.path();
+        let name = entry.file_name();
+        if name == "__pycache__" {
+            continue;
+        }
+        let kind = entry.file_type().expect("a file type");
+        if kind.is_dir() {
+            copy_tree(&path, &to.join(&name));
+        } else if kind.is_file() {
+            let dest = to.join(&name);
+            std::fs::copy(&path, &dest).expect("copy a file");
+            let mut perms = std::fs::metadata(&dest).expect("metadata").permissions();
+            #[allow(clippy::permissions_set_readonly_false)]
+            perms.set_readonly(false);
+            std::fs::set_permissions(&dest, perms).expect("make the copy writable");
+        }
+    }
+}
+
 /// Asserts a command failed with exit code 2, one line on stderr mentioning `needle`, no panic.
 pub fn assert_bad_input(out: &Output, needle: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);
