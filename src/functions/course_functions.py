@@ -7,12 +7,30 @@ calls the submission's own function, unmodified, and returns the answer's "resul
 exception (the submission's, or NotFound / BadReturn / RandomExhausted raised here) becomes the
 answer's "error".
 
-Finding functions. The course puts reflect, refract, schlick, halfvector, the samplers and ONB
-in RT_utility, the materials in RT_material, the textures in RT_texture, Scene in RT_scene,
-Integrator in RT_integrator, Camera in RT_camera; a student may put them elsewhere. Each is
-looked for in every RT_*.py module of the submission (RT_utility first; RT_renderer and RT_pbar
-are never imported: they need progressbar2), and a function also as a static method of Vec3.
-What cannot be found is an error of type NotFound that names where it looked.
+Finding functions. The course (weeks 5 to 10, its real code) puts reflect, refract, schlick and
+halfvector in RT_material, the samplers as static methods of RT_utility.Vec3
+(Vec3.random_vec3_unit(), Vec3.random_vec3_in_unit_disk(), Vec3.random_cosine_hemisphere_on_z()),
+ONB in RT_utility, the materials in RT_material, Diffuse_light in RT_light, the textures in
+RT_texture, Scene in RT_scene, Integrator in RT_integrator, Camera in RT_camera; a student may
+put them elsewhere. Each is looked for in every RT_*.py module of the submission (RT_utility
+first; RT_renderer and RT_pbar are never imported: they need progressbar2), and a function also
+as a static method of Vec3. What cannot be found is an error of type NotFound that names where it
+looked.
+
+Imports. Each RT_*.py module is imported on its own, the first time a request needs one: a module
+that fails to import (a helper importing a package the grader lacks, say) is remembered with its
+file, line and the missing package, and fails only the requests that need what it would have
+defined (their NotFound names it); the others are answered.
+
+Each week's API. A request drives the version of a function the submission has: the integrator's
+compute_scattering with or without its depth (week 4's takes two arguments), ONB.local with one
+Vec3 (the course's) or three numbers and its axes as methods (the course's u(), v(), w()) or
+attributes, the camera's frame as camera_frame_u/v/w (the course's) or u/v/w, its defocus radius
+as defocus_radius or the length of defocus_disk_u, CookTorrance with or without the albedo first
+(week 8's skeleton has it). Where a submission keeps the course's behaviour through another
+convention (init_camera taking the lens's aperture instead of its defocus angle: the course's
+lens is given as the aperture 2 focus tan(angle / 2)), the answer lists it in "departures"
+(codes rtoracle words: "aperture").
 
 Random numbers. A request's "replace" object gives the values that the course's random
 functions return for the call: "random_double" (numbers u in [0, 1]; a call
@@ -58,16 +76,45 @@ class RandomExhausted(Exception):
     """The code drew more random numbers than the request gave."""
 
 
-_state = {"dir": ".", "modules": None}
+_state = {"dir": ".", "modules": None, "failed": None}
 
 
 def set_submission(folder):
     _state["dir"] = folder
     _state["modules"] = None
+    _state["failed"] = None
+
+
+def import_failure(name, exc):
+    """Why module `name` failed to import, in words: the file and line where it raised (the
+    deepest frame in the submission's folder) and, for a missing module, the package."""
+    import traceback
+    folder = os.path.abspath(_state["dir"])
+    where = None
+    for frame in traceback.extract_tb(exc.__traceback__):
+        path = os.path.abspath(frame.filename)
+        if os.path.dirname(path) == folder:
+            where = "%s, line %d" % (os.path.basename(path), frame.lineno)
+    if isinstance(exc, SyntaxError) and getattr(exc, "filename", None):
+        where = "%s, line %s" % (os.path.basename(exc.filename), exc.lineno)
+    if isinstance(exc, ModuleNotFoundError) and getattr(exc, "name", None):
+        what = "imports %s, which the grader does not provide" % exc.name.split(".")[0]
+        top = exc.name.split(".")[0]
+        if top.startswith("RT_") and not os.path.exists(os.path.join(folder, top + ".py")):
+            what = "imports %s, which is not in the submission folder" % top
+    else:
+        try:
+            what = "raises %s: %s" % (type(exc).__name__, str(exc)[:300])
+        except Exception:
+            what = "raises %s" % type(exc).__name__
+    if where is None:
+        return "%s.py could not be imported: it %s" % (name, what)
+    return "%s.py could not be imported: %s %s" % (name, where, what)
 
 
 def modules():
-    """The submission's RT_*.py modules, imported: the course's order first, then the others."""
+    """The submission's RT_*.py modules that import: the course's order first, then the others.
+    A module that fails to import is left out and remembered (`import_failures`)."""
     if _state["modules"] is None:
         names = sorted(
             os.path.basename(p)[:-3]
@@ -76,10 +123,22 @@ def modules():
         names = [n for n in names if n.isidentifier() and n not in SKIPPED]
         ordered = [n for n in PREFERRED if n in names] + [n for n in names if n not in PREFERRED]
         found = []
+        failed = []
         for name in ordered:
-            found.append((name, __import__(name)))
+            try:
+                found.append((name, __import__(name)))
+            except BaseException as exc:  # SyntaxError, ImportError, SystemExit, ...
+                sys.modules.pop(name, None)
+                failed.append((name, import_failure(name, exc)))
         _state["modules"] = found
+        _state["failed"] = failed
     return _state["modules"]
+
+
+def import_failures():
+    """`(module, why)` of the submission's modules that failed to import."""
+    modules()
+    return _state["failed"] or []
 
 
 def module(name):
@@ -90,7 +149,11 @@ def module(name):
 
 
 def where_looked():
-    return ", ".join(n + ".py" for n, _ in modules()) or "no RT_*.py module"
+    looked = ", ".join(n + ".py" for n, _ in modules()) or "no RT_*.py module"
+    failed = import_failures()
+    if failed:
+        looked += "; " + "; ".join(why for _, why in failed)
+    return looked
 
 
 def find_function(name, aliases=(), course_home="RT_utility"):
@@ -324,8 +387,20 @@ def make_object(spec):
     raise ValueError("unknown object type %r" % kind)
 
 
+# The background colour of the course's scenes (Scene()'s default, cBgcolor).
+COURSE_BACKGROUND = (0.01, 0.01, 0.01)
+
+
 def make_scene(objects):
-    scene = find_class("Scene", "RT_scene")()
+    """The course's Scene of `objects`, its background colour given explicitly as the course's
+    scenes have it (0.01 grey), so an integrator that returns the scene's own colour on a miss
+    answers what the course's does whatever the class's default."""
+    cls = find_class("Scene", "RT_scene")
+    count = positional_count(cls.__init__)
+    if count is not None and count >= 2:
+        scene = cls(color(COURSE_BACKGROUND))
+    else:
+        scene = cls()
     add = method(scene, "add_object", "Scene")
     for o in objects:
         add(make_object(o))
@@ -576,16 +651,26 @@ def op_scatter(req):
             "attenuation": out[3], "draws": r.draws()}
 
 
+def onb_axis(o, name):
+    """An ONB's axis: the course's method u() (or an attribute u)."""
+    a = getattr(o, name, None)
+    if callable(a) and not hasattr(a, "e"):
+        a = a()
+    return out_vec(a, "ONB." + name)
+
+
 def op_onb(req):
     cls = find_class(("ONB", "Onb", "OrthonormalBasis"), "RT_utility")
     o = cls()
     method(o, "build_from_w", cls.__name__)(vec3(req["w"]))
-    x, y, z = (float(c) for c in req["local"])
-    local = method(o, "local", cls.__name__)(x, y, z)
-    return {"u": out_vec(getattr(o, "u", None), "ONB.u"),
-            "v": out_vec(getattr(o, "v", None), "ONB.v"),
-            "w": out_vec(getattr(o, "w", None), "ONB.w"),
-            "local": out_vec(local, "ONB.local")}
+    local = method(o, "local", cls.__name__)
+    # The course's local(self, val) takes one Vec3; some take the three numbers.
+    if positional_count(local) == 3:
+        out = local(*(float(c) for c in req["local"]))
+    else:
+        out = local(vec3(req["local"]))
+    return {"u": onb_axis(o, "u"), "v": onb_axis(o, "v"), "w": onb_axis(o, "w"),
+            "local": out_vec(out, "ONB.local")}
 
 
 CAMERA_FIELDS = (("img_width", "width", int), ("aspect_ratio", "aspect_ratio", float),
@@ -594,13 +679,34 @@ CAMERA_FIELDS = (("img_width", "width", int), ("aspect_ratio", "aspect_ratio", f
                  ("vec_up", "vup", vec3), ("max_depth", "max_depth", int))
 
 
-def make_camera(spec):
+def first_parameter(f):
+    """The name of f's first parameter after self, or ""."""
+    try:
+        params = [p for p in inspect.signature(f).parameters.values()
+                  if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    except (TypeError, ValueError):
+        return ""
+    return params[0].name if params else ""
+
+
+def make_camera(spec, departures=None):
+    """The course's Camera with the request's fields set before init_camera(defocus_angle,
+    focus_distance), as every main.py does. A camera whose init_camera takes the lens's
+    aperture (week 10's task 2: "DoF by using an 'aperture' parameter instead of
+    'defocus_angle'") is given the course's lens as its aperture, 2 focus tan(angle / 2)."""
     cam = find_class("Camera", "RT_camera")()
     for attr, key, conv in CAMERA_FIELDS:
         if key in spec:
             setattr(cam, attr, conv(spec[key]))
     init = method(cam, "init_camera", "Camera")
-    init(float(spec.get("defocus_angle", 0.0)), float(spec.get("focus_distance", 10.0)))
+    angle = float(spec.get("defocus_angle", 0.0))
+    focus = float(spec.get("focus_distance", 10.0))
+    if "aperture" in first_parameter(init).lower():
+        init(2.0 * focus * math.tan(math.radians(angle) / 2.0), focus)
+        if departures is not None:
+            departures.append("aperture")
+    else:
+        init(angle, focus)
     return cam
 
 
@@ -612,23 +718,40 @@ def camera_attr(cam, names, what):
     raise NotFound("the camera has no %s (looked for %s)" % (what, ", ".join(names)))
 
 
+def defocus_radius(cam):
+    """The camera's defocus radius: an attribute defocus_radius, else the length of
+    defocus_disk_u (the course keeps the radius only as defocus_disk_u and defocus_disk_v)."""
+    r = getattr(cam, "defocus_radius", None)
+    if r is not None:
+        return out_num(r, "defocus_radius")
+    du = getattr(cam, "defocus_disk_u", None)
+    if du is None:
+        raise NotFound("the camera has no defocus radius (looked for defocus_radius and "
+                       "defocus_disk_u)")
+    e = out_vec(du, "defocus_disk_u")
+    return math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+
+
 def op_camera(req):
-    cam = make_camera(req["camera"])
-    return {
+    departures = []
+    cam = make_camera(req["camera"], departures)
+    answer = {
         "center": out_vec(camera_attr(cam, ("center", "camera_center"), "centre"), "center"),
-        "u": out_vec(camera_attr(cam, ("u",), "u"), "u"),
-        "v": out_vec(camera_attr(cam, ("v",), "v"), "v"),
-        "w": out_vec(camera_attr(cam, ("w",), "w"), "w"),
+        "u": out_vec(camera_attr(cam, ("camera_frame_u", "u"), "u"), "camera_frame_u"),
+        "v": out_vec(camera_attr(cam, ("camera_frame_v", "v"), "v"), "camera_frame_v"),
+        "w": out_vec(camera_attr(cam, ("camera_frame_w", "w"), "w"), "camera_frame_w"),
         "pixel00": out_vec(camera_attr(cam, ("pixel00_location", "pixel00_loc"), "pixel00"),
                            "pixel00_location"),
         "pixel_du": out_vec(camera_attr(cam, ("pixel_du", "pixel_delta_u"), "pixel_du"),
                             "pixel_du"),
         "pixel_dv": out_vec(camera_attr(cam, ("pixel_dv", "pixel_delta_v"), "pixel_dv"),
                             "pixel_dv"),
-        "defocus_radius": out_num(camera_attr(cam, ("defocus_radius",), "defocus_radius"),
-                                  "defocus_radius"),
+        "defocus_radius": defocus_radius(cam),
         "height": int(camera_attr(cam, ("img_height", "image_height"), "image height")),
     }
+    if departures:
+        answer["departures"] = departures
+    return answer
 
 
 def op_occlusion(req):
@@ -652,7 +775,11 @@ def op_shade(req):
     integrator = make_integrator(req.get("integrator"))
     f = method(integrator, "compute_scattering", "Integrator")
     with Seeded(req.get("seed", 0)):
-        value = f(make_ray(req["ray"]), scene, int(req.get("depth", 1)))
+        # Week 4's compute_scattering(ray, scene) has no depth; weeks 5 to 10 take it.
+        if positional_count(f) == 2:
+            value = f(make_ray(req["ray"]), scene)
+        else:
+            value = f(make_ray(req["ray"]), scene, int(req.get("depth", 1)))
     return {"color": out_vec(value, "Integrator.compute_scattering")}
 
 
@@ -664,7 +791,7 @@ def sample_count(req):
 
 
 def op_sample_unit_vector(req):
-    return sample_vectors(req, "random_vec3_unit", ("random_unit_vector",))
+    return sample_vectors(req, "random_vec3_unit", ("random_unit_vector", "random_vec3_unit_vector"))
 
 
 def op_sample_cosine_hemisphere(req):
@@ -672,7 +799,7 @@ def op_sample_cosine_hemisphere(req):
 
 
 def op_sample_unit_disk(req):
-    return sample_vectors(req, "random_in_unit_disk", ())
+    return sample_vectors(req, "random_in_unit_disk", ("random_vec3_in_unit_disk",))
 
 
 def sample_vectors(req, name, aliases):
@@ -700,8 +827,9 @@ def op_sample_scatter(req):
 def op_sample_camera_ray(req):
     n = sample_count(req)
     samples = []
+    departures = []
     with Seeded(req["seed"]):
-        cam = make_camera(req["camera"])
+        cam = make_camera(req["camera"], departures)
         i, j = (int(c) for c in req["pixel"])
         stratum = req.get("stratum")
         if stratum is not None:
@@ -721,6 +849,8 @@ def op_sample_camera_ray(req):
             samples.append(out_vec(r.getOrigin(), what + "'s origin")
                            + out_vec(r.getDirection(), what + "'s direction")
                            + [out_num(time if time is not None else 0.0, what + "'s time")])
+    if departures:
+        return {"samples": samples, "departures": departures}
     return {"samples": samples}
 
 

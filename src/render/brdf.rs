@@ -75,21 +75,23 @@ pub fn ggx(n_dot_h: f64, alpha: f64) -> f64 {
     a2 / (PI * cos2 * cos2 * s * s)
 }
 
-/// Smith's `G1` as the course writes it: `2 chi(v.h / v.n) / (1 + sqrt(1 + alpha^2 tan^2))`
-/// with `tan^2 = (1 - (v.n)^2) / (v.n)^2`, `v.n` already clamped to at least `1e-8`. With
-/// unnormalised vectors `(v.n)^2` may exceed 1 and make the root's argument negative, where the
-/// course's `math.sqrt` raises; it is taken as 0 (what the formula means at a grazing limit).
+/// Smith's `G1` as the course's `Gterm(vP, vH, vN, alpha)` computes it (weeks 8 to 10):
+/// `2 chi(v.h / v.n) / (1 + sqrt(1 + alpha^2 tan^2))` with `tan^2 = (1 - (v.h)^2) / (v.h)^2`,
+/// taken from `v.h` (not `v.n`), both dot products already clamped to at least `1e-8`. With an
+/// unnormalised `v` the dot `v.h` may exceed 1 and, for `alpha > 1`, make the root's argument
+/// negative, where the course's `math.sqrt` raises; it is taken as 0 here.
 #[inline]
 pub fn smith_g1(v_dot_h: f64, v_dot_n: f64, alpha: f64) -> f64 {
-    let c2 = v_dot_n * v_dot_n;
+    let c2 = v_dot_h * v_dot_h;
     let tan2 = (1.0 - c2) / c2;
     2.0 * chi(v_dot_h / v_dot_n) / (1.0 + (1.0 + alpha * alpha * tan2).max(0.0).sqrt())
 }
 
-/// Cook-Torrance: `kd / pi + ks D G1(V) G1(L) F / (4 (V.N)(L.N))` with every vector
-/// unnormalised (course departure, week 8): `V = -view`, `L = light`, `H = halfvector(V, L)`,
-/// `V.N` and `L.N` clamped to at least `1e-8`, `D` [`ggx`] of `N.H`, [`smith_g1`] of `V` and `L`,
-/// `F = schlick(min(L.N, 1), ior)`.
+/// Cook-Torrance as the course's `CookTorrance.BRDF(rView, rLight, hHinfo)` computes it (weeks 8
+/// to 10): `kd / pi + ks D G1(V) G1(L) F / (4 (V.N)(L.N))` with `V = -view` and `L = light`
+/// unnormalised (course departure), `H = unit(halfvector(V, L))`, `V.N`, `L.N`, `H.N`, `V.H`
+/// and `L.H` each clamped to at least `1e-8`, `D` [`ggx`] of `H.N` (0 where the clamped `H.N`
+/// fails `chi`), [`smith_g1`] of `V` and `L`, `F = schlick(min(L.N, 1), ior)` (unclamped below).
 ///
 /// The course's function returns a number, and its integrator then computes `float * Color`,
 /// which raises `TypeError` (`Color` has no `__rmul__`): what it evidently intends is a grey
@@ -105,13 +107,14 @@ pub fn cook_torrance(
     n: DVec3,
 ) -> DVec3 {
     let v = -view;
-    let h = halfvector(v, light);
+    let h = unit_vector(halfvector(v, light));
     let nv = n.dot(v).max(1e-8);
     let nl = n.dot(light).max(1e-8);
-    let d = ggx(n.dot(h), alpha);
-    let g = smith_g1(v.dot(h), nv, alpha) * smith_g1(light.dot(h), nl, alpha);
+    let nh = h.dot(n).max(1e-8);
+    let d = chi(nh) * ggx(nh, alpha);
+    let g = smith_g1(v.dot(h).max(1e-8), nv, alpha) * smith_g1(light.dot(h).max(1e-8), nl, alpha);
     let f = schlick(n.dot(light).min(1.0), ior);
-    DVec3::splat(kd / PI + ks * d * g * f / (4.0 * nv * nl))
+    DVec3::splat(kd / PI + ks * d * g * f * (1.0 / (4.0 * nv * nl)))
 }
 
 #[cfg(test)]
@@ -209,9 +212,12 @@ mod tests {
         let got = cook_torrance(0.3, 0.7, 0.5, 1.5, DOWN, N, N);
         let expected = 0.3 / PI + 0.7 * 0.04 / (4.0 * PI * 0.25);
         assert!((got.x - expected).abs() < 1e-15 && got.x == got.y && got.y == got.z);
-        // Smith's G1 falls to 0 where v.h / v.n is not positive.
+        // Smith's G1 falls to 0 where v.h / v.n is not positive, and is 1 where v.h = 1 (the
+        // course takes its tangent from v.h).
         assert_eq!(smith_g1(-0.1, 0.5, 0.5), 0.0);
-        assert_eq!(smith_g1(0.5, 1.0, 0.5), 1.0);
+        assert_eq!(smith_g1(1.0, 0.5, 0.5), 1.0);
+        // v.h = 0.5: tan^2 = 3, G1 = 2 / (1 + sqrt(1 + 0.25 * 3)).
+        assert!((smith_g1(0.5, 1.0, 0.5) - 2.0 / (1.0 + 1.75f64.sqrt())).abs() < 1e-15);
     }
 
     #[test]

@@ -2,10 +2,11 @@
 //! them (the reference's [`phong`], [`blinn`], [`cook_torrance`]), with the course's
 //! unnormalised view and light vectors.
 //!
-//! Cook-Torrance returns a number (the course's), which its integrator cannot multiply with a
-//! colour; a grey colour of that value is accepted too (what the code evidently intends). Its
-//! thresholds (`chi(x)` at 1e-8, the clamps of `V.N` and `L.N` at 1e-8) and the inputs where
-//! the course's code divides by zero (`N.H = 0`) or takes the root of a negative number
+//! Cook-Torrance is the course's own `BRDF` (its `Gterm` takes `tan^2` from `v.H` of the unit
+//! half vector; [`cook_torrance`]). It returns a number (the course's), which its integrator
+//! cannot multiply with a colour; a grey colour of that value is accepted too (what the code
+//! evidently intends). Its thresholds (`chi(x)` and the clamps at 1e-8) and the inputs where the
+//! course's code divides by zero (`V + L = 0`) or takes the root of a negative number
 //! (`1 + alpha^2 tan^2 < 0` with unnormalised vectors) are kept out of the scored cases.
 
 use glam::DVec3;
@@ -219,35 +220,40 @@ fn grey_as_number(answer: serde_json::Value) -> serde_json::Value {
     }
 }
 
-/// Why the course's Cook-Torrance cannot be scored on this input, if it cannot.
+/// Why the course's Cook-Torrance cannot be scored on this input, if it cannot: a dot product
+/// within rounding of one of its `1e-8` thresholds (the clamps of `V.N`, `L.N`, `H.N`, `V.H`,
+/// `L.H` and `chi`), a half vector of length 0 (the course's `unit_vector` divides by zero) or
+/// a negative root in `Gterm` (`1 + alpha^2 tan^2 < 0`, where `v.H > 1` with the unnormalised
+/// vectors and `alpha > 1`; the course's `math.sqrt` raises `ValueError`).
 fn cook_torrance_trouble(c: &Input, alpha: f64) -> Option<Class> {
     let (n, _) = c.hit.facing();
     let v = -c.hit.direction;
     let l = c.light;
-    let h = halfvector(v, l);
-    let nh = n.dot(h);
-    if nh.abs() < 1e-9 {
+    let half = halfvector(v, l);
+    if half.length() < 1e-9 * (v.length() + l.length()) {
         return Some(Class::CourseFails(
-            "N . H = 0: the course's D divides by zero".into(),
+            "V + L = 0: the course's unit_vector of the half vector divides by zero".into(),
         ));
     }
-    if nh < 0.0 {
+    let h = half.normalize();
+    let near = |x: f64| (x - 1e-8).abs() < 1e-12 * (1.0 + x.abs());
+    if near(h.dot(n)) {
         return Some(Class::Ambiguous(
-            "N . H < 0: the course's D is positive there, the microfacets point away".into(),
+            "N . H within rounding of the 1e-8 threshold".into(),
         ));
     }
     for x in [v, l] {
-        let xn = n.dot(x).max(1e-8);
-        let c2 = xn * xn;
-        let inside = 1.0 + alpha * alpha * (1.0 - c2) / c2;
-        if inside < 1e-9 {
-            return Some(Class::CourseFails("1 + alpha^2 tan^2 < 0 with the unnormalised vectors: the course's sqrt raises ValueError".into()));
-        }
-        let chi = x.dot(h) / xn;
-        if (chi - 1e-8).abs() < 1e-12 || (n.dot(x) - 1e-8).abs() < 1e-12 {
+        let xn = n.dot(x);
+        let xh = x.dot(h);
+        if near(xn) || near(xh) || near(xh.max(1e-8) / xn.max(1e-8)) {
             return Some(Class::Ambiguous(
                 "a value within rounding of the 1e-8 thresholds".into(),
             ));
+        }
+        let c2 = xh.max(1e-8).powi(2);
+        let inside = 1.0 + alpha * alpha * (1.0 - c2) / c2;
+        if inside < 1e-9 {
+            return Some(Class::CourseFails("1 + alpha^2 tan^2 < 0 with the unnormalised vectors: the course's sqrt raises ValueError".into()));
         }
     }
     None
