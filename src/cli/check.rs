@@ -421,7 +421,12 @@ fn week_of(given: Option<u8>, folder: Option<&std::path::Path>) -> Option<(Week,
                 .take(3)
                 .map(|b| rtoracle::escape::terminal_line(b))
                 .collect();
-            Some((week, format!("found from the files: {}", shown.join(", "))))
+            let mut why = format!("found from the files: {}", shown.join(", "));
+            for aside in &found.set_aside {
+                why.push_str("; ");
+                why.push_str(&rtoracle::escape::terminal_line(aside));
+            }
+            Some((week, why))
         }
     }
 }

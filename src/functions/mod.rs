@@ -10,11 +10,13 @@
 //! - [`simulate`]: the same samplers (and mistakes) in Rust, to measure false alarms and power.
 //! - [`checks`]: each week's functions, their cases, expected answers and mistakes.
 //! - [`run`]: running a week's checks and judging them ([`WeekReport`]).
+//! - [`departures`]: departures that keep the course's behaviour, named and not charged.
 //! - [`report`]: the report in words.
 //! - [`score`]: each week's groups of functions and their points.
 //! - [`submission`]: a week's submission checked in one session (intersections and functions).
 
 pub mod checks;
+pub mod departures;
 pub mod expect;
 pub mod report;
 pub mod run;

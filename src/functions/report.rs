@@ -21,6 +21,7 @@ fn standing_word(s: Standing) -> &'static str {
         Standing::Mistake | Standing::Course => "mistake",
         Standing::Physical => "physical alternative",
         Standing::Alternative => "the course's other version",
+        Standing::Departure => "departure that keeps the course's behaviour",
     }
 }
 

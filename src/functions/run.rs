@@ -162,10 +162,49 @@ pub fn run_week(
         .iter()
         .map(|c| run_check(runner, c, options, &mut memo))
         .collect();
-    WeekReport {
+    let mut report = WeekReport {
         week,
         options,
         functions,
+    };
+    apply_departures(&mut report);
+    report
+}
+
+/// The departures that rest on several functions' results ([`super::departures`]): a failing
+/// function whose failure is one of them passes, with the departure named and noted.
+fn apply_departures(report: &mut WeekReport) {
+    let passed = |id: &str| {
+        report
+            .functions
+            .iter()
+            .any(|f| f.id == id && f.status == Status::Passed)
+    };
+    let (dielectric, choice) = (passed("dielectric"), passed("dielectric-choice"));
+    for f in &mut report.functions {
+        let fits: Vec<&str> = f.mistakes.iter().map(|m| m.name.as_str()).collect();
+        let departure = match f.id.as_str() {
+            "refract" if f.status == Status::Failed => {
+                super::departures::schlick_in_material(&fits, dielectric, choice)
+            }
+            _ => None,
+        };
+        if let Some(d) = departure {
+            let moved = f.counts.failed;
+            f.counts.passed += moved;
+            f.counts.failed = 0;
+            f.status = Status::Passed;
+            f.failure = None;
+            f.mistakes = vec![NamedMistake {
+                name: d.name.to_string(),
+                says: d.says.to_string(),
+                standing: Standing::Departure,
+            }];
+            f.notes.push(format!(
+                "departure that keeps the course's behaviour: {} ({moved} case(s) answered as such)",
+                d.says
+            ));
+        }
     }
 }
 
@@ -229,6 +268,9 @@ pub fn run_check(
                 .iter()
                 .map(|c| {
                     let r = ask(&c.request, runner);
+                    if let Reply::Result(v) = &r {
+                        note_departures(&mut result, v);
+                    }
                     match (r, normalise) {
                         (Reply::Result(v), Some(f)) => Reply::Result(f(v)),
                         (r, _) => r,
@@ -244,6 +286,11 @@ pub fn run_check(
             repro,
         } => {
             let replies: Vec<Reply> = requests.iter().map(|r| ask(r, runner)).collect();
+            for r in &replies {
+                if let Reply::Result(v) = r {
+                    note_departures(&mut result, v);
+                }
+            }
             judge_samples(
                 &mut result,
                 &replies,
@@ -255,6 +302,15 @@ pub fn run_check(
         }
     }
     result
+}
+
+/// Adds to `result`'s notes the departures `answer` lists (each once).
+fn note_departures(result: &mut FunctionResult, answer: &serde_json::Value) {
+    for note in super::departures::listed(answer) {
+        if !result.notes.contains(&note) {
+            result.notes.push(note);
+        }
+    }
 }
 
 /// Why a reply is not an answer, in words (`None` for an answer).

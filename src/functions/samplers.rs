@@ -57,6 +57,10 @@ pub enum Standing {
     /// Another version of the course's own code (or of its README): accepted or named, not a
     /// slip.
     Alternative,
+    /// The course's behaviour, reached another way (the work split differently between
+    /// functions, another convention for the same input): named, and not charged
+    /// ([`crate::functions::departures`]).
+    Departure,
 }
 
 /// How a hypothesis's cell probabilities are known.

@@ -3,7 +3,7 @@
 //!
 //! Each week's skeleton holds the functions the week introduces (stubbed) on top of the
 //! solution of the week before, so the latest week whose marks are in the folder is the week of
-//! the submission. The marks, one set per week (any one is enough):
+//! the submission, as long as the marks agree. The marks, one set per week:
 //!
 //! | week | marks |
 //! |---|---|
@@ -16,9 +16,19 @@
 //!
 //! Marks are read as `def NAME` / `class NAME` at the start of a line (after indentation) in the
 //! folder's `RT_*.py` and `main.py` files, so a name in a comment or a string does not count.
-//! A folder without any is week 4's (intersections only). `RT_texture.py` and `tex_value` are
-//! not marks: later weeks' code is often checked with week 4's vectors, and a week-4 folder may
-//! hold a texture module already (the course's `RT_object.py` imports it from week 7 on).
+//! A folder without any is week 4's (intersections only).
+//!
+//! Marks that disagree: the week is the latest one with at least two of its marks in the
+//! folder. A later week with a single mark, where an earlier week has two or more, is taken for
+//! a piece borrowed from elsewhere (the book's `class Metal` pasted into a week-5 tree), not for
+//! the week: the folder is checked as the week most of its marks say, and
+//! [`Detected::set_aside`] says which mark was set aside and why. A folder whose weeks have one
+//! mark each is the latest of them. Each of the course's fourteen folders (weeks 4 to 10,
+//! skeleton and solution) holds at least three marks of its own week and none of a later one.
+//! `RT_texture.py`, `tex_value` and `random_vec3_in_unit_disk` are not marks: later weeks' code is
+//! often checked with week 4's vectors, a week-4 folder may hold a texture module already (the
+//! course's `RT_object.py` imports it from week 7 on), and the course's `Vec3` has the unit disk
+//! from week 4 on.
 
 use std::path::Path;
 
@@ -101,6 +111,10 @@ pub struct Detected {
     pub week: Option<Week>,
     /// The marks of that week found, as `"def halfvector in RT_utility.py"`.
     pub because: Vec<String>,
+    /// Marks of a later week that were not taken for the folder's week, and why (empty when
+    /// the marks agree).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub set_aside: Vec<String>,
 }
 
 /// Names defined at the start of a line of `text`: `(kind, name)` for `def NAME` and
@@ -155,16 +169,40 @@ pub fn detect(dir: &Path) -> Detected {
             }
         }
     }
-    let week = found.iter().map(|(w, _)| *w).max();
-    let mut because: Vec<String> = found
+    // Each mark once (a class's `def BRDF` is one mark however many classes define it).
+    let mut seen = std::collections::HashSet::new();
+    found.retain(|m| seen.insert(m.clone()));
+    let count = |week: u8| found.iter().filter(|(w, _)| *w == week).count();
+    let latest_agreed = found
+        .iter()
+        .map(|(w, _)| *w)
+        .filter(|&w| count(w) >= 2)
+        .max();
+    let latest = found.iter().map(|(w, _)| *w).max();
+    // The latest week two of its marks agree on; without one, the latest week with a mark.
+    let week = latest_agreed.or(latest);
+    let set_aside = match (week, latest) {
+        (Some(w), Some(l)) if l > w => found
+            .iter()
+            .filter(|(m, _)| *m > w)
+            .map(|(m, why)| {
+                format!(
+                    "{why} is week {m}'s only mark here, where {} of week {w}'s are: taken for a piece from elsewhere, not the week (--week {m} checks it as week {m})",
+                    count(w)
+                )
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
+    let because: Vec<String> = found
         .into_iter()
         .filter(|(w, _)| Some(*w) == week)
         .map(|(_, why)| why)
         .collect();
-    because.dedup();
     Detected {
         week: week.and_then(Week::new),
         because,
+        set_aside,
     }
 }
 
@@ -208,5 +246,53 @@ mod tests {
         let empty = tempfile::tempdir().unwrap();
         assert_eq!(detect(empty.path()).week, None);
         assert!(Week::new(4).is_none() && Week::new(11).is_none());
+    }
+
+    /// One book-style `class Metal` (week 7's mark) in a week-5 tree is set aside: three marks
+    /// of week 5 against one of week 7. Two marks of week 7 are the week.
+    #[test]
+    fn a_single_mark_of_a_later_week_is_set_aside_with_the_reason() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("RT_scene.py"),
+            "class Scene:\n    def find_occlusion(self, r, i):\n        pass\n    def find_point_lights(self):\n        pass\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("RT_light.py"),
+            "class Diffuse_light:\n    pass\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("RT_material.py"),
+            "class Metal:\n    pass\n",
+        )
+        .unwrap();
+        let d = detect(dir.path());
+        assert_eq!(d.week, Week::new(5));
+        assert_eq!(d.because.len(), 3, "{d:?}");
+        assert_eq!(d.set_aside.len(), 1, "{d:?}");
+        assert!(
+            d.set_aside[0].starts_with(
+                "class Metal in RT_material.py is week 7's only mark here, where 3 of week 5's are"
+            ),
+            "{d:?}"
+        );
+        std::fs::write(
+            dir.path().join("RT_object.py"),
+            "class Sphere:\n    def get_uv(self, n):\n        pass\n",
+        )
+        .unwrap();
+        let d = detect(dir.path());
+        assert_eq!(d.week, Week::new(7));
+        assert!(d.set_aside.is_empty());
+        // One mark only, of one week: that week.
+        let one = tempfile::tempdir().unwrap();
+        std::fs::write(
+            one.path().join("RT_utility.py"),
+            "def schlick(c, x):\n    pass\n",
+        )
+        .unwrap();
+        assert_eq!(detect(one.path()).week, Week::new(6));
     }
 }

@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod compare;
 mod compare_report;
+mod course_code;
 mod course_weeks;
 mod feedback;
 mod functions;

@@ -180,7 +180,7 @@ fn camera_check(seed: u64) -> FunctionCheck {
                 py::f(c.settings.focus_distance)
             ),
             repro: py::script(
-                &format!("{}\nprint(cam.u.e, cam.v.e, cam.w.e, cam.pixel00_location.e, cam.defocus_radius)", c.py()),
+                &format!("{}\nprint({{'center': cam.center.e, 'u': cam.camera_frame_u.e, 'v': cam.camera_frame_v.e, 'w': cam.camera_frame_w.e, 'pixel00': cam.pixel00_location.e, 'pixel_du': cam.pixel_du.e, 'pixel_dv': cam.pixel_dv.e, 'defocus_radius': cam.defocus_disk_u.len(), 'height': cam.img_height}})", c.py()),
                 &format!("u = {}, v = {}, w = {}, defocus_radius = {}", py::list(u), py::list(v), py::list(w), py::f(radius)),
             ),
         });
@@ -213,7 +213,7 @@ fn camera_check(seed: u64) -> FunctionCheck {
 fn unit_disk_check(seed: u64) -> FunctionCheck {
     FunctionCheck {
         id: "unit-disk",
-        function: "RT_utility.random_in_unit_disk()",
+        function: "RT_utility.Vec3.random_vec3_in_unit_disk()",
         week: week(10),
         given: true,
         op: "sample_unit_disk",
@@ -229,7 +229,7 @@ fn unit_disk_check(seed: u64) -> FunctionCheck {
             extract: Box::new(vector_samples),
             check: SamplerCheck::unit_disk(),
             repro: py::script(
-                "print([rtu.random_in_unit_disk().e for _ in range(5)])",
+                "print([rtu.Vec3.random_vec3_in_unit_disk().e for _ in range(5)])",
                 "points uniform in the unit disk",
             ),
         },
@@ -550,7 +550,7 @@ fn moving_intersect_check(seed: u64) -> FunctionCheck {
             input: format!("Sphere({}, 1.0) moving to {}; a ray from {} along {} at time {}", py::list(c0), py::list(c1), py::list(origin), py::list(d), py::f(t)),
             repro: py::script(
                 &format!(
-                    "s = rto.Sphere({}, 1.0)\ns.add_moving({})\nh = s.intersect({}, rtu.Interval(1e-06, rtu.infinity_number))\nprint(h and (h.getT(), h.getP().e, h.getNormal().e))",
+                    "s = rto.Sphere({}, 1.0)\ns.add_moving({})\nh = s.intersect({}, rtu.Interval(1e-06, rtu.infinity_number))\nprint({{'hit': False}} if h is None else {{'hit': True, 't': h.getT(), 'point': h.getP().e, 'normal': h.getNormal().e, 'front_face': h.front_face, 'uv': h.getUV()}})",
                     py::vec(c0),
                     py::vec(c1),
                     py::ray(origin, d, t)

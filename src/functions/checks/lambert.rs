@@ -60,7 +60,7 @@ pub(crate) fn vector_samples(answer: &serde_json::Value) -> Result<Vec<Sample>, 
 fn unit_sphere_check(seed: u64) -> FunctionCheck {
     FunctionCheck {
         id: "unit-sphere",
-        function: "RT_utility.random_vec3_unit()",
+        function: "RT_utility.Vec3.random_vec3_unit()",
         week: week(5),
         given: true,
         op: "sample_unit_vector",
@@ -76,7 +76,7 @@ fn unit_sphere_check(seed: u64) -> FunctionCheck {
             extract: Box::new(vector_samples),
             check: SamplerCheck::unit_sphere(),
             repro: py::script(
-                "print([rtu.random_vec3_unit().e for _ in range(5)])",
+                "print([rtu.Vec3.random_vec3_unit().e for _ in range(5)])",
                 "unit vectors, uniform on the sphere",
             ),
         },
@@ -87,7 +87,7 @@ fn unit_sphere_check(seed: u64) -> FunctionCheck {
 fn cosine_hemisphere_check(seed: u64) -> FunctionCheck {
     FunctionCheck {
         id: "cosine-hemisphere",
-        function: "RT_utility.random_cosine_hemisphere_on_z()",
+        function: "RT_utility.Vec3.random_cosine_hemisphere_on_z()",
         week: week(9),
         given: false,
         op: "sample_cosine_hemisphere",
@@ -103,7 +103,7 @@ fn cosine_hemisphere_check(seed: u64) -> FunctionCheck {
             extract: Box::new(vector_samples),
             check: SamplerCheck::cosine_hemisphere(),
             repro: py::script(
-                "print([rtu.random_cosine_hemisphere_on_z().e for _ in range(5)])",
+                "print([rtu.Vec3.random_cosine_hemisphere_on_z().e for _ in range(5)])",
                 "unit vectors about z with density cos(theta) / pi",
             ),
         },
@@ -172,9 +172,10 @@ fn lambertian_check(seed: u64) -> FunctionCheck {
                 input: format!("{}, random_vec3_unit() = {}", h.words(), py::list(u)),
                 repro: py::script(
                     &format!(
-                        "{}\n{}\ns = m.scattering(ray, hit)\nprint(s.scattered_ray.getDirection().e)",
+                        "{}\n{}\ns = m.scattering(ray, hit)\n{}",
                         py::random_vectors("random_vec3_unit", &[u]),
-                        h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO)))
+                        h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO))),
+                        py::PRINT_SCATTERED
                     ),
                     &py::list(d),
                 ),
@@ -328,7 +329,7 @@ fn onb_check(seed: u64) -> FunctionCheck {
             input: format!("build_from_w({}), local({}, {}, {})", py::list(w), py::f(l.x), py::f(l.y), py::f(l.z)),
             repro: py::script(
                 &format!(
-                    "o = rtu.ONB()\no.build_from_w({})\nprint(o.u.e, o.v.e, o.w.e, o.local({}, {}, {}).e)",
+                    "o = rtu.ONB()\no.build_from_w({})\nprint(o.u().e, o.v().e, o.w().e, o.local(rtu.Vec3({}, {}, {})).e)",
                     py::vec(w),
                     py::f(l.x),
                     py::f(l.y),
@@ -352,7 +353,7 @@ fn onb_check(seed: u64) -> FunctionCheck {
     }
     FunctionCheck {
         id: "onb",
-        function: "RT_utility.ONB.build_from_w(n), ONB.local(x, y, z)",
+        function: "RT_utility.ONB.build_from_w(n), ONB.local(Vec3), ONB.u(), v(), w()",
         week: week(9),
         given: false,
         op: "onb",
@@ -406,9 +407,10 @@ fn lambertian_onb_check(seed: u64) -> FunctionCheck {
             input: format!("{}, random_cosine_hemisphere_on_z() = {}", h.words(), py::list(c)),
             repro: py::script(
                 &format!(
-                    "{}\n{}\ns = m.scattering(ray, hit)\nprint(s.scattered_ray.getDirection().e)",
+                    "{}\n{}\ns = m.scattering(ray, hit)\n{}",
                     py::random_vectors("random_cosine_hemisphere_on_z", &[c]),
-                    h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO)))
+                    h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO))),
+                    py::PRINT_SCATTERED
                 ),
                 &py::list(d),
             ),
@@ -536,9 +538,10 @@ fn metal_check(seed: u64) -> FunctionCheck {
             input: format!("Metal(roughness {}): {}, random_vec3_unit() = {}", py::f(roughness), h.words(), py::list(u)),
             repro: py::script(
                 &format!(
-                    "{}\n{}\ns = m.scattering(ray, hit)\nprint(s.scattered_ray.getDirection().e, s.attenuation_color.e)",
+                    "{}\n{}\ns = m.scattering(ray, hit)\n{}",
                     py::random_vectors("random_vec3_unit", &[u]),
-                    h.py(&format!("rtm.Metal({}, {})", py::color(albedo), py::f(roughness)))
+                    h.py(&format!("rtm.Metal({}, {})", py::color(albedo), py::f(roughness))),
+                    py::PRINT_SCATTERED
                 ),
                 "the direction and attenuation above",
             ),

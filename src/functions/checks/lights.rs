@@ -69,7 +69,7 @@ impl Mat {
     fn py(&self) -> String {
         match *self {
             Mat::Lambertian(a) => format!("rtm.Lambertian({})", py::color(a)),
-            Mat::Light(e) => format!("rtm.Diffuse_light({})", py::color(e)),
+            Mat::Light(e) => format!("rtl.Diffuse_light({})", py::color(e)),
             Mat::Phong {
                 albedo,
                 kd,
@@ -309,7 +309,7 @@ impl Scene {
     /// Python lines that make `scene` and `ray`.
     fn py(&self) -> String {
         let mut lines = vec![
-            "import RT_scene as rts".to_string(),
+            "import RT_scene as rts, RT_light as rtl".to_string(),
             "scene = rts.Scene()".to_string(),
         ];
         for o in &self.objects {

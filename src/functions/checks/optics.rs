@@ -171,7 +171,7 @@ fn reflect_check(seed: u64) -> FunctionCheck {
             class: Class::Definite,
             input: format!("v = {}, n = {}", py::list(v), py::list(n)),
             repro: py::script(
-                &format!("print(rtu.reflect({}, {}).e)", py::vec(v), py::vec(n)),
+                &format!("print(rtm.reflect({}, {}).e)", py::vec(v), py::vec(n)),
                 &py::list(want),
             ),
         });
@@ -186,7 +186,7 @@ fn reflect_check(seed: u64) -> FunctionCheck {
     }
     FunctionCheck {
         id: "reflect",
-        function: "RT_utility.reflect(v, n)",
+        function: "RT_material.reflect(v, n)",
         week: week(6),
         given: false,
         op: "reflect",
@@ -369,7 +369,7 @@ fn refract_check(seed: u64) -> FunctionCheck {
             ),
             repro: py::script(
                 &format!(
-                    "{}\nprint(rtu.refract({}, {}, {}).e)",
+                    "{}\nprint(rtm.refract({}, {}, {}).e)",
                     py::random_doubles(&[c.u]),
                     py::vec(c.v),
                     py::vec(c.n),
@@ -381,7 +381,7 @@ fn refract_check(seed: u64) -> FunctionCheck {
     }
     FunctionCheck {
         id: "refract",
-        function: "RT_utility.refract(v, n, ratio)",
+        function: "RT_material.refract(v, n, ratio)",
         week: week(6),
         given: false,
         op: "refract",
@@ -432,7 +432,7 @@ fn schlick_check(seed: u64) -> FunctionCheck {
             class: Class::Definite,
             input: format!("cosine = {}, ratio = {}", py::f(cos), py::f(x)),
             repro: py::script(
-                &format!("print(rtu.schlick({}, {}))", py::f(cos), py::f(x)),
+                &format!("print(rtm.schlick({}, {}))", py::f(cos), py::f(x)),
                 &py::f(want),
             ),
         });
@@ -450,7 +450,7 @@ fn schlick_check(seed: u64) -> FunctionCheck {
     }
     FunctionCheck {
         id: "schlick",
-        function: "RT_utility.schlick(cosine, ratio)",
+        function: "RT_material.schlick(cosine, ratio)",
         week: week(6),
         given: false,
         op: "schlick",
@@ -492,7 +492,7 @@ fn halfvector_check(seed: u64) -> FunctionCheck {
             class: Class::Definite,
             input: format!("V = {}, L = {}", py::list(v), py::list(l)),
             repro: py::script(
-                &format!("print(rtu.halfvector({}, {}).e)", py::vec(v), py::vec(l)),
+                &format!("print(rtm.halfvector({}, {}).e)", py::vec(v), py::vec(l)),
                 &py::list(want),
             ),
         });
@@ -507,7 +507,7 @@ fn halfvector_check(seed: u64) -> FunctionCheck {
     }
     FunctionCheck {
         id: "halfvector",
-        function: "RT_utility.halfvector(V, L)",
+        function: "RT_material.halfvector(V, L)",
         week: week(8),
         given: false,
         op: "halfvector",
@@ -627,8 +627,9 @@ fn mirror_check(seed: u64) -> FunctionCheck {
             input: h.words(),
             repro: py::script(
                 &format!(
-                    "{}\ns = m.scattering(ray, hit)\nprint(s.scattered_ray.getOrigin().e, s.scattered_ray.getDirection().e, s.attenuation_color.e)",
-                    h.py(&format!("rtm.Mirror({})", py::color(albedo)))
+                    "{}\ns = m.scattering(ray, hit)\n{}",
+                    h.py(&format!("rtm.Mirror({})", py::color(albedo))),
+                    py::PRINT_SCATTERED
                 ),
                 &format!("the direction {}", py::list(want)),
             ),

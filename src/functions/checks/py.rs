@@ -1,5 +1,13 @@
 //! Python reproductions of the requests, written with the course's modules and short names, so
 //! a student can paste one into a Python started in the submission folder.
+//!
+//! They follow the course's real code (weeks 5 to 10): `reflect`, `refract`, `schlick` and
+//! `halfvector` are `RT_material`'s, `Diffuse_light` is `RT_light`'s, the random helpers are
+//! static methods of `RT_utility.Vec3`. Each ends with one `print` of what the check compares:
+//! the value itself when the check compares one field of the answer, else the fields as
+//! separate arguments in the answer's order or a dict keyed by the answer's field names (so a
+//! test can run every reproduction in the course's folder and compare what it prints with the
+//! reference's answer).
 
 use glam::DVec3;
 
@@ -46,14 +54,19 @@ pub(crate) fn random_doubles(values: &[f64]) -> String {
     )
 }
 
-/// The lines that make `rtu.NAME()` return the vectors `values` in turn.
+/// The lines that make the course's `rtu.Vec3.NAME()` (a static method) return the vectors
+/// `values` in turn.
 pub(crate) fn random_vectors(name: &str, values: &[DVec3]) -> String {
     let list: Vec<String> = values.iter().map(|&v| vec(v)).collect();
     format!(
-        "_v = iter([{}])\nrtu.{name} = lambda: next(_v)",
+        "_v = iter([{}])\nrtu.Vec3.{name} = staticmethod(lambda: next(_v))",
         list.join(", ")
     )
 }
+
+/// The line that prints what a scattering `s` gave: its ray's origin and direction and its
+/// attenuation, keyed as the answer's fields.
+pub(crate) const PRINT_SCATTERED: &str = "print({'origin': s.scattered_ray.getOrigin().e, 'direction': s.scattered_ray.getDirection().e, 'attenuation': s.attenuation_color.e})";
 
 /// A hit record as the course's intersect makes one, in a variable `hit`.
 pub(crate) fn hit(point: DVec3, outward: DVec3, ray_var: &str, material: &str) -> String {

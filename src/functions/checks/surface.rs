@@ -474,6 +474,7 @@ fn image_check(seed: u64) -> FunctionCheck {
     }
     let texture = json!({"type": "image", "width": w, "height": h, "rgb": rgb});
     let ctor = "rtt.ImageTexture('picture.png')";
+    let bytes: Vec<u8> = rgb.clone();
     let mut cases = Vec::new();
     let (mut flipped, mut swapped, mut unscaled) = (Vec::new(), Vec::new(), Vec::new());
     for (k, &(u, v)) in uvs.iter().enumerate() {
@@ -495,9 +496,12 @@ fn image_check(seed: u64) -> FunctionCheck {
             want,
             class,
         );
-        case.repro = format!(
-            "# picture.png: the {w} x {h} picture whose texel (i, j) is (10 + 20 i + 60 j, +10, +20) mod 256, row 0 at the top\n{}",
-            case.repro
+        // The picture is written first: the {w} x {h} picture whose texel (i, j) is
+        // (10 + 20 i + 60 j, +10, +20) mod 256, row 0 at the top.
+        case.repro = case.repro.replacen(
+            "import RT_texture as rtt\n",
+            &format!("import RT_texture as rtt\nfrom PIL import Image\nImage.frombytes('RGB', ({w}, {h}), bytes({bytes:?})).save('picture.png')\n"),
+            1,
         );
         cases.push(case);
         let ok = cu < 1.0 && cv < 1.0;

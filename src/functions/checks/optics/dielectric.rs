@@ -131,9 +131,10 @@ pub(super) fn dielectric_check(seed: u64) -> FunctionCheck {
             ),
             repro: py::script(
                 &format!(
-                    "{}\n{}\ns = m.scattering(ray, hit)\nprint(s.scattered_ray.getDirection().e)",
+                    "{}\n{}\ns = m.scattering(ray, hit)\n{}",
                     py::random_doubles(&[c.u; 4]),
-                    c.hit.py(&format!("rtm.Dielectric({}, {})", py::color(albedo), py::f(c.ior)))
+                    c.hit.py(&format!("rtm.Dielectric({}, {})", py::color(albedo), py::f(c.ior))),
+                    py::PRINT_SCATTERED
                 ),
                 "the direction above",
             ),
