@@ -13,8 +13,10 @@ It drives every week's API unmodified: a `Ray` with extra defaulted parameters (
 `Triangle` whose constructor takes a material (`Triangle(v0, v1, v2, mat)`, given `None`) or
 none, answers holding numpy floats or arrays (read with float() and bool()). A module the
 submission imports that is neither its own nor in `--requires` (default numpy and PIL) is
-reported as the student's ("your code imports scipy, which the grader does not provide"); a
-missing required module is said to be the grader's.
+reported as the student's ("your code imports scipy (RT_extra.py, line 3), which the grader
+does not provide"); a missing required module is said to be the grader's. An error raised inside
+multiprocessing (no semaphores without /dev/shm, no worker past the sandbox's process bound) says
+what is missing and what to do.
 
 The requests for the course's functions of weeks 5 to 10 (reflect, refract, the samplers, ...;
 docs/PROTOCOL.md, "Function requests") are answered by rtoracle's driver, a second file written
@@ -125,6 +127,32 @@ def missing_module_message(exc):
     return "your code imports %s, which the grader does not provide" % top_in
 
 
+def multiprocessing_message(exc):
+    """What an error raised inside multiprocessing means in the grader's sandbox, with what to
+    do, or None when it is not one."""
+    import errno
+    frames = traceback.extract_tb(exc.__traceback__)
+    if not any(os.sep + "multiprocessing" + os.sep in f.filename for f in frames):
+        return None
+    if not isinstance(exc, OSError):
+        return None
+    if exc.errno in (errno.EAGAIN, errno.ENOMEM, errno.EMFILE, errno.ENFILE):
+        return (
+            "multiprocessing could not start its worker processes (%s): the grader's sandbox "
+            "bounds the processes, open files and memory of your code; ask for a few workers "
+            "(multiprocessing.Pool(4), not one per CPU of the grader's machine) or render in one "
+            "process when the pool cannot start" % exc
+        )
+    if exc.errno in (errno.EROFS, errno.ENOENT, errno.EACCES, errno.ENOSYS, errno.ENOSPC):
+        return (
+            "multiprocessing could not make its locks and semaphores (%s): they live in "
+            "/dev/shm, which this sandbox does not give (or is full); render in one process "
+            "when the pool cannot start (try: pool = multiprocessing.Pool(n) / "
+            "except OSError: render without it)" % exc
+        )
+    return None
+
+
 def error_json(exc):
     # Leave out the adapter's own frame: the traceback starts in the submission.
     raw = exc.__traceback__
@@ -145,6 +173,11 @@ def error_json(exc):
             tb += "ModuleNotFoundError: " + message + "\n"
             if len(tb) > TB_LIMIT:
                 tb = "..." + tb[-TB_LIMIT:]
+    if message is None:
+        try:
+            message = multiprocessing_message(exc)
+        except Exception:
+            message = None
     if message is None:
         try:
             message = str(exc)

@@ -3,9 +3,10 @@
 //!
 //! Promises: the sandbox sees the system view and the exposed paths ([`super::view`]: read-only,
 //! its rtoracle binaries covered with an empty file), a fresh `/proc` of the new PID namespace, a
-//! minimal read-only `/dev` (so no `/dev/shm`), a `/tmp` that is a tmpfs of bounded size
+//! minimal read-only `/dev` whose `/dev/shm` is a tmpfs of [`SHM_BYTES`] (the semaphores and
+//! locks of Python's `multiprocessing`), a `/tmp` that is a tmpfs of bounded size
 //! ([`Args::tmp_bytes`]: its pages are the host's memory), and the sandbox folder at [`INSIDE`]:
-//! those two are the only writable places. The root (bubblewrap's own tmpfs, which would hold
+//! those three are the only writable places. The root (bubblewrap's own tmpfs, which would hold
 //! whatever the code wrote there in the host's memory, unbounded) is remounted read-only last.
 //! The harness's own binary is covered wherever the view shows it.
 
@@ -13,6 +14,11 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use super::view::{SystemEntry, View, system};
+
+/// The size of the tmpfs at `/dev/shm`: room for the POSIX semaphores and locks of Python's
+/// `multiprocessing` (a `Pool` makes a handful, a page each), small enough that what it holds
+/// in the host's memory stays a bounded extra beside the memory limit.
+pub const SHM_BYTES: u64 = 4 << 20;
 
 /// Where the sandbox folder is seen from inside.
 pub const INSIDE: &str = "/sandbox";
@@ -88,13 +94,18 @@ pub fn args(a: &Args) -> Vec<OsString> {
             SystemEntry::Shown(p) => push(&[&"--ro-bind", &p, &p]),
         }
     }
-    // `/dev` read-only (its device nodes still work), so `/dev/shm` is not writable; `/tmp` a
-    // tmpfs whose size bounds what it holds in the host's memory.
+    // `/dev` read-only (its device nodes still work), but for `/dev/shm`, a small tmpfs of its
+    // own (mounted before the remount, which leaves it writable); `/tmp` a tmpfs whose size
+    // bounds what it holds in the host's memory.
     push(&[
         &"--proc",
         &"/proc",
         &"--dev",
         &"/dev",
+        &"--size",
+        &SHM_BYTES.to_string(),
+        &"--tmpfs",
+        &"/dev/shm",
         &"--remount-ro",
         &"/dev",
     ]);

@@ -215,7 +215,14 @@ impl ViewPlan {
                 false,
             );
         }
+        // `/dev/shm`: made before `/dev` is read-only, mounted after (a tmpfs of its own, so it
+        // stays writable), as bubblewrap's.
+        p.folders(&under(root, Path::new("/dev/shm")), true);
         p.push(Step::ReadOnly(c(&under(root, Path::new("/dev")))), true);
+        p.tmpfs(
+            Path::new("/dev/shm"),
+            format!("size={},mode=1777", super::bwrap::SHM_BYTES),
+        );
         let proc_dir = under(root, Path::new("/proc"));
         p.folders(&proc_dir, true);
         p.push(

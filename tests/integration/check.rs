@@ -303,7 +303,7 @@ fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
     assert_eq!(e.kind, "ModuleNotFoundError");
     assert_eq!(
         e.message,
-        "your code imports rtoracle_no_such_module, which the grader does not provide"
+        "your code imports rtoracle_no_such_module (RT_object.py, line 5), which the grader does not provide"
     );
     // The traceback (what grade's feedback shows) ends with the same words, after the line of
     // the student's file that imports it.

@@ -1234,3 +1234,63 @@ fn the_week_of_each_of_the_fourteen_folders_is_found() {
     );
     assert_eq!(out.status.code(), Some(0), "{stderr}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// multiprocessing in a student's code.
+
+/// Week 6's solution whose `reflect` runs `body` first (four-space indented lines).
+fn reflect_running(body: &str) -> Option<(tempfile::TempDir, PathBuf)> {
+    let (guard, folder) = course_week_copy("course code", 6, CourseTree::Solution)?;
+    python()?;
+    let path = folder.join("RT_material.py");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let head = "def reflect(vRay, vNormal):\n";
+    assert_eq!(text.matches(head).count(), 1);
+    std::fs::write(&path, text.replace(head, &format!("{head}{body}"))).unwrap();
+    Some((guard, folder))
+}
+
+/// A `multiprocessing.Pool` works inside the sandbox (its semaphores live in the sandbox's own
+/// small `/dev/shm`); one past the sandbox's bounds, or one without `/dev/shm` (simulated: the
+/// semaphore raises as it does on a read-only `/dev/shm`), fails with a message that says what
+/// is missing and what to do.
+#[test]
+#[cfg_attr(
+    not(rtoracle_course_code),
+    ignore = "set RTORACLE_COURSE_CODE to the course's code to run it"
+)]
+fn multiprocessing_works_in_the_sandbox_or_says_what_is_missing() {
+    let Some((_guard, folder)) = reflect_running(
+        "    import multiprocessing\n    with multiprocessing.Pool(2) as pool:\n        assert pool.map(abs, [-1, -2]) == [1, 2]\n",
+    ) else {
+        return;
+    };
+    let (report, stderr) = check(&folder, 6);
+    assert_eq!(status_of(&report, "reflect"), "passed", "{stderr}");
+    let problem = |body: &str| {
+        let (_guard, folder) = reflect_running(body).unwrap();
+        let (report, _) = check(&folder, 6);
+        let f = functions(&report)
+            .into_iter()
+            .find(|f| f.0 == "reflect")
+            .unwrap();
+        assert_eq!(f.1, "failed");
+        f.3
+    };
+    let too_many = problem(
+        "    import multiprocessing\n    with multiprocessing.Pool(200) as pool:\n        pool.map(abs, [-1, -2])\n",
+    );
+    assert!(
+        too_many.contains("multiprocessing could not start its worker processes")
+            && too_many.contains("ask for a few workers"),
+        "{too_many}"
+    );
+    let no_shm = problem(
+        "    import errno, _multiprocessing, multiprocessing\n    class NoShm:\n        SEM_VALUE_MAX = 2 ** 31 - 1\n        def __init__(self, *args, **kwargs):\n            raise OSError(errno.EROFS, 'Read-only file system')\n    _multiprocessing.SemLock = NoShm\n    multiprocessing.Lock()\n",
+    );
+    assert!(
+        no_shm.contains("multiprocessing could not make its locks and semaphores ([Errno 30] Read-only file system): they live in /dev/shm")
+            && no_shm.contains("render in one process"),
+        "{no_shm}"
+    );
+}
