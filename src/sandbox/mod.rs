@@ -16,7 +16,8 @@
 //!   runs in new user, PID, mount, IPC, network, UTS (and cgroup, where allowed) namespaces, with
 //!   `--die-with-parent`, `--new-session`, `--disable-userns`, `--cap-drop ALL`, a cleared
 //!   environment and a view of its own ([`view`], [`bwrap`]): the system's `/usr` and `/lib*`,
-//!   the loader's `/etc` files, a read-only `/dev`, a `/tmp` that is a tmpfs of bounded size, the
+//!   the loader's `/etc` files, a read-only `/dev` (but a 4 MiB tmpfs at `/dev/shm`, for
+//!   `multiprocessing`), a `/tmp` that is a tmpfs of bounded size, the
 //!   sandbox folder at `/sandbox`, and the paths exposed read-only (an interpreter and its
 //!   library tree; for an `--adapter` its program's and its files' folders, and those
 //!   `--expose` names). Its root is read-only. Nothing of the grader is visible: not its binary,
