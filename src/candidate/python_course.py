@@ -94,11 +94,16 @@ def where_raised(exc):
     """"FILE, line N" of the deepest frame of exc's traceback in the submission's folder, or
     None."""
     folder = os.path.abspath(SUBMISSION)
+    own = os.path.abspath(__file__)
     where = None
     for frame in traceback.extract_tb(exc.__traceback__):
         path = os.path.abspath(frame.filename)
+        name = os.path.basename(path)
+        # The adapter and rtoracle's drivers sit beside the submission's files: not its code.
+        if path == own or name.startswith("rtoracle_"):
+            continue
         if os.path.dirname(path) == folder:
-            where = "%s, line %d" % (os.path.basename(path), frame.lineno)
+            where = "%s, line %d" % (name, frame.lineno)
     return where
 
 

@@ -90,11 +90,16 @@ def import_failure(name, exc):
     deepest frame in the submission's folder) and, for a missing module, the package."""
     import traceback
     folder = os.path.abspath(_state["dir"])
+    own = os.path.abspath(__file__)
     where = None
     for frame in traceback.extract_tb(exc.__traceback__):
         path = os.path.abspath(frame.filename)
+        name = os.path.basename(path)
+        # The adapter and this driver sit beside the submission's files: not its code.
+        if path == own or name.startswith("rtoracle_") or name == "course_adapter.py":
+            continue
         if os.path.dirname(path) == folder:
-            where = "%s, line %d" % (os.path.basename(path), frame.lineno)
+            where = "%s, line %d" % (name, frame.lineno)
     if isinstance(exc, SyntaxError) and getattr(exc, "filename", None):
         where = "%s, line %s" % (os.path.basename(exc.filename), exc.lineno)
     if isinstance(exc, ModuleNotFoundError) and getattr(exc, "name", None):

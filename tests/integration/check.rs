@@ -321,8 +321,9 @@ fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
     );
     let e = r.import_error.as_ref().expect("an import error");
     assert!(
-        e.message
-            .contains("imports RT_camera_not_uploaded, which is not in your submission"),
+        e.message.contains(
+            "imports RT_camera_not_uploaded (RT_object.py, line 5), which is not in your submission"
+        ),
         "{}",
         e.message
     );

@@ -40,33 +40,40 @@ fn check(folder: &Path, week: u8) -> (Value, String) {
     (report, stderr)
 }
 
-/// The report's functions, by id: `(status, names of the mistakes it fits, the failure's
-/// problem, notes)`.
-fn functions(report: &Value) -> Vec<(String, String, Vec<String>, String, Vec<String>)> {
+/// A function's verdict in a report.
+#[derive(Debug)]
+struct Verdict {
+    id: String,
+    status: String,
+    /// The names of the mistakes (or departures) it fits.
+    mistakes: Vec<String>,
+    /// Its smallest failing case's problem.
+    problem: String,
+    notes: Vec<String>,
+}
+
+/// The report's functions.
+fn functions(report: &Value) -> Vec<Verdict> {
+    let strings = |v: &Value, key: &str| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|m| {
+                let m = if key.is_empty() { m } else { &m[key] };
+                m.as_str().unwrap().to_string()
+            })
+            .collect()
+    };
     report["functions"]["functions"]
         .as_array()
         .expect("a functions list")
         .iter()
-        .map(|f| {
-            let names = f["mistakes"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|m| m["name"].as_str().unwrap().to_string())
-                .collect();
-            let notes = f["notes"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|n| n.as_str().unwrap().to_string())
-                .collect();
-            (
-                f["id"].as_str().unwrap().to_string(),
-                f["status"].as_str().unwrap().to_string(),
-                names,
-                f["failure"]["problem"].as_str().unwrap_or("").to_string(),
-                notes,
-            )
+        .map(|f| Verdict {
+            id: f["id"].as_str().unwrap().to_string(),
+            status: f["status"].as_str().unwrap().to_string(),
+            mistakes: strings(&f["mistakes"], "name"),
+            problem: f["failure"]["problem"].as_str().unwrap_or("").to_string(),
+            notes: strings(&f["notes"], ""),
         })
         .collect()
 }
@@ -74,9 +81,9 @@ fn functions(report: &Value) -> Vec<(String, String, Vec<String>, String, Vec<St
 fn status_of(report: &Value, id: &str) -> String {
     functions(report)
         .into_iter()
-        .find(|f| f.0 == id)
+        .find(|f| f.id == id)
         .unwrap_or_else(|| panic!("no function {id}"))
-        .1
+        .status
 }
 
 /// The tasks each week's skeleton leaves to the student (its README's, as the skeleton's code
@@ -105,7 +112,7 @@ fn solution_passes_and_skeleton_fails(week: u8) {
     let (report, stderr) = check(&solution, week);
     let failing: Vec<_> = functions(&report)
         .into_iter()
-        .filter(|f| f.1 != "passed")
+        .filter(|f| f.status != "passed")
         .collect();
     assert!(
         failing.is_empty(),
@@ -942,12 +949,12 @@ fn mistakes_are_caught_and_named(week: u8) {
         let (report, _) = check(&folder, week);
         let named = functions(&report)
             .into_iter()
-            .any(|f| f.1 == "failed" && f.2.iter().any(|m| m == p.name));
+            .any(|f| f.status == "failed" && f.mistakes.iter().any(|m| m == p.name));
         if !named {
             let failing: Vec<_> = functions(&report)
                 .into_iter()
-                .filter(|f| f.1 != "passed")
-                .map(|f| (f.0, f.2, f.3))
+                .filter(|f| f.status != "passed")
+                .map(|f| (f.id, f.mistakes, f.problem))
                 .collect();
             missed.push(format!("{}: {failing:?}", p.name));
         }
@@ -958,7 +965,7 @@ fn mistakes_are_caught_and_named(week: u8) {
         let (report, _) = check(&folder, week);
         let failing: Vec<_> = functions(&report)
             .into_iter()
-            .filter(|f| f.1 != "passed")
+            .filter(|f| f.status != "passed")
             .collect();
         assert!(failing.is_empty(), "{}: {failing:?}", p.name);
     }
@@ -1094,10 +1101,10 @@ fn departures_that_keep_the_courses_behaviour_are_named_and_not_charged() {
         return;
     };
     let fs = functions(&report);
-    let refract = fs.iter().find(|f| f.0 == "refract").unwrap();
-    assert_eq!(refract.1, "passed", "{fs:#?}");
-    assert_eq!(refract.2, ["schlick_in_dielectric"], "{fs:#?}");
-    assert!(fs.iter().all(|f| f.1 == "passed"), "{fs:#?}");
+    let refract = fs.iter().find(|f| f.id == "refract").unwrap();
+    assert_eq!(refract.status, "passed", "{fs:#?}");
+    assert_eq!(refract.mistakes, ["schlick_in_dielectric"], "{fs:#?}");
+    assert!(fs.iter().all(|f| f.status == "passed"), "{fs:#?}");
     assert_eq!(report["score"]["score"], 100.0);
     // Without the material's choice it is a mistake, charged in refract and the material.
     let k = MISTAKES
@@ -1112,18 +1119,19 @@ fn departures_that_keep_the_courses_behaviour_are_named_and_not_charged() {
 
     let report = patched_report(APERTURE).unwrap();
     let fs = functions(&report);
-    assert!(fs.iter().all(|f| f.1 == "passed"), "{fs:#?}");
+    assert!(fs.iter().all(|f| f.status == "passed"), "{fs:#?}");
     for id in ["camera", "lens"] {
-        let f = fs.iter().find(|f| f.0 == id).unwrap();
+        let f = fs.iter().find(|f| f.id == id).unwrap();
         assert!(
-            f.4.iter()
+            f.notes
+                .iter()
                 .any(|n| n.contains("init_camera takes the lens's aperture")),
             "{id}: {f:?}"
         );
     }
     let report = patched_report(BLACK_DEFAULT).unwrap();
     let fs = functions(&report);
-    assert!(fs.iter().all(|f| f.1 == "passed"), "{fs:#?}");
+    assert!(fs.iter().all(|f| f.status == "passed"), "{fs:#?}");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1149,7 +1157,7 @@ fn a_module_that_fails_to_import_fails_only_what_needs_it_and_is_named() {
     .unwrap();
     let (report, _) = check(&folder, 10);
     let fs = functions(&report);
-    assert!(fs.iter().all(|f| f.1 == "passed"), "{fs:#?}");
+    assert!(fs.iter().all(|f| f.status == "passed"), "{fs:#?}");
     // The materials import it: what needs RT_material fails and names the file, the line and
     // the package; what does not (the ONB, the samplers, the camera, the textures) passes.
     let path = folder.join("RT_material.py");
@@ -1157,10 +1165,10 @@ fn a_module_that_fails_to_import_fails_only_what_needs_it_and_is_named() {
     std::fs::write(&path, format!("import RT_transformer\n{text}")).unwrap();
     let (report, _) = check(&folder, 10);
     let fs = functions(&report);
-    let reflect = fs.iter().find(|f| f.0 == "reflect").unwrap();
-    assert_eq!(reflect.1, "failed");
+    let reflect = fs.iter().find(|f| f.id == "reflect").unwrap();
+    assert_eq!(reflect.status, "failed");
     assert!(
-        reflect.3.contains("RT_material.py could not be imported: RT_transformer.py, line 2 imports stl, which the grader does not provide"),
+        reflect.problem.contains("RT_material.py could not be imported: RT_transformer.py, line 2 imports stl, which the grader does not provide"),
         "{reflect:?}"
     );
     for id in [
@@ -1272,10 +1280,10 @@ fn multiprocessing_works_in_the_sandbox_or_says_what_is_missing() {
         let (report, _) = check(&folder, 6);
         let f = functions(&report)
             .into_iter()
-            .find(|f| f.0 == "reflect")
+            .find(|f| f.id == "reflect")
             .unwrap();
-        assert_eq!(f.1, "failed");
-        f.3
+        assert_eq!(f.status, "failed");
+        f.problem
     };
     let too_many = problem(
         "    import multiprocessing\n    with multiprocessing.Pool(200) as pool:\n        pool.map(abs, [-1, -2])\n",
