@@ -94,12 +94,12 @@ def import_failure(name, exc):
     where = None
     for frame in traceback.extract_tb(exc.__traceback__):
         path = os.path.abspath(frame.filename)
-        name = os.path.basename(path)
+        base = os.path.basename(path)
         # The adapter and this driver sit beside the submission's files: not its code.
-        if path == own or name.startswith("rtoracle_") or name == "course_adapter.py":
+        if path == own or base.startswith("rtoracle_") or base == "course_adapter.py":
             continue
         if os.path.dirname(path) == folder:
-            where = "%s, line %d" % (name, frame.lineno)
+            where = "%s, line %d" % (base, frame.lineno)
     if isinstance(exc, SyntaxError) and getattr(exc, "filename", None):
         where = "%s, line %s" % (os.path.basename(exc.filename), exc.lineno)
     if isinstance(exc, ModuleNotFoundError) and getattr(exc, "name", None):
@@ -154,11 +154,13 @@ def module(name):
 
 
 def where_looked():
-    looked = ", ".join(n + ".py" for n, _ in modules()) or "no RT_*.py module"
+    return ", ".join(n + ".py" for n, _ in modules()) or "no RT_*.py module"
+
+
+def failed_imports():
+    """"; " and the modules that could not be imported, in words, or ""."""
     failed = import_failures()
-    if failed:
-        looked += "; " + "; ".join(why for _, why in failed)
-    return looked
+    return "".join("; " + why for _, why in failed)
 
 
 def find_function(name, aliases=(), course_home="RT_utility"):
@@ -176,7 +178,7 @@ def find_function(name, aliases=(), course_home="RT_utility"):
             return f
     raise NotFound(
         "no function %s in the submission (looked in %s, and for Vec3.%s); the course defines "
-        "it in %s.py" % (name, where_looked(), name, course_home)
+        "it in %s.py%s" % (name, where_looked(), name, course_home, failed_imports())
     )
 
 
@@ -189,8 +191,8 @@ def find_class(names, course_home):
             if inspect.isclass(c):
                 return c
     raise NotFound(
-        "no class %s in the submission (looked in %s); the course defines it in %s.py"
-        % (names[0], where_looked(), course_home)
+        "no class %s in the submission (looked in %s); the course defines it in %s.py%s"
+        % (names[0], where_looked(), course_home, failed_imports())
     )
 
 
@@ -361,7 +363,7 @@ def make_material(spec):
     if kind == "metal":
         return find_class("Metal", home)(color(spec["albedo"]), float(spec["roughness"]))
     if kind == "diffuse_light":
-        return find_class(("Diffuse_light", "DiffuseLight", "Diffuse_Light"), home)(
+        return find_class(("Diffuse_light", "DiffuseLight", "Diffuse_Light"), "RT_light")(
             color(spec["color"]))
     if kind in ("phong", "blinn"):
         cls = find_class("Phong" if kind == "phong" else "Blinn", home)
@@ -545,24 +547,24 @@ class Seeded:
 # The requests.
 
 def op_reflect(req):
-    f = find_function("reflect")
+    f = find_function("reflect", (), "RT_material")
     return {"vector": out_vec(f(vec3(req["v"]), vec3(req["n"])), "reflect")}
 
 
 def op_refract(req):
-    f = find_function("refract")
+    f = find_function("refract", (), "RT_material")
     with Replaced({"random_double": req.get("random", [])}) as r:
         out = f(vec3(req["v"]), vec3(req["n"]), float(req["ratio"]))
     return {"vector": out_vec(out, "refract"), "draws": r.draws()}
 
 
 def op_schlick(req):
-    f = find_function("schlick", ("reflectance",))
+    f = find_function("schlick", ("reflectance",), "RT_material")
     return {"value": out_num(f(float(req["cosine"]), float(req["ratio"])), "schlick")}
 
 
 def op_halfvector(req):
-    f = find_function("halfvector", ("half_vector",), "RT_utility")
+    f = find_function("halfvector", ("half_vector",), "RT_material")
     return {"vector": out_vec(f(vec3(req["v"]), vec3(req["l"])), "halfvector")}
 
 
