@@ -158,6 +158,22 @@ pub fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::Relaxed)
 }
 
+/// Once a signal has come, waits for the signal thread to finish its cleanups and exit the
+/// process with the signal's code (so it never returns then); otherwise returns at once. Called
+/// before anything is reported (every line the binary prints, and its exit): a child that the
+/// cleanups killed must not be reported as the command's own failure, nor a verdict drawn from
+/// it printed, and the exit code must be the signal's.
+pub fn exit_if_interrupted() {
+    if !interrupted() {
+        return;
+    }
+    // The signal thread holds the gate from the signal to its `exit`: this blocks until then.
+    let _gate = SPAWN_GATE.lock();
+    loop {
+        std::thread::park();
+    }
+}
+
 /// Lets one process be started: hold the returned guard across the spawn and the registration
 /// of its cleanup. `None` once a signal has come (the process is about to exit; start nothing).
 /// While the signal thread cleans up it holds the gate, so a spawn either finished before the

@@ -18,7 +18,10 @@ fn main() -> ExitCode {
         errln!("rtoracle: cannot install the signal handlers: {err}");
         return ExitCode::from(2);
     }
-    match cli::run() {
+    let outcome = cli::run();
+    // A command cut short by a signal ends with the signal's code, whatever it returned.
+    rtoracle::interrupt::exit_if_interrupted();
+    match outcome {
         Ok(code) => code,
         Err(err) => {
             // One line: the whole chain of causes, joined by ": ".

@@ -15,6 +15,7 @@ static CLOSED: AtomicBool = AtomicBool::new(false);
 
 /// Writes `text` to stdout and flushes it. A closed pipe is not an error (see the module docs).
 pub fn print(text: &str) -> anyhow::Result<()> {
+    rtoracle::interrupt::exit_if_interrupted();
     if CLOSED.load(Ordering::Relaxed) {
         return Ok(());
     }
@@ -50,9 +51,11 @@ macro_rules! outln {
 }
 
 /// `eprintln!` that cannot panic: a closed stderr (`2>&1 | head -1`) loses the line quietly.
+/// Neither it nor [`print`] writes once a signal has come (see `interrupt::exit_if_interrupted`).
 macro_rules! errln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
+        rtoracle::interrupt::exit_if_interrupted();
         let _ = writeln!(std::io::stderr(), $($arg)*);
     }};
 }
