@@ -10,12 +10,19 @@ use rtoracle::compare::{
 use rtoracle::golden::{GoldenRecord, GoldenScene, cache_dir};
 
 /// `rtoracle compare CANDIDATE (--scene NAME|FILE.toml [--golden FILE.exr] | --golden FILE.exr) [--spp N] [--encoding E]
-/// [--json] [--heatmap OUT.png] [--report DIR]`
+/// [--json] [--heatmap OUT.png] [--report DIR]`, or `rtoracle compare A B [--json] [--heatmap
+/// OUT.png] [--report DIR]` (two renders, no golden)
 #[derive(Debug, clap::Args)]
-#[command(group(clap::ArgGroup::new("reference").required(true).multiple(true).args(["scene", "golden"])))]
+#[command(group(clap::ArgGroup::new("reference").required(false).multiple(true).args(["scene", "golden"])))]
 pub struct Args {
-    /// The image to judge: a PNG (8-bit RGB or RGBA), a PPM (P3 or P6, 8-bit) or an EXR.
+    /// The image to judge: a PNG (8-bit RGB or RGBA), a PPM (P3 or P6, 8-bit) or an EXR. With
+    /// OTHER: an EXR with a variance layer, or a folder of EXR renders with different seeds.
     candidate: PathBuf,
+    /// A second render of the same scene to compare CANDIDATE with, with no golden (two-sample
+    /// tests): an EXR with a variance layer (`rtoracle render --variance`) and an rtoracle.spp
+    /// attribute, or a folder of EXR renders with different seeds.
+    #[arg(value_name = "OTHER", conflicts_with_all = ["scene", "golden", "spp", "encoding"])]
+    other: Option<PathBuf>,
     /// Compare with the golden of this built-in scene (see `rtoracle scenes`), or of this scene
     /// file (`.toml`; its golden rendered once and cached, as grading does).
     #[arg(long, value_name = "NAME|FILE.toml")]
@@ -74,12 +81,15 @@ fn summary(c: &Comparison, candidate: &Path, pictures: bool, spp_note: Option<&s
         ));
     }
     s.push_str(&format!(
-        "  bias (linear R G B) {:+.5} {:+.5} {:+.5}; effective spp {}\n",
+        "  bias (linear R G B) {:+.5} {:+.5} {:+.5}; effective spp {}; relMSE {}; FLIP {}\n",
         c.bias[0],
         c.bias[1],
         c.bias[2],
         c.effective_spp
-            .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}"))
+            .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}")),
+        c.rel_mse
+            .map_or_else(|| "unknown".to_string(), |r| format!("{r:.3e}")),
+        flip_words(c.flip.as_ref())
     ));
     for r in c.regions.iter().take(5) {
         let change = r
@@ -109,6 +119,14 @@ fn summary(c: &Comparison, candidate: &Path, pictures: bool, spp_note: Option<&s
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    if let Some(other) = &args.other {
+        return two_sample(&args, other);
+    }
+    if args.scene.is_none() && args.golden.is_none() {
+        anyhow::bail!(
+            "give --scene NAME or --golden FILE.exr, or a second render OTHER to compare with"
+        );
+    }
     let encoding: Encoding = args
         .encoding
         .parse()
@@ -293,4 +311,111 @@ fn recorded_spp(record: &GoldenRecord) -> (u32, String) {
             "judged as a render of {n} spp, the samples_per_pixel of {which} (--spp N to change)"
         ),
     )
+}
+
+/// The EXRs of one side of `compare A B`: the file, or every `.exr` of the folder (name order).
+fn side_files(path: &Path) -> anyhow::Result<Vec<(PathBuf, rtoracle::image_io::ExrImage)>> {
+    let files: Vec<PathBuf> = if path.is_dir() {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(path)
+            .with_context(|| format!("{}: cannot read the folder", path.display()))?
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")))
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            anyhow::bail!("{}: the folder holds no .exr render", path.display());
+        }
+        files
+    } else if path.exists() {
+        vec![path.to_path_buf()]
+    } else {
+        anyhow::bail!("{}: no such file or folder", path.display());
+    };
+    files
+        .into_iter()
+        .map(|f| {
+            let image = rtoracle::image_io::read_exr(&f)?;
+            Ok((f, image))
+        })
+        .collect()
+}
+
+/// `rtoracle compare A B`: two renders with no golden.
+fn two_sample(args: &Args, other: &Path) -> anyhow::Result<ExitCode> {
+    use rtoracle::compare::twosample::{Side, compare_two};
+    if let Some(h) = &args.heatmap {
+        rtoracle::output::check_output_file(h, "--heatmap")?;
+    }
+    let report_out = args
+        .report
+        .as_deref()
+        .map(|r| report::report_dir(r, "--report"))
+        .transpose()?;
+    let shown = |p: &Path| p.display().to_string();
+    let a = Side::from_exrs(&side_files(&args.candidate)?, &shown(&args.candidate))?;
+    let b = Side::from_exrs(&side_files(other)?, &shown(other))?;
+    let comparison = compare_two(&a, &b, CompareOptions::default().alpha)?;
+    if let Some(h) = &args.heatmap {
+        write_heatmap(h, &comparison)?;
+    }
+    if let Some(out) = report_out {
+        let candidate = CandidateImage::Linear {
+            width: a.width,
+            height: a.height,
+            data: a.mean.iter().map(|p| p.map(|x| x as f32)).collect(),
+        };
+        let golden = Golden::new(
+            b.width,
+            b.height,
+            b.spp.max(1),
+            b.mean.clone(),
+            b.variance.clone(),
+            None,
+        )?;
+        write_report_to(out, &comparison, &candidate, &golden, Encoding::Srgb)?;
+    }
+    if args.json {
+        outln!("{}", report::to_json(&comparison))?;
+    } else {
+        let sides = format!(
+            "{} ({}) against {} ({})",
+            rtoracle::escape::terminal_line(&a.label),
+            side_words(&a),
+            rtoracle::escape::terminal_line(&b.label),
+            side_words(&b)
+        );
+        let text = summary(
+            &comparison,
+            &args.candidate,
+            args.heatmap.is_some() || args.report.is_some(),
+            None,
+        );
+        // The first line names both sides instead of a golden.
+        let rest = text.split_once('\n').map_or("", |(_, r)| r);
+        out!(
+            "{} {sides}: {}x{}, two-sample tests (no golden)\n{rest}",
+            if comparison.passed() { "PASS" } else { "FAIL" },
+            comparison.width,
+            comparison.height
+        )?;
+    }
+    Ok(ExitCode::from(if comparison.passed() { 0 } else { 1 }))
+}
+
+/// FLIP's summary in words: `mean 0.021, worst 1% from 0.150`.
+fn flip_words(flip: Option<&rtoracle::compare::flip::FlipSummary>) -> String {
+    flip.map_or_else(
+        || "unknown".to_string(),
+        |f| format!("mean {:.3}, worst 1% from {:.3}", f.mean, f.p99),
+    )
+}
+
+/// A side in words: its renders or its samples.
+fn side_words(side: &rtoracle::compare::twosample::Side) -> String {
+    match side.renders {
+        0 => "exact".to_string(),
+        1 => format!("{} spp, its variance layer", side.spp),
+        n => format!("{n} renders"),
+    }
 }

@@ -93,6 +93,27 @@ impl CandidateImage {
         }
     }
 
+    /// The linear values the image stands for: an 8-bit code's the mid-point of its interval
+    /// under `encoding` (within `[0, 1]`), a linear image's its own.
+    pub fn linear_mid_points(&self, encoding: Encoding) -> Vec<[f64; 3]> {
+        match self {
+            CandidateImage::Rgb8 { data, .. } => {
+                let table = encoding.table();
+                data.chunks_exact(3)
+                    .map(|p| {
+                        [0, 1, 2].map(|c| {
+                            let (lo, hi) = table[p[c] as usize];
+                            (0.5 * (lo + hi)).clamp(0.0, 1.0)
+                        })
+                    })
+                    .collect()
+            }
+            CandidateImage::Linear { data, .. } => {
+                data.iter().map(|p| p.map(|x| x as f64)).collect()
+            }
+        }
+    }
+
     /// The image as 8-bit RGB for pictures (linear images are encoded with `encoding`).
     pub fn to_rgb8(&self, encoding: Encoding) -> Vec<u8> {
         match self {

@@ -102,28 +102,65 @@ enum Try {
 /// Scales within this of each other are "the same in every channel".
 const SAME_SCALE: f64 = 0.02;
 
-/// The name and words of a uniform scale `k`.
-fn scale_mistake(k: [f64; 3]) -> (String, String) {
+/// The exponent that turns a linear factor into the factor of the codes written under
+/// `encoding` (codes are `x^(1/gamma)`, so a linear `k` is the codes times `k^(1/gamma)`; sRGB's
+/// curve is `x^(1/2.4)` but for its dark end, so its factor is approximate there).
+fn code_gamma(encoding: Encoding) -> f64 {
+    match encoding {
+        Encoding::Course | Encoding::Rtiow => 2.0,
+        Encoding::Srgb => 2.4,
+        Encoding::Gamma22 => 2.2,
+        Encoding::Linear => 1.0,
+        Encoding::GammaTwice => 4.0,
+    }
+}
+
+/// How much darker or brighter a factor `f` makes what it multiplies: `10% darker`.
+fn change_words(f: f64) -> String {
+    let way = if f < 1.0 { "darker" } else { "brighter" };
+    format!("{:.0}% {way}", 100.0 * (f - 1.0).abs())
+}
+
+/// The name and words of a uniform scale `k` of the linear values, said in the terms of the
+/// file judged: for an 8-bit PNG the factor of its codes (under the `encoding` asked for), with
+/// the linear factor beside it (`every code times 0.90 (linear x0.81)`: the picture darkened by
+/// 10%); for an EXR (`codes` false) the factor of its values, which are linear.
+fn scale_mistake(k: [f64; 3], codes: Option<Encoding>) -> (String, String) {
     let (lo, hi) = (
         k.iter().copied().fold(f64::INFINITY, f64::min),
         k.iter().copied().fold(0.0, f64::max),
     );
+    // The factor of the file's own numbers, and the linear one beside it (for codes).
+    let said = |k: f64| match codes {
+        Some(e) => (k.powf(1.0 / code_gamma(e)), format!(" (linear x{k:.2})")),
+        None => (k, String::new()),
+    };
+    let what = if codes.is_some() { "code" } else { "value" };
     if hi - lo <= SAME_SCALE * hi {
         let m = (k[0] + k[1] + k[2]) / 3.0;
-        let way = if m < 1.0 { "darker" } else { "brighter" };
+        let (f, linear) = said(m);
+        let how = match codes {
+            Some(_) => format!("{} in the picture", change_words(f)),
+            None => change_words(f),
+        };
         (
             format!("scale:{m:.2}"),
             format!(
-                "fits the golden with every value times {m:.2} (the same in red, green and blue: {:.0}% {way}): an exposure or brightness change, a light's strength, or every albedo scaled",
-                100.0 * (m - 1.0).abs()
+                "fits the golden with every {what} times {f:.2}{linear} (the same in red, green and blue: {how}): an exposure or brightness change, a light's strength, or every albedo scaled"
             ),
         )
     } else {
+        let part = |name: &str, k: f64| {
+            let (f, linear) = said(k);
+            format!("{name} {what}s times {f:.2}{linear}")
+        };
         (
             format!("scale:{:.2},{:.2},{:.2}", k[0], k[1], k[2]),
             format!(
-                "fits the golden with red times {:.2}, green times {:.2} and blue times {:.2}: a colour cast (a light's or the albedos' colour scaled per channel)",
-                k[0], k[1], k[2]
+                "fits the golden with {}, {} and {}: a colour cast (a light's or the albedos' colour scaled per channel)",
+                part("red", k[0]),
+                part("green", k[1]),
+                part("blue", k[2])
             ),
         )
     }
@@ -194,7 +231,8 @@ fn attempt(
             evaluate(candidate, &golden.half_pixel_shifted(-1), asked, options),
         ),
         Try::Scale(k) => {
-            let (name, mistake) = scale_mistake(k);
+            let codes = matches!(candidate, CandidateImage::Rgb8 { .. }).then_some(asked);
+            let (name, mistake) = scale_mistake(k, codes);
             let e = evaluate(candidate, &hypotheses::scaled(golden, k), asked, options);
             (name, mistake, e)
         }
@@ -281,6 +319,42 @@ pub fn diagnose(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A scale is said in the file's own numbers: a PNG's codes under the course's encoding
+    /// (codes are sqrt of the linear values, so linear x0.81 is every code times 0.9), an EXR's
+    /// linear values as they are; the other factor beside it.
+    #[test]
+    fn a_scale_is_said_in_the_encoding_of_the_file_judged() {
+        let (_, png) = scale_mistake([0.81; 3], Some(Encoding::Course));
+        assert!(
+            png.contains("every code times 0.90 (linear x0.81)")
+                && png.contains("10% darker in the picture"),
+            "{png}"
+        );
+        let (_, exr) = scale_mistake([0.81; 3], None);
+        assert!(
+            exr.contains("every value times 0.81 (") && exr.contains("19% darker"),
+            "{exr}"
+        );
+        assert!(!exr.contains("linear x"), "{exr}");
+        // Gamma 2.2: codes times 0.81^(1/2.2) = 0.9087.
+        let (_, g22) = scale_mistake([0.81; 3], Some(Encoding::Gamma22));
+        assert!(
+            g22.contains("every code times 0.91 (linear x0.81)"),
+            "{g22}"
+        );
+        // No curve: the codes are the linear values.
+        let (_, lin) = scale_mistake([0.81; 3], Some(Encoding::Linear));
+        assert!(
+            lin.contains("every code times 0.81 (linear x0.81)"),
+            "{lin}"
+        );
+        let (_, cast) = scale_mistake([0.64, 1.0, 1.21], Some(Encoding::Course));
+        assert!(
+            cast.contains("red codes times 0.80 (linear x0.64), green codes times 1.00 (linear x1.00) and blue codes times 1.10 (linear x1.21)"),
+            "{cast}"
+        );
+    }
 
     /// On a 3 x 2 image of distinct pixels, both kinds: y reverses the rows, x each row, and
     /// both twice give the image back.

@@ -12,6 +12,7 @@ pub mod bench;
 pub mod candidate;
 pub mod diagnose;
 pub mod encoding;
+pub mod flip;
 pub mod heatmap;
 mod hypotheses;
 pub mod mistakes;
@@ -19,6 +20,7 @@ pub mod noise_model;
 pub mod regions;
 pub mod report;
 pub mod stats;
+pub mod twosample;
 pub mod verdict;
 
 use std::path::{Path, PathBuf};
@@ -218,6 +220,19 @@ pub struct Comparison {
     /// Mean of (candidate - golden) per channel, linear, over all pixels (mid-points of the
     /// candidate's intervals).
     pub bias: [f64; 3],
+    /// How far, not whether: relMSE, the mean over pixels and channels of `(candidate -
+    /// golden)^2 / (golden^2 + 0.01)` (the candidate's mid-points; in `compare A B`, A's means
+    /// against B's). It never decides the verdict. Absent from reports written before it.
+    #[serde(default)]
+    pub rel_mse: Option<f64>,
+    /// How far, as people see it: NVIDIA's FLIP of the candidate against the golden (in
+    /// `compare A B`, of A against B) as an sRGB display shows them ([`flip`]). It never decides
+    /// the verdict. Absent from reports written before it.
+    #[serde(default)]
+    pub flip: Option<flip::FlipSummary>,
+    /// FLIP's error per pixel, for the HTML report's map (empty when there is none).
+    #[serde(skip)]
+    pub flip_map: Vec<f32>,
     /// The candidate's samples per pixel as its noise suggests (from the noisy pixels).
     pub effective_spp: Option<f64>,
     /// The diagnosis, when the image fails and diagnosis was asked for.
@@ -228,6 +243,14 @@ pub struct Comparison {
 }
 
 impl Comparison {
+    /// Records FLIP's summary and map (none when `flip` is `None`).
+    pub fn set_flip(&mut self, flip: Option<flip::Flip>) {
+        (self.flip, self.flip_map) = match flip {
+            Some(f) => (Some(f.summary), f.map),
+            None => (None, Vec::new()),
+        };
+    }
+
     /// Whether the candidate passed.
     pub fn passed(&self) -> bool {
         self.verdict == Verdict::Pass
@@ -291,7 +314,10 @@ pub fn compare_image(
     } else {
         None
     };
-    Ok(evaluation.into_comparison(candidate, golden, options, diagnosis))
+    let mut comparison = evaluation.into_comparison(candidate, golden, options, diagnosis);
+    let test = candidate.linear_mid_points(options.encoding);
+    comparison.set_flip(flip::flip_of(&golden.mean, &test, w, h));
+    Ok(comparison)
 }
 
 /// Reads a candidate file and compares it, naming the file in errors (size mismatches too).

@@ -239,15 +239,33 @@ fn index_html(c: &Comparison, crops: &[(String, super::Region)]) -> String {
     }
     let _ = writeln!(
         h,
-        "</table><p>Bias (linear, R G B): {:+.5} {:+.5} {:+.5}. Effective spp: {}.</p>",
+        "</table><p>Bias (linear, R G B): {:+.5} {:+.5} {:+.5}. Effective spp: {}. relMSE (how \
+         far, not whether): {}.</p>{}",
         c.bias[0],
         c.bias[1],
         c.bias[2],
         c.effective_spp
-            .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}"))
+            .map_or_else(|| "unknown".to_string(), |n| format!("{n:.1}")),
+        c.rel_mse
+            .map_or_else(|| "unknown".to_string(), |r| format!("{r:.3e}")),
+        flip_paragraph(c)
     );
     h.push_str("<p>Report: <a href=\"report.json\">report.json</a></p></body></html>\n");
     h
+}
+
+/// FLIP's figures and map, when there is one: how far as people see it, never the verdict.
+fn flip_paragraph(c: &Comparison) -> String {
+    match &c.flip {
+        Some(f) if !c.flip_map.is_empty() => format!(
+            "<h2>FLIP (how far as people see it, not whether)</h2><p>Mean {:.4}, median {:.4}, \
+             worst 1% from {:.4}, largest {:.4} (0 equal, 1 as different as FLIP can say; both \
+             images as an sRGB display shows them).</p><img src=\"flip.png\" alt=\"FLIP error \
+             map\">\n",
+            f.mean, f.median, f.p99, f.max
+        ),
+        _ => String::new(),
+    }
 }
 
 /// The |difference| x4 image of two images' codes: per pixel the largest channel's difference
@@ -298,6 +316,7 @@ fn is_report_file(name: &str) -> bool {
             | "candidate.png"
             | "golden.png"
             | "difference.png"
+            | "flip.png"
     ) || is_heatmap_name(name)
         || name
             .strip_prefix("region-")
@@ -376,6 +395,18 @@ pub fn write_report_to(
         "difference.png",
         &difference_image(&cand, &gold, comparison.width, comparison.height),
     )?;
+    if let Some(data) =
+        super::flip::magma_picture(&comparison.flip_map, comparison.width, comparison.height)
+    {
+        png(
+            "flip.png",
+            &Rgb8Image {
+                width: comparison.width,
+                height: comparison.height,
+                data,
+            },
+        )?;
+    }
     let mut crops = Vec::new();
     for (k, r) in comparison.regions.iter().take(CROPS).enumerate() {
         let name = format!("region-{}.png", k + 1);

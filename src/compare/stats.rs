@@ -31,8 +31,26 @@ pub fn sidak(p: f64, m: f64) -> f64 {
     (-(m * (-p).ln_1p()).exp_m1()).min(1.0)
 }
 
+/// The constant in relMSE's denominator: it keeps the near-black pixels, where any difference is
+/// a large ratio, from dominating the mean.
+pub const REL_MSE_EPSILON: f64 = 0.01;
+
+/// One term of relMSE, `(x - reference)^2 / (reference^2 + 0.01)`: how far a value is from the
+/// reference's, relative to it. relMSE is the mean of these over the pixels and channels.
+pub fn rel_mse_term(x: f64, reference: f64) -> f64 {
+    (x - reference).powi(2) / (reference * reference + REL_MSE_EPSILON)
+}
+
 #[cfg(test)]
 mod tests {
+    /// A value 10% below a reference of 1: 0.01 / 1.01; equal values: 0.
+    #[test]
+    fn rel_mse_term_by_hand() {
+        assert!((super::rel_mse_term(0.9, 1.0) - 0.01 / 1.01).abs() < 1e-15);
+        assert_eq!(super::rel_mse_term(0.25, 0.25), 0.0);
+        assert!((super::rel_mse_term(0.1, 0.0) - 1.0).abs() < 1e-12);
+    }
+
     use super::*;
 
     #[test]

@@ -212,6 +212,8 @@ pub struct Evaluation {
     pub z_map: Vec<[f32; 3]>,
     /// Mean (candidate mid-point - golden) per channel.
     pub bias: [f64; 3],
+    /// relMSE of the candidate's mid-points against the golden's means.
+    pub rel_mse: f64,
     /// Estimated samples per pixel.
     pub effective_spp: Option<f64>,
     /// Sum of min(z^2, 100) over pixel and 8x8-tile tests: how badly the image fits.
@@ -368,6 +370,8 @@ struct PixelPass {
     z_map: Vec<[f32; 3]>,
     /// Sum of (candidate mid-point - golden) per channel.
     bias: [f64; 3],
+    /// Sum of relMSE's terms.
+    rel_mse: f64,
     noise: NoiseSums,
     misfit: f64,
 }
@@ -385,6 +389,7 @@ impl PixelPass {
             pixel_failing: 0,
             z_map: vec![[0.0f32; 3]; g.width * g.height],
             bias: [0.0; 3],
+            rel_mse: 0.0,
             noise: NoiseSums::default(),
             misfit: 0.0,
         };
@@ -440,6 +445,7 @@ impl PixelPass {
             }
             let mid = 0.5 * (lo + hi);
             self.bias[c] += mid - mu;
+            self.rel_mse += super::stats::rel_mse_term(mid, mu);
             // Pixels whose noise shows through the quantisation enter the sums; the others
             // are decided exactly at the pixel scale (a rule that reads only the golden).
             let width_here = iv.width_at(mu);
@@ -676,6 +682,7 @@ pub fn evaluate(
         noise,
         z_map: pass.z_map,
         bias: pass.bias.map(|b| b / pixels),
+        rel_mse: pass.rel_mse / (3.0 * pixels),
         effective_spp,
         misfit: pass.misfit,
         encoding: iv.encoding,
@@ -792,6 +799,9 @@ impl Evaluation {
             outline: ranked,
             noise: self.noise,
             bias: self.bias,
+            rel_mse: Some(self.rel_mse),
+            flip: None,
+            flip_map: Vec::new(),
             effective_spp: self.effective_spp,
             diagnosis,
             z_map: self.z_map,
@@ -936,6 +946,27 @@ mod tests {
             "{:?}",
             e.scales
         );
+    }
+
+    /// relMSE against a golden of 1: a linear candidate of 0.9 gives 0.01 / 1.01 (by hand:
+    /// `(0.9 - 1)^2 / (1 + 0.01)` everywhere), one equal to the golden 0.
+    #[test]
+    fn rel_mse_of_a_uniform_scale() {
+        let golden = Golden::new(4, 4, 4096, vec![[1.0; 3]; 16], vec![[0.0; 3]; 16], None).unwrap();
+        let scaled = CandidateImage::Linear {
+            width: 4,
+            height: 4,
+            data: vec![[0.9; 3]; 16],
+        };
+        let options = CompareOptions::default();
+        let e = evaluate(&scaled, &golden, Encoding::Course, &options);
+        assert!((e.rel_mse - 0.01 / 1.01).abs() < 1e-6, "{}", e.rel_mse);
+        let same = CandidateImage::Linear {
+            width: 4,
+            height: 4,
+            data: vec![[1.0; 3]; 16],
+        };
+        assert!(evaluate(&same, &golden, Encoding::Course, &options).rel_mse < 1e-12);
     }
 
     /// A linear candidate equal to the golden passes; off by 1% in red fails, darker.

@@ -892,3 +892,80 @@ fn compare_refuses_a_golden_whose_deviation_is_not_a_distance() {
         String::from_utf8_lossy(&out.stdout)
     );
 }
+
+/// Every 8-bit code of `img` times `f`, rounded down (as a student darkening a picture would).
+fn codes_times(img: &Rgb8Image, f: f64) -> Rgb8Image {
+    Rgb8Image {
+        width: img.width,
+        height: img.height,
+        data: img.data.iter().map(|&c| (f64::from(c) * f) as u8).collect(),
+    }
+}
+
+/// A scale is diagnosed in the terms of the file judged: an honest PNG with every code times
+/// 0.9 is "every code times 0.90 (linear x0.81)" (the course's codes are the square root of the
+/// linear values, so 0.9 on the codes is 0.81 in linear light); an honest EXR with every value
+/// times 0.81 is "every value times 0.81", with no codes to speak of.
+#[test]
+fn a_darkened_picture_is_diagnosed_in_its_own_encoding() {
+    let d = rtoracle::scene::builtin("week04-sphere").unwrap();
+    let film = render(
+        &d.scene(),
+        &d.camera(None),
+        &RenderOptions {
+            samples_per_pixel: 20,
+            seed: 41,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let honest = Rgb8Image {
+        width: film.width,
+        height: film.height,
+        data: film.to_course_rgb8(),
+    };
+    let c = compare("week04-sphere", codes_times(&honest, 0.9));
+    let summary = &c.diagnosis.as_ref().unwrap().summary;
+    assert!(
+        summary.contains("every code times 0.90 (linear x0.81)")
+            && summary.contains("10% darker in the picture"),
+        "{summary}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let mut darker = film.clone();
+    for m in &mut darker.mean {
+        *m *= 0.81;
+    }
+    let dark = dir.path().join("dark.exr");
+    rtoracle::image_io::write_exr(&dark, &darker, &[]).unwrap();
+    let c =
+        rtoracle::compare::compare_file(&dark, golden("week04-sphere"), &CompareOptions::default())
+            .unwrap();
+    let summary = &c.diagnosis.as_ref().unwrap().summary;
+    assert!(
+        summary.contains("every value times 0.81 (") && summary.contains("19% darker"),
+        "{summary}"
+    );
+    assert!(!summary.contains("code"), "{summary}");
+}
+
+/// The course's own published picture (rendered by its Python code), every code times 0.9, is
+/// diagnosed the same way.
+#[test]
+#[cfg_attr(
+    not(rtoracle_course_code),
+    ignore = "set RTORACLE_COURSE_CODE to the course's code to run it"
+)]
+fn the_course_s_picture_darkened_is_diagnosed_in_codes() {
+    let Some(root) = course_code("the_course_s_picture_darkened_is_diagnosed_in_codes") else {
+        return;
+    };
+    let png = root.join("week04/skeleton/week04_quad.png");
+    let img = rtoracle::image_io::read_png(&png).unwrap();
+    let c = compare("week04-quad", codes_times(&img, 0.9));
+    let summary = &c.diagnosis.as_ref().unwrap().summary;
+    assert!(
+        summary.contains("every code times 0.90 (linear x0.81)"),
+        "{summary}"
+    );
+}

@@ -147,6 +147,42 @@ fn case(name: &str) -> &'static Case {
     cases().iter().find(|c| c.name == name).unwrap()
 }
 
+/// FLIP says where the change is: with the quad recoloured, its mean error over the pixels the
+/// change touched is several times that over the rest (which differ from the golden by noise and
+/// quantisation only); every case has a map of one error per pixel in `[0, 1]`, and a summary
+/// whose figures are in order.
+#[test]
+fn flip_s_error_is_where_the_change_is() {
+    for case in cases() {
+        let name = case.name;
+        let c = compared(case);
+        let f = c.flip.expect("a FLIP summary");
+        assert_eq!(c.flip_map.len(), c.width * c.height, "{name}");
+        assert!(c.flip_map.iter().all(|e| (0.0..=1.0).contains(e)), "{name}");
+        assert!(
+            f.median <= f.p99 && f.p99 <= f.max && f.mean <= f.max,
+            "{name}: {f:?}"
+        );
+        let mean_where = |touched: bool| {
+            let errors: Vec<f64> = c
+                .flip_map
+                .iter()
+                .zip(&case.changed)
+                .filter(|(_, t)| **t == touched)
+                .map(|(e, _)| *e as f64)
+                .collect();
+            errors.iter().sum::<f64>() / errors.len() as f64
+        };
+        if name == "colour" {
+            let (changed, rest) = (mean_where(true), mean_where(false));
+            assert!(
+                changed > 3.0 * rest,
+                "{name}: {changed} where changed, {rest} elsewhere"
+            );
+        }
+    }
+}
+
 /// Every failing region of every case, listed or only outlined, holds a pixel the case changed.
 #[test]
 fn every_failing_region_holds_a_changed_pixel() {
@@ -211,8 +247,8 @@ fn the_first_regions_are_distinct_places() {
     }
 }
 
-/// A render 10% darker everywhere is named a uniform scale of 0.90; the darker case's words say
-/// every channel is darker.
+/// A render 10% darker in linear light everywhere is named a uniform scale of 0.90, said in the
+/// PNG's codes (the square root of 0.90: 0.95) with the linear factor beside it.
 #[test]
 fn a_darker_render_is_a_uniform_scale() {
     let c = compared(case("darker"));
@@ -220,11 +256,15 @@ fn a_darker_render_is_a_uniform_scale() {
     assert_eq!(d.best.as_deref(), Some("scale:0.90"), "{}", d.summary);
     assert!(d.hypotheses[0].passes, "{}", d.summary);
     assert!(
-        d.summary.contains("every value times 0.90"),
+        d.summary.contains("every code times 0.95 (linear x0.90)"),
         "{}",
         d.summary
     );
-    assert!(d.summary.contains("10% darker"), "{}", d.summary);
+    assert!(
+        d.summary.contains("5% darker in the picture"),
+        "{}",
+        d.summary
+    );
 }
 
 /// A field of view of 80 degrees where the scene says 90 is named a zoom, with the field of view
@@ -357,7 +397,7 @@ fn the_html_report_shows_what_an_instructor_reads_at_a_glance() {
             "red up, blue down: a different colour, not a brighter one",
         ),
         ("flip", "upside down"),
-        ("darker", "every value times 0.90"),
+        ("darker", "every code times 0.95 (linear x0.90)"),
         ("fov80", "field of view of about"),
     ];
     for case in cases() {
@@ -406,6 +446,12 @@ fn the_html_report_shows_what_an_instructor_reads_at_a_glance() {
         for (src, _) in &imgs {
             assert!(folder.join(src).is_file(), "{name}: {src} is missing");
         }
+        // FLIP's map and figures, beside the verdict.
+        assert!(
+            imgs.iter().any(|(s, _)| s == "flip.png"),
+            "{name}: no FLIP map: {dom}"
+        );
+        assert!(dom.contains("FLIP (how far as people see it"), "{name}");
         // Legends: the heatmap's colour scale and the difference's, with what white means.
         for legend in ["id=\"z-legend\"", "id=\"difference-legend\""] {
             assert!(dom.contains(legend), "{name}: no {legend}");
