@@ -242,10 +242,11 @@ static inline surface surface_of(const object *s, vec3 o, vec3 d, double t) {
     return h;
 }
 
-/* The material's colour at p: its albedo, or the checker's (course: floor(p / scale) summed). */
+/* The material's colour at p: its albedo, or the checker's (course: floor(p * (1 / scale)) summed). */
 static inline vec3 colour_at(const bl_material *m, vec3 p) {
     if (m->kind != BL_CHECKER) return m->colour;
-    double cells = floor(p.x / m->scale) + floor(p.y / m->scale) + floor(p.z / m->scale);
+    double inv = 1.0 / m->scale;
+    double cells = floor(p.x * inv) + floor(p.y * inv) + floor(p.z * inv);
     double r = fmod(cells, 2.0);
     if (r < 0.0) r += 2.0;
     return r == 0.0 ? m->colour : m->odd;

@@ -3,7 +3,7 @@ use std::process::ExitCode;
 
 use rtoracle::scene::{BUILTIN_SCENES, TextureSource};
 
-/// `rtoracle scenes [--dump NAME [--textures DIR] [--profile P]]`
+/// `rtoracle scenes [--dump NAME [--textures DIR] [--profile P] | --export mitsuba NAME [--profile P]]`
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Print the built-in scene NAME as a TOML scene file instead of listing the scenes.
@@ -13,9 +13,18 @@ pub struct Args {
     /// absolute paths) instead of the pictures rtoracle generates.
     #[arg(long, value_name = "DIR", requires = "dump")]
     textures: Option<PathBuf>,
-    /// With --dump: the scene under this profile (course or physical) instead of its own.
-    #[arg(long, value_name = "P", requires = "dump", value_parser = super::render::parse_profile)]
+    /// With --dump or --export: the scene under this profile (course or physical) instead of its
+    /// own.
+    #[arg(long, value_name = "P", value_parser = super::render::parse_profile)]
     profile: Option<rtoracle::scene::Profile>,
+    /// Print the scene NAME (built-in, or a .toml scene file) for another renderer instead:
+    /// `mitsuba` (a Mitsuba 3 scene file, where the two share the physics;
+    /// docs/scenes-and-rendering.md).
+    #[arg(long, value_name = "FORMAT", requires = "name", conflicts_with_all = ["dump", "textures"], value_parser = ["mitsuba"])]
+    export: Option<String>,
+    /// With --export: the built-in scene or scene file (`.toml`) to write.
+    #[arg(value_name = "NAME|FILE.toml", requires = "export")]
+    name: Option<String>,
 }
 
 /// Where a built-in scene comes from, as `scenes` lists it.
@@ -28,6 +37,17 @@ fn origin(scene: &rtoracle::scene::BuiltinScene) -> String {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    if args.profile.is_some() && args.dump.is_none() && args.export.is_none() {
+        anyhow::bail!("--profile is for --dump NAME or --export FORMAT NAME");
+    }
+    if let Some(name) = &args.name {
+        let (_, description) = super::render::load_scene_with(name, None)?;
+        let description = super::render::with_profile(name, description, args.profile)?;
+        let xml = rtoracle::scene::to_mitsuba_xml(&description)
+            .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        out!("{xml}")?;
+        return Ok(ExitCode::SUCCESS);
+    }
     match args.dump {
         Some(name) => {
             let source = match &args.textures {

@@ -4,6 +4,7 @@
 //! A scene file ([`SceneDescription`]) states a profile (how it is rendered: as the course or as
 //! *Ray Tracing in One Weekend*), the image, the camera, the integrator's settings, textures,
 //! materials and objects; [`SceneDescription::scene`] turns it into a [`World`].
+//! [`to_mitsuba_xml`] writes one for Mitsuba 3 where the two renderers share the physics.
 
 mod builtin;
 mod bvh;
@@ -12,6 +13,7 @@ mod description;
 mod error;
 mod file;
 mod material;
+mod mitsuba;
 mod object;
 mod profile;
 mod settings;
@@ -33,6 +35,7 @@ pub use description::{
 };
 pub use error::SceneError;
 pub use material::Material;
+pub use mitsuba::{MitsubaError, to_mitsuba_xml};
 pub use object::{Object, Scene, SceneObject};
 pub use profile::Profile;
 pub use settings::{

@@ -67,15 +67,13 @@ impl Texture {
         match *self {
             Texture::Solid(c) => c,
             Texture::Checker { scale, even, odd } => {
-                let cells = match profile {
-                    Profile::Course => {
-                        (p.x / scale).floor() + (p.y / scale).floor() + (p.z / scale).floor()
-                    }
-                    Profile::Physical => {
-                        let inv = 1.0 / scale;
-                        (inv * p.x).floor() + (inv * p.y).floor() + (inv * p.z).floor()
-                    }
-                };
+                // The course (`RT_texture.CheckerTexture`: `inv_scale = 1.0 / fScale`,
+                // `floor(p.x() * inv_scale)`) and the book alike multiply by the inverse of the
+                // scale; a division rounds differently where `p / scale` is within an ulp of a
+                // whole number.
+                let _ = profile;
+                let inv = 1.0 / scale;
+                let cells = (p.x * inv).floor() + (p.y * inv).floor() + (p.z * inv).floor();
                 if is_even(cells) { even } else { odd }
             }
             Texture::Image { image, tint } => match images.get(image) {

@@ -145,14 +145,14 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     },
     BuiltinScene {
         name: "week07-procedural-texture",
-        summary: "renderProceduralTexture: checkers, the earth picture and a solid colour, depth 5, 400x225, 20 spp",
+        summary: "renderProceduralTexture: two checkers, a solid colour and a Lambertian sphere, depth 5, 400x225, 20 spp",
         week: Some(7),
         profiles: BOTH,
-        build: Build::Textured(weeks::week07_procedural_texture),
+        build: Build::Fixed(weeks::week07_procedural_texture),
     },
     BuiltinScene {
         name: "week07-earth",
-        summary: "renderEarth: picture textures on three spheres and a quad, depth 5, 400x225, 20 spp",
+        summary: "renderEarth: the earth picture on the ground, pictures on two spheres and a quad, depth 5, 400x225, 20 spp",
         week: Some(7),
         profiles: BOTH,
         build: Build::Textured(weeks::week07_earth),
@@ -173,7 +173,7 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     },
     BuiltinScene {
         name: "week09-blinn",
-        summary: "renderBlinn: Blinn spheres under the sky, cosine-sampled bounces, jittered, depth 5, 320x180, 30 spp",
+        summary: "renderBlinn: Blinn spheres under the sky, cosine-sampled bounces, render(), depth 5, 320x180, 30 spp",
         week: Some(9),
         profiles: COURSE,
         build: Build::Fixed(weeks::week09_blinn),
@@ -365,18 +365,30 @@ mod tests {
         };
         png("earthmap.png");
         let source = TextureSource::Folder(dir.path().to_path_buf());
-        let d = builtin_with_textures("week07-procedural-texture", &source).unwrap();
-        let files = d.external_files();
-        assert_eq!(files.len(), 1);
-        assert!(
-            files[0].is_absolute() && files[0].ends_with("earthmap.png"),
-            "{files:?}"
-        );
-        d.validate("t").unwrap();
         let e = builtin_with_textures("week07-earth", &source)
             .unwrap_err()
             .to_string();
         assert!(e.contains("basketball.jpg or basketball.png"), "{e}");
+        for name in ["basketball.jpg", "soccer.png", "pepsi.jpg"] {
+            png(name);
+        }
+        let d = builtin_with_textures("week07-earth", &source).unwrap();
+        let files = d.external_files();
+        assert_eq!(files.len(), 4);
+        assert!(
+            files.iter().all(|f| f.is_absolute())
+                && files.iter().any(|f| f.ends_with("earthmap.png"))
+                && files.iter().any(|f| f.ends_with("soccer.png")),
+            "{files:?}"
+        );
+        d.validate("t").unwrap();
+        // The procedural scene reads no picture.
+        assert!(
+            builtin_with_textures("week07-procedural-texture", &source)
+                .unwrap()
+                .external_files()
+                .is_empty()
+        );
         // Without a folder the generated pictures stand in, and no file is read.
         assert!(builtin("week07-earth").unwrap().external_files().is_empty());
     }

@@ -1,13 +1,14 @@
 //! The course's fixed scenes of weeks 5 to 10, one per render function of its `main.py`, with
-//! the cameras, sizes, sample counts, depths and materials its code uses.
+//! the cameras, sizes, sample counts, depths, materials and render calls of the instructor's
+//! solution of each week (its objects in `main.py`'s order).
 //!
 //! Where the course's code does not settle a value, the choice is named in the scene's
 //! function: week 5's `renderPointLightShadow` (from a deleted solution) takes
-//! `renderPointLight`'s sample count and depth; week 7's materials are the solution's, the
-//! checkers' scalar colours read as greys, the earth in the centre; weeks 9 and 10 keep week 8's
-//! checker ground, and week 9 its field of view and depth; week 9's `renderBlinn` uses
-//! `render_jittered` (although its output is `week09_nojittered.png`). These are also the
-//! choices of the Python fixtures of the weeks (`tests/fixtures/python/weeks/`).
+//! `renderPointLight`'s sample count and depth; week 7's pictures are the ones rtoracle
+//! generates (the grader hands them to the submission's `main.py` in place of the course's
+//! files, so both sides read the same texels); weeks 9 and 10 keep week 8's checker ground, and
+//! week 9 its field of view and depth. Week 9's `renderBlinn` renders with `render()` (uniform
+//! jitter), weeks 10's with `render_jittered()`.
 
 use super::parts::{
     TextureSource, brdf, camera, checker, dielectric, lambertian, light, mirror, moving_sphere,
@@ -136,58 +137,76 @@ pub(super) fn week06_dielectric() -> SceneDescription {
     week06("mirror", "glass", [-2.0, 2.0, 1.0], [0.0, 0.0, -1.0], 50.0)
 }
 
-/// Week 7's scene: a checker ground (`Checker(0.32, .2, .9)`) and three spheres of the given
-/// textures; 400x225, spp 20, depth 5, vfov 60, from `(-2, 2, 1)` at `(0, 0, -1)`, focus 10, the
-/// flat background (the skeleton's; its README says sky).
-fn week07(textures: Vec<crate::scene::TextureEntry>, spheres: [&str; 3]) -> SceneDescription {
-    let mut all = vec![checker("ground", 0.32, [0.2; 3], [0.9; 3])];
-    all.extend(textures);
-    let mut materials = vec![textured("ground", "ground")];
-    materials.extend(all[1..].iter().map(|t| textured(&t.name, &t.name)));
+/// Week 7's scenes: the ground, centre, left and right spheres of the given materials (in
+/// `main.py`'s order), 400x225, spp 20, depth 5, vfov 60, from `(-2, 2, 1)` at `(0, 0, -1)`,
+/// focus 10, the flat background (the skeleton's; its README says sky).
+fn week07(
+    textures: Vec<crate::scene::TextureEntry>,
+    materials: Vec<crate::scene::MaterialEntry>,
+    spheres: [&str; 4],
+) -> SceneDescription {
     let mut d = SceneDescription::new(
         image(400, 16.0 / 9.0, 20),
         camera([-2.0, 2.0, 1.0], [0.0, 0.0, -1.0], 60.0, 10.0),
         materials,
         vec![
-            sphere([0.0, -100.5, -1.0], 100.0, "ground"),
-            sphere([-1.0, 0.0, -1.0], 0.5, spheres[0]),
+            sphere([0.0, -100.5, -1.0], 100.0, spheres[0]),
             sphere([0.0, 0.0, -1.0], 0.5, spheres[1]),
-            sphere([1.0, 0.0, -1.0], 0.5, spheres[2]),
+            sphere([-1.0, 0.0, -1.0], 0.5, spheres[2]),
+            sphere([1.0, 0.0, -1.0], 0.5, spheres[3]),
         ],
     );
-    d.textures = all;
+    d.textures = textures;
     d.render = direct(5, Background::Flat);
     d
 }
 
-/// `renderProceduralTexture`: the solution's textures, `Checker(0.12, (.2, .3, .1), .9)` on the
-/// left, the earth picture in the centre, `Solid(.8, .2, .5)` on the right.
-pub(super) fn week07_procedural_texture(
-    source: &TextureSource,
-) -> Result<SceneDescription, SceneError> {
-    let name = "week07-procedural-texture";
-    Ok(week07(
-        vec![
-            checker("checker", 0.12, [0.2, 0.3, 0.1], [0.9; 3]),
-            solid("solid", [0.8, 0.2, 0.5]),
-            picture(name, "earth", "earth", source)?,
-        ],
-        ["checker", "earth", "solid"],
-    ))
+/// The solution's black-and-white checker, `CheckerTexture(0.32, (.2, .2, .2), (.9, .9, .9))`.
+fn checker_bw() -> crate::scene::TextureEntry {
+    checker("checker_bw", 0.32, [0.2; 3], [0.9; 3])
 }
 
-/// `renderEarth`: the basketball, earth and soccer pictures on the spheres (left to right), and
-/// `Quad((1, 0, -1), (1, 2, -1), (1, 0, 1))` with the pepsi picture.
+/// `renderProceduralTexture` (the solution's `main.py`): the black-and-white checker on the
+/// ground, `Lambertian(.7, .3, .3)` in the centre, `CheckerTexture(0.12, (.2, .3, .1), (.9, .9,
+/// .9))` on the left, `SolidColor(.8, .2, .5)` on the right.
+pub(super) fn week07_procedural_texture() -> SceneDescription {
+    week07(
+        vec![
+            checker_bw(),
+            checker("checker", 0.12, [0.2, 0.3, 0.1], [0.9; 3]),
+            solid("solid", [0.8, 0.2, 0.5]),
+        ],
+        vec![
+            textured("checker_bw", "checker_bw"),
+            lambertian("center", [0.7, 0.3, 0.3]),
+            textured("checker", "checker"),
+            textured("solid", "solid"),
+        ],
+        ["checker_bw", "center", "checker", "solid"],
+    )
+}
+
+/// `renderEarth` (the solution's `main.py`): the earth picture on the ground, the
+/// black-and-white checker in the centre, the basketball on the left, the soccer ball on the
+/// right, and `Quad((1, 0, -1), (1, 2, -1), (1, 0, 1))` with the pepsi picture.
 pub(super) fn week07_earth(source: &TextureSource) -> Result<SceneDescription, SceneError> {
     let name = "week07-earth";
     let mut d = week07(
         vec![
-            picture(name, "basketball", "basketball", source)?,
+            checker_bw(),
             picture(name, "earth", "earth", source)?,
+            picture(name, "basketball", "basketball", source)?,
             picture(name, "soccer", "soccer", source)?,
             picture(name, "pepsi", "pepsi", source)?,
         ],
-        ["basketball", "earth", "soccer"],
+        vec![
+            textured("earth", "earth"),
+            textured("checker_bw", "checker_bw"),
+            textured("basketball", "basketball"),
+            textured("soccer", "soccer"),
+            textured("pepsi", "pepsi"),
+        ],
+        ["earth", "checker_bw", "basketball", "soccer"],
     );
     d.objects.push(quad(
         [1.0, 0.0, -1.0],
@@ -273,9 +292,9 @@ fn week09_spheres(ks: [f64; 3], alphas: [f64; 3]) -> [(MaterialKind, [f64; 3], f
 }
 
 /// `renderBlinn` of week 9: cosine-sampled diffuse scattering, the sky, no light, spp 30, focus
-/// 5, `render_jittered` with week 9's frozen step `1 / int(sqrt(10)) = 1/3` (25 samples over
-/// 30; the output's name, `week09_nojittered.png`, says otherwise, but the week's subject is the
-/// jitter).
+/// 5, rendered as its `main.py` does, with `renderer.render()`: uniform jitter in the pixel
+/// (`get_ray`'s `random_pixel_in_square`), not `render_jittered` (its output is
+/// `week09_nojittered.png`; the jittered rays are checked by their function check).
 pub(super) fn week09_blinn() -> SceneDescription {
     brdf_scene(
         30,
@@ -283,8 +302,6 @@ pub(super) fn week09_blinn() -> SceneDescription {
         week09_spheres([0.2, 0.6, 0.2], [0.08, 8.0, 300.0]),
         RenderSettings {
             diffuse_sampling: DiffuseSampling::Cosine,
-            sampling: PixelSampling::CourseJittered,
-            jitter_step: Some(1.0 / 3.0),
             ..RenderSettings::default()
         },
     )
