@@ -12,13 +12,168 @@
 //! - HTML: [`html`];
 //! - CSV (`gradebook.csv`): [`csv_cell`] quotes per RFC 4180 and defuses formulas (a cell starting
 //!   with `=`, `+`, `-`, `@`, tab or carriage return is prefixed with `'`, as OWASP advises);
-//! - XML (JUnit) keeps its own writer in `grade::report::junit`, which already drops what XML
-//!   forbids and escapes the rest.
+//! - XML (JUnit): [`xml`], for element content and quoted attribute values;
+//! - JSON: serde's writer (every candidate text is a JSON string value).
+//!
+//! **One door.** Text that comes from a candidate is kept as [`Untrusted`]: it has no `Display`,
+//! no `Deref` and no way to be read as a `&str` for output; it can only be written out through
+//! one of its methods, each escaping it for one format (or serialised, which escapes it for
+//! JSON). A new report path that forgets to escape does not compile. The result model keeps as
+//! `Untrusted` what a submission names or says, whole: its folder's name, each check's message
+//! (a render's exception, a copy finding, the code's error), each failing vector's message,
+//! why its code could not run and what it wrote to stderr
+//! (`tests/integration/hostile.rs` sends a hostile payload through every path into every
+//! format).
 //!
 //! No function here bounds length: caps belong to the harness that keeps the text ([`truncate`]
 //! helps it).
 
 use std::fmt::Write;
+
+use serde::{Deserialize, Serialize};
+
+/// Text a candidate controls (a submission's folder name, an exception's message, a message
+/// quoting what the code answered): it can only be written out escaped for a format, through
+/// its methods, or serialised (a JSON string, escaped by the JSON writer). Made from any string
+/// (`From`); compared, searched and measured without being written out.
+#[derive(Clone, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Untrusted(String);
+
+impl From<String> for Untrusted {
+    fn from(s: String) -> Self {
+        Untrusted(s)
+    }
+}
+
+impl From<&str> for Untrusted {
+    fn from(s: &str) -> Self {
+        Untrusted(s.to_string())
+    }
+}
+
+impl Untrusted {
+    /// The text for one line of a terminal ([`terminal_line`]).
+    pub fn terminal_line(&self) -> String {
+        terminal_line(&self.0)
+    }
+
+    /// The text for a terminal, lines kept ([`terminal_text`]).
+    pub fn terminal_text(&self) -> String {
+        terminal_text(&self.0)
+    }
+
+    /// The text inside a Markdown sentence ([`markdown_inline`]).
+    pub fn markdown_inline(&self) -> String {
+        markdown_inline(&self.0)
+    }
+
+    /// The text as a fenced Markdown block ([`markdown_block`]).
+    pub fn markdown_block(&self, info: &str) -> String {
+        markdown_block(&self.0, info)
+    }
+
+    /// The text for HTML ([`html`]).
+    pub fn html(&self) -> String {
+        html(&self.0)
+    }
+
+    /// The text as one CSV cell ([`csv_cell`]).
+    pub fn csv_cell(&self) -> String {
+        csv_cell(&self.0)
+    }
+
+    /// The text for XML ([`xml`]).
+    pub fn xml(&self) -> String {
+        xml(&self.0)
+    }
+
+    /// The text as a file or folder name, for the file system only (never for a report): a
+    /// batch's submission folders are named by it.
+    pub fn as_file_name(&self) -> &str {
+        &self.0
+    }
+
+    /// Whether it is `s`.
+    pub fn is(&self, s: &str) -> bool {
+        self.0 == s
+    }
+
+    /// Whether it holds `s`.
+    pub fn contains(&self, s: &str) -> bool {
+        self.0.contains(s)
+    }
+
+    /// Whether it starts with `s`.
+    pub fn starts_with(&self, s: &str) -> bool {
+        self.0.starts_with(s)
+    }
+
+    /// Whether it ends with `s`.
+    pub fn ends_with(&self, s: &str) -> bool {
+        self.0.ends_with(s)
+    }
+
+    /// Whether it is empty.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// Its length in bytes.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// The text without the prefix `s`, when it starts with it.
+    pub fn strip_prefix(&self, s: &str) -> Option<Untrusted> {
+        self.0.strip_prefix(s).map(Untrusted::from)
+    }
+
+    /// Appends `s` (the harness's words): the whole stays untrusted.
+    pub fn push_str(&mut self, s: &str) {
+        self.0.push_str(s);
+    }
+
+    /// Appends `more`.
+    pub fn push(&mut self, more: &Untrusted) {
+        self.0.push_str(&more.0);
+    }
+
+    /// Its lines (without their newlines), each still untrusted.
+    pub fn lines(&self) -> Vec<Untrusted> {
+        self.0.lines().map(Untrusted::from).collect()
+    }
+
+    /// The text without whitespace at its end.
+    pub fn trim_end(&self) -> Untrusted {
+        Untrusted::from(self.0.trim_end())
+    }
+
+    /// The text without the untrusted suffix `s`, when it ends with it.
+    pub fn strip_suffix_of(&self, s: &Untrusted) -> Option<Untrusted> {
+        self.strip_suffix(&s.0)
+    }
+
+    /// The text without the suffix `s`, when it ends with it.
+    pub fn strip_suffix(&self, s: &str) -> Option<Untrusted> {
+        self.0.strip_suffix(s).map(Untrusted::from)
+    }
+
+    /// Its first line (without the newline), still untrusted.
+    pub fn first_line(&self) -> Untrusted {
+        Untrusted::from(self.0.lines().next().unwrap_or(""))
+    }
+
+    /// The text cut to at most `max_bytes` ([`truncate`]).
+    pub fn truncated(&self, max_bytes: usize) -> Untrusted {
+        Untrusted(truncate(&self.0, max_bytes))
+    }
+
+    /// This text, then `more` (the harness's words or the candidate's), all of it untrusted.
+    pub fn join(&self, sep: &str, more: &Untrusted) -> Untrusted {
+        Untrusted(format!("{}{sep}{}", self.0, more.0))
+    }
+}
 
 /// Writes `c` as `\xHH` (or `\u{HHHH}` above U+00FF).
 fn push_escaped(out: &mut String, c: char) {
@@ -224,6 +379,31 @@ pub fn csv_cell(s: &str) -> String {
     }
 }
 
+/// Text for XML element content or a quoted attribute value (JUnit): `& < > " '` as entities,
+/// newline, tab and carriage return as character references, and every other control
+/// character (C0, DEL, C1, bidirectional and zero-width controls) shown as `\x1b` or
+/// `\u{202e}` (as [`terminal_text`] does), so nothing XML forbids is written and no viewer
+/// reorders or hides text.
+pub fn xml(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            '\n' | '\t' | '\r' => {
+                let _ = write!(out, "&#{};", c as u32);
+            }
+            '\u{fffe}' | '\u{ffff}' => push_escaped(&mut out, c),
+            c if is_control(c) => push_escaped(&mut out, c),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 /// `s` cut to at most `max_bytes` bytes on a character boundary, with a note of how much was
 /// left out (`... [12345 more bytes]`) when it was cut.
 pub fn truncate(s: &str, max_bytes: usize) -> String {
@@ -305,6 +485,34 @@ mod tests {
         assert_eq!(csv_cell("-1"), "\"'-1\"");
         assert_eq!(csv_cell("@x"), "\"'@x\"");
         assert_eq!(csv_cell("a\x1bb"), "a\\x1bb");
+    }
+
+    #[test]
+    fn xml_escapes_markup_and_shows_controls() {
+        assert_eq!(xml("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&apos;");
+        assert_eq!(
+            xml("x\u{1}y\nz\u{1b}[2J\u{202e}\u{0}"),
+            "x\\x01y&#10;z\\x1b[2J\\u{202e}\\x00"
+        );
+    }
+
+    #[test]
+    fn untrusted_text_is_written_only_escaped() {
+        let t = Untrusted::from("# Score: 100 / 100\n<img onerror=x>\u{1b}[31m");
+        assert_eq!(
+            t.terminal_line(),
+            "# Score: 100 / 100\\x0a<img onerror=x>\\x1b[31m"
+        );
+        assert!(!t.markdown_inline().contains('<') && t.markdown_inline().starts_with("\\#"));
+        assert!(!t.html().contains('<'));
+        assert!(!t.xml().contains('<'));
+        assert_eq!(Untrusted::from("=1").csv_cell(), "\"'=1\"");
+        // JSON: a string, escaped by the JSON writer.
+        assert_eq!(
+            serde_json::to_string(&t).unwrap(),
+            "\"# Score: 100 / 100\\n<img onerror=x>\\u001b[31m\""
+        );
+        assert!(t.starts_with("# Score") && t.contains("onerror") && !t.is("x"));
     }
 
     #[test]

@@ -38,8 +38,13 @@ pub const MAX_SKIPPED_NAMED: usize = 20;
 pub const PYTHON_COURSE_ADAPTER: &str = include_str!("python_course.py");
 
 /// The adapter's driver of the course's functions of weeks 5 to 10 (function requests,
-/// `docs/PROTOCOL.md`), written beside the adapter, which loads it from its own folder.
-pub const COURSE_FUNCTIONS_DRIVER: &str = include_str!("../functions/course_functions.py");
+/// `docs/PROTOCOL.md`), written beside the adapter, which loads it from its own folder. The
+/// material requests' driver (`rtoracle physics`) is appended to it: it extends the driver's
+/// `OPS` and `answer`.
+pub const COURSE_FUNCTIONS_DRIVER: &str = concat!(
+    include_str!("../functions/course_functions.py"),
+    include_str!("../physics/course_materials.py")
+);
 
 /// The driver's name in the sandbox folder (the adapter's `FUNCTIONS_FILE`).
 const FUNCTIONS_NAME: &str = "rtoracle_course_functions.py";

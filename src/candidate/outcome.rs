@@ -5,6 +5,9 @@
 use super::protocol::Answer;
 
 /// What the harness got for one case.
+// An answer (with its error's file, line and code) is a few hundred bytes, made once per case
+// and read once: boxing it would cost an allocation per case for nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum Outcome {
     /// An answer line with the case's id; `junk` holds the non-answer lines printed while the

@@ -31,6 +31,30 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 /// [`parse_line`]), so what is queued stays within a few tens of MB however big the lines.
 pub const LINE_QUEUE: usize = 1024;
 
+/// The environment variable naming a file that every byte sent to a candidate is appended to:
+/// how the tests (and a wary instructor) see everything that left the grader, to check that no
+/// secret did (`tests/integration/attacks.rs`). The grader's own environment only: a candidate
+/// never sees it.
+pub const RECORD_REQUESTS_ENV: &str = "RTORACLE_RECORD_REQUESTS";
+
+/// Appends `bytes` to the file [`RECORD_REQUESTS_ENV`] names, when it names one (opened once per
+/// process; a file that cannot be opened or written records nothing).
+fn record(bytes: &[u8]) {
+    static FILE: std::sync::OnceLock<Option<Mutex<std::fs::File>>> = std::sync::OnceLock::new();
+    let file = FILE.get_or_init(|| {
+        let path = std::env::var_os(RECORD_REQUESTS_ENV).filter(|p| !p.is_empty())?;
+        std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .ok()
+            .map(Mutex::new)
+    });
+    if let Some(f) = file {
+        let _ = f.lock().unwrap_or_else(|e| e.into_inner()).write_all(bytes);
+    }
+}
+
 /// The last bytes of a stream.
 #[derive(Debug, Default)]
 pub(crate) struct Tail(VecDeque<u8>);
@@ -52,6 +76,9 @@ impl Tail {
 }
 
 /// What the reader thread passes on: each stdout line parsed (and capped) on that thread.
+// A parsed line is a few hundred bytes and passed on once; boxing it would cost an allocation
+// per line for nothing.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum Line {
     /// A line, parsed.
     Parsed(ParsedLine),
@@ -147,8 +174,10 @@ impl Proc {
         })
     }
 
-    /// Queues `bytes` for the child's stdin.
+    /// Queues `bytes` for the child's stdin (and records them when `RTORACLE_RECORD_REQUESTS`
+    /// names a file: [`record`]).
     pub(crate) fn send(&self, bytes: Vec<u8>) {
+        record(&bytes);
         if let Some(w) = &self.writer {
             let _ = w.send(bytes);
         }

@@ -66,7 +66,7 @@ impl<'a> Request<'a> {
 }
 
 /// An exception or error the candidate reports for one case.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CandidateError {
     /// The exception's type, e.g. `ZeroDivisionError`.
     #[serde(rename = "type", default)]
@@ -77,14 +77,36 @@ pub struct CandidateError {
     /// The traceback, when the candidate has one.
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub traceback: String,
+    /// Where the candidate's own code raised it, as the candidate says (the course adapter:
+    /// the last frame in the submission's folder, never the adapter's): a file's name, without
+    /// a folder. Text from the candidate: capped ([`CandidateError::capped`]), and escaped
+    /// wherever it is shown.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// The line of `file` it was raised on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line: Option<u64>,
+    /// The function of `file` it was raised in, when there is one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub function: Option<String>,
+    /// The code of that line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub code: Option<String>,
 }
 
+/// `TYPE: MESSAGE (FILE, line N)`: the exception, and where the candidate's code raised it
+/// when the candidate said so (as Python writes a `SyntaxError`'s place). All of it is the
+/// candidate's text.
 impl std::fmt::Display for CandidateError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match (self.kind.is_empty(), self.message.is_empty()) {
-            (false, false) => write!(f, "{}: {}", self.kind, self.message),
-            (false, true) => f.write_str(&self.kind),
-            _ => f.write_str(&self.message),
+            (false, false) => write!(f, "{}: {}", self.kind, self.message)?,
+            (false, true) => f.write_str(&self.kind)?,
+            _ => f.write_str(&self.message)?,
+        }
+        match self.place() {
+            Some(place) => write!(f, " ({place})"),
+            None => Ok(()),
         }
     }
 }
@@ -142,7 +164,7 @@ impl Answer {
             error: Some(CandidateError {
                 kind: kind.into(),
                 message: message.into(),
-                traceback: String::new(),
+                ..CandidateError::default()
             }),
             ..Answer::default()
         }
@@ -211,16 +233,42 @@ impl CandidateError {
                 crate::escape::truncate(&s, max)
             }
         };
+        let short =
+            |s: Option<String>| s.map(|s| crate::escape::truncate(&s, max.min(MAX_QUOTE_CHARS)));
         CandidateError {
             kind: cut(self.kind),
             message: cut(self.message),
             traceback: cut(self.traceback),
+            // A name, not a path: what follows the last `/`.
+            file: short(
+                self.file
+                    .map(|f| f.rsplit('/').next().unwrap_or_default().to_string()),
+            ),
+            line: self.line,
+            function: short(self.function),
+            code: short(self.code),
         }
     }
 
     /// Bytes of text the error holds.
     pub fn text_len(&self) -> usize {
-        self.kind.len() + self.message.len() + self.traceback.len()
+        self.kind.len()
+            + self.message.len()
+            + self.traceback.len()
+            + [&self.file, &self.function, &self.code]
+                .iter()
+                .map(|s| s.as_ref().map_or(0, String::len))
+                .sum::<usize>()
+    }
+
+    /// Where the candidate's code raised it, when the candidate said (a file, and a line):
+    /// `RT_object.py, line 29` (the candidate's text, unescaped).
+    pub fn place(&self) -> Option<String> {
+        let file = self.file.as_deref().filter(|f| !f.is_empty())?;
+        Some(match self.line {
+            Some(line) => format!("{file}, line {line}"),
+            None => file.to_string(),
+        })
     }
 }
 

@@ -158,13 +158,55 @@ def multiprocessing_message(exc):
     return None
 
 
+# The adapter's own files, written beside the submission's modules: never the student's frame.
+ADAPTER_FILES = ("course_adapter.py", FUNCTIONS_FILE, PROGRAM_FILE)
+# Longest file name, function name and line of code an error's place keeps.
+PLACE_LIMIT = 200
+
+
+def raised_in(exc):
+    """Where the submission's own code raised exc: (file, line, function, code) of the last
+    frame in the submission's folder that is not one of the adapter's files (for a SyntaxError,
+    the file and line Python could not compile), or None when no frame is the submission's."""
+    folder = os.path.abspath(SUBMISSION)
+
+    def own(path):
+        path = os.path.abspath(path or "")
+        name = os.path.basename(path)
+        return os.path.dirname(path) == folder and name.endswith(".py") and name not in ADAPTER_FILES
+
+    place = None
+    try:
+        for frame in traceback.extract_tb(exc.__traceback__):
+            if own(frame.filename):
+                place = (frame.filename, frame.lineno, frame.name, frame.line)
+        if isinstance(exc, SyntaxError) and own(exc.filename) and exc.lineno:
+            place = (exc.filename, exc.lineno, None, exc.text)
+    except Exception:
+        return None
+    if place is None or not isinstance(place[1], int):
+        return None
+    path, line, function, code = place
+    code = (code or "").strip()
+    return {
+        "file": os.path.basename(path)[:PLACE_LIMIT],
+        "line": line,
+        "function": function[:PLACE_LIMIT] if isinstance(function, str) else None,
+        "code": code[:PLACE_LIMIT] if code else None,
+    }
+
+
 def error_json(exc):
+    """The protocol's error object of exc: its type, message and traceback (from the first
+    frame past the adapter's), and where the submission raised it ("file", "line", "function",
+    "code": raised_in), so that every report can name the student's file and line."""
     # Leave out the adapter's own frame: the traceback starts in the submission.
     raw = exc.__traceback__
     raw = raw.tb_next if raw else None
     tb = "".join(traceback.format_exception(type(exc), exc, raw))
     if len(tb) > TB_LIMIT:
         tb = "..." + tb[-TB_LIMIT:]
+    place = raised_in(exc)
     message = None
     if isinstance(exc, ModuleNotFoundError):
         try:
@@ -178,6 +220,9 @@ def error_json(exc):
             tb += "ModuleNotFoundError: " + message + "\n"
             if len(tb) > TB_LIMIT:
                 tb = "..." + tb[-TB_LIMIT:]
+    if message is None and isinstance(exc, SyntaxError) and place is not None:
+        # Python's message ends with "(RT_object.py, line 19)": the place says it.
+        message = exc.msg if isinstance(exc.msg, str) else None
     if message is None:
         try:
             message = multiprocessing_message(exc)
@@ -188,9 +233,12 @@ def error_json(exc):
             message = str(exc)
         except Exception:
             message = "(the exception's message cannot be printed)"
-    return json.dumps(
-        {"type": type(exc).__name__, "message": message[:TB_LIMIT], "traceback": tb}
-    )
+    error = {"type": type(exc).__name__, "message": message[:TB_LIMIT], "traceback": tb}
+    if place is not None:
+        for key, value in place.items():
+            if value is not None:
+                error[key] = value
+    return json.dumps(error)
 
 
 def triangle_maker(Triangle, Vec3):
@@ -250,6 +298,10 @@ MATERIAL_CLASSES = {
 }
 
 
+# The material classes the course defines in RT_light.py (week 5 on), not RT_material.py.
+LIGHT_CLASSES = ("Diffuse_light",)
+
+
 class Declined(Exception):
     """The submission's classes cannot build this scene (the answer says why)."""
 
@@ -284,6 +336,15 @@ class SceneBuilder:
         if c is None:
             raise Declined("%s.py has no class %s, which the scene needs" % (module, name))
         return c
+
+    def material_class(self, name):
+        """A material class: from RT_light.py where the course keeps its lights (Diffuse_light,
+        from week 5 on), else from RT_material.py."""
+        if name in LIGHT_CLASSES and os.path.exists(os.path.join(SUBMISSION, "RT_light.py")):
+            c = getattr(self.module("RT_light"), name, None)
+            if c is not None:
+                return c
+        return self.cls("RT_material", name)
 
     def color(self, c):
         return self.rtu.Color(float(c[0]), float(c[1]), float(c[2]))
@@ -322,7 +383,7 @@ class SceneBuilder:
         if kind not in MATERIAL_CLASSES:
             raise Declined("the adapter cannot build %r materials" % (kind,))
         name, keys = MATERIAL_CLASSES[kind]
-        make = self.cls("RT_material", name)
+        make = self.material_class(name)
         if kind == "textured":
             return make(textures[m["texture"]])
         args = [float(m[k]) for k in keys]
@@ -443,6 +504,10 @@ def render_tile(built, req):
     x0, y0, x1, y1 = (int(v) for v in req["tile"])
     depth = camera.max_depth
     trace = integrator.compute_scattering
+    # Week 4's compute_scattering(ray, scene) has no depth; from week 5 on it takes one.
+    if positional_count(trace) == 2:
+        shallow = trace
+        trace = lambda ray, world, depth: shallow(ray, world)
     # The course's render_jittered: floor(sqrt(spp))^2 stratified samples, summed and divided
     # by spp all the same; else spp samples of get_ray.
     if jittered:
@@ -510,7 +575,7 @@ class Renderer:
             self.program_module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(self.program_module)
             self.program = self.program_module.ProgramRenderer()
-        key = json.dumps([req["program"], req["scene"], req["spp"], req.get("seed", 0)], sort_keys=True)
+        key = json.dumps([req["program"], req["scene"], req["spp"], req.get("seed", 0), req.get("variant")], sort_keys=True)
         try:
             return self.program.answer(req, key)
         except self.program_module.Declined as d:

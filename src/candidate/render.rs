@@ -15,10 +15,14 @@
 //! answer within the time left of the job's limit ends the render with the reason, and memory is
 //! the image's own size (`3 * width * height` `f32`s) plus one answer line.
 //!
-//! When the job's program rendered the image, [`render_scene`] then asks for the tiles of one
-//! band of rows in [`CHECKED_BAND_PERIOD`] from the description ([`checked_tiles`]), with the same
-//! spp and seed and within the same time limit, and hands them back beside the film
-//! ([`RenderedImage::class_rows`]): the caller can tie the film to the candidate's own classes.
+//! A job may be a *variant* ([`RenderJob::variant`]): the scene seen from a camera the grader
+//! moved ([`CameraMove`]), by an amount the candidate cannot know in advance. Its description is
+//! sent already moved, and a program is asked to move its own camera by the same amount (the
+//! course adapter does it in `Camera.init_camera`), so that a picture made in advance cannot
+//! answer it.
+//!
+//! A program that raises is the candidate's error: the render ends with it
+//! ([`RenderOutcome::Raised`]), it does not fall back to the description.
 
 use std::time::{Duration, Instant};
 
@@ -40,16 +44,46 @@ pub struct RenderJob<'a> {
     pub scene: &'a SceneDescription,
     /// Samples per pixel (the scene's own count is ignored).
     pub spp: u32,
-    /// A seed the candidate may use for its random numbers (the course adapter does).
+    /// A seed the candidate may use for its random numbers (the course adapter does); sent in
+    /// every request (grading derives it from the rubric's secret: [`crate::secret`]).
     pub seed: u64,
     /// Wall time the whole render may take, from the first tile's request.
     pub time_limit: Duration,
     /// The candidate's own program that renders this scene (a course `main.py` render
     /// function, `renderMoving`), asked for when its hello lists `"render_program"`: the answer
     /// is then the 8-bit film the program saves. When the program cannot render it (declined,
-    /// raised, the wrong size), the scene is rendered from its description, and the image says
-    /// why ([`MadeBy::DescriptionInstead`]).
+    /// or an answer of the wrong size), the scene is rendered from its description, and the
+    /// image says why ([`MadeBy::DescriptionInstead`]); a program that raises ends the render.
     pub program: Option<&'a str>,
+    /// The camera move of a variant: [`scene`](Self::scene) is already seen from the moved
+    /// camera, and a program is asked to move its own camera by the same amount (the request's
+    /// `"variant"`).
+    pub variant: Option<CameraMove>,
+}
+
+/// How the grader moved a scene's camera for a variant: added to the camera's `look_from` and
+/// `look_at`, its vertical field of view multiplied by `vfov_scale`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct CameraMove {
+    /// Added to `look_from`.
+    pub look_from: [f64; 3],
+    /// Added to `look_at`.
+    pub look_at: [f64; 3],
+    /// The vertical field of view is multiplied by it.
+    pub vfov_scale: f64,
+}
+
+impl CameraMove {
+    /// `scene` seen from the moved camera.
+    pub fn apply(&self, scene: &SceneDescription) -> SceneDescription {
+        let mut d = scene.clone();
+        for k in 0..3 {
+            d.camera.look_from[k] += self.look_from[k];
+            d.camera.look_at[k] += self.look_at[k];
+        }
+        d.camera.vfov *= self.vfov_scale;
+        d
+    }
 }
 
 /// How a render was made.
@@ -89,28 +123,7 @@ pub struct RenderedImage {
     pub film: Option<Vec<u8>>,
     /// How it was made.
     pub made_by: MadeBy,
-    /// For a program's film: some of its rows rendered again from the scene's description with
-    /// the candidate's own classes ([`ClassRows`]), so that the film can be tied to the
-    /// candidate's code. `None` for a render from the description.
-    pub class_rows: Option<ClassRows>,
 }
-
-/// Rows of a program's film rendered again from the scene's description by the candidate's
-/// own classes, at the same spp and seed. A program could save a picture it carries (a
-/// reference render, say) instead of rendering; these rows are what its classes compute, and a
-/// grader judges them too ([`checked_tiles`] says which rows).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ClassRows {
-    /// The rows, top to bottom.
-    pub rows: Vec<usize>,
-    /// Their mean linear RGB, the rows stacked in that order (`rows.len() * width` pixels), or
-    /// why the classes did not render them (the render's [`RenderOutcome::reason`]).
-    pub rendered: Result<Vec<[f32; 3]>, String>,
-}
-
-/// One band of rows in this many is rendered again from the description after a program's
-/// film ([`checked_tiles`]): about a sixth of the image, so a sixth of the render's time.
-pub const CHECKED_BAND_PERIOD: usize = 6;
 
 /// How a render ended.
 #[derive(Clone, Debug, PartialEq)]
@@ -136,6 +149,12 @@ pub enum RenderOutcome {
 }
 
 impl RenderOutcome {
+    /// Whether an answer broke the protocol (a malformed answer, a key a render answer does not
+    /// have): the bundled adapter never does, so a person should look.
+    pub fn is_protocol_error(&self) -> bool {
+        matches!(self, RenderOutcome::Invalid(why) if why.starts_with("a protocol error"))
+    }
+
     /// One sentence saying why there is no image (`None` for a rendered one).
     pub fn reason(&self) -> Option<String> {
         match self {
@@ -184,28 +203,6 @@ pub fn tiles(width: usize, height: usize) -> Vec<[usize; 4]> {
     out
 }
 
-/// The tiles of a `width` x `height` image that are rendered again from the description after a
-/// program's film, and the rows they cover (top to bottom): of the bands of rows [`tiles`] makes
-/// (its whole-row tiles, or single rows when a row takes several tiles), one in
-/// [`CHECKED_BAND_PERIOD`], starting at the band `seed % CHECKED_BAND_PERIOD`, so which rows are
-/// checked depends on the grader's seed. An image with fewer bands than that starts at band 0.
-pub fn checked_tiles(width: usize, height: usize, seed: u64) -> (Vec<[usize; 4]>, Vec<usize>) {
-    let all = tiles(width, height);
-    let band_rows = all.first().map_or(1, |t| t[3] - t[1]);
-    let bands = height.div_ceil(band_rows.max(1));
-    let mut start = (seed % CHECKED_BAND_PERIOD as u64) as usize;
-    if start >= bands {
-        start = 0;
-    }
-    let chosen: Vec<[usize; 4]> = all
-        .into_iter()
-        .filter(|t| (t[1] / band_rows.max(1)) % CHECKED_BAND_PERIOD == start)
-        .collect();
-    let mut rows: Vec<usize> = chosen.iter().flat_map(|t| t[1]..t[3]).collect();
-    rows.dedup();
-    (chosen, rows)
-}
-
 /// The scene as sent: each image texture carries its picture as `png_hex`, the hex of a PNG
 /// of the 8-bit RGB the reference reads (a generated picture, or the file decoded: a JPEG is
 /// sent as the reference decodes it), so the candidate reads exactly the golden's texels and
@@ -250,6 +247,9 @@ pub fn render_request(job: &RenderJob, scene: &Value, tile: [usize; 4]) -> Value
     });
     if let Some(program) = job.program {
         request["program"] = json!(program);
+        if let Some(v) = &job.variant {
+            request["variant"] = json!(v);
+        }
     }
     request
 }
@@ -409,19 +409,20 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
     }
     let start = Instant::now();
     let Some(program) = job.program else {
-        return render_tiles(session, job, start, None, None);
+        return render_tiles(session, job, start, None);
     };
     let why = if session.hello().answers("render_program") {
-        match render_tiles(session, job, start, Some(program), None) {
-            RenderOutcome::Rendered(image) => return with_class_rows(session, job, start, image),
-            done @ RenderOutcome::TimedOut { .. } => return done,
+        match render_tiles(session, job, start, Some(program)) {
+            done @ (RenderOutcome::Rendered(_)
+            | RenderOutcome::TimedOut { .. }
+            | RenderOutcome::Raised(_)) => return done,
             failed => failed.reason().unwrap_or_default(),
         }
     } else {
         "the candidate does not run its own program (its hello does not list \"render_program\")"
             .to_string()
     };
-    match render_tiles(session, job, start, None, None) {
+    match render_tiles(session, job, start, None) {
         RenderOutcome::Rendered(mut image) => {
             image.made_by = MadeBy::DescriptionInstead {
                 program: program.to_string(),
@@ -433,37 +434,13 @@ pub fn render_scene(session: &mut Session, job: &RenderJob) -> RenderOutcome {
     }
 }
 
-/// Renders again from the description, with the candidate's classes, the rows of a program's
-/// film that [`checked_tiles`] picks, within the time left of the job's limit, and keeps them in
-/// the image's [`class_rows`](RenderedImage::class_rows).
-fn with_class_rows(
-    session: &mut Session,
-    job: &RenderJob,
-    start: Instant,
-    mut image: RenderedImage,
-) -> RenderOutcome {
-    let (width, height) = (image.width, image.height);
-    let (tiles, rows) = checked_tiles(width, height, job.seed);
-    let rendered = match render_tiles(session, job, start, None, Some(&tiles)) {
-        RenderOutcome::Rendered(sample) => Ok(rows
-            .iter()
-            .flat_map(|&y| sample.data[y * width..(y + 1) * width].iter().copied())
-            .collect()),
-        other => Err(other.reason().unwrap_or_default()),
-    };
-    image.class_rows = Some(ClassRows { rows, rendered });
-    RenderOutcome::Rendered(image)
-}
-
-/// Renders `job` from its description, or by `program` (its film), every tile (or the tiles
-/// of `only`, the rest of the image left black) within the job's time limit counted from
-/// `start`.
+/// Renders `job` from its description, or by `program` (its film), every tile, within the job's
+/// time limit counted from `start`.
 fn render_tiles(
     session: &mut Session,
     job: &RenderJob,
     start: Instant,
     program: Option<&str>,
-    only: Option<&[[usize; 4]]>,
 ) -> RenderOutcome {
     let camera = job.scene.camera(None);
     let (width, height) = (camera.width, camera.height);
@@ -480,8 +457,7 @@ fn render_tiles(
     let mut data = vec![[0f32; 3]; width * height];
     let mut film = program.map(|_| vec![0u8; 3 * width * height]);
     let mut rows_done = 0;
-    let plan = only.map_or_else(|| tiles(width, height), <[_]>::to_vec);
-    for (k, tile) in plan.into_iter().enumerate() {
+    for (k, tile) in tiles(width, height).into_iter().enumerate() {
         let left = deadline.saturating_duration_since(Instant::now());
         let timed_out = RenderOutcome::TimedOut {
             limit: job.time_limit,
@@ -494,6 +470,9 @@ fn render_tiles(
         let request = render_request(&asked, &scene, tile);
         match session.call(&format!("render-{k}"), &request, left) {
             CallOutcome::Result(result) => {
+                if let Some(why) = unknown_render_key(&result) {
+                    return RenderOutcome::Invalid(why);
+                }
                 if let Some(why) = result.get("declined") {
                     let why = why.as_str().map_or_else(|| why.to_string(), str::to_string);
                     return RenderOutcome::Declined(crate::escape::truncate(&why, 400));
@@ -511,6 +490,9 @@ fn render_tiles(
             }
             CallOutcome::Error(e) => return RenderOutcome::Raised(e),
             CallOutcome::TimedOut => return timed_out,
+            CallOutcome::Protocol(why) => {
+                return RenderOutcome::Invalid(format!("a protocol error: {why}"));
+            }
             CallOutcome::Failed(why) => {
                 if Instant::now() >= deadline {
                     return timed_out;
@@ -527,7 +509,24 @@ fn render_tiles(
         data,
         made_by: program.map_or(MadeBy::Description, |p| MadeBy::Program(p.to_string())),
         film,
-        class_rows: None,
+    })
+}
+
+/// The keys a render answer's `result` may hold (docs/PROTOCOL.md, "Render requests").
+pub const RENDER_KEYS: [&str; 5] = ["tile", "size", "rgb", "film", "declined"];
+
+/// A protocol error when a render answer's `result` is not an object or holds a key
+/// [`RENDER_KEYS`] does not name.
+fn unknown_render_key(result: &serde_json::Value) -> Option<String> {
+    let Some(map) = result.as_object() else {
+        return Some("a protocol error: the render answer's \"result\" is not an object".into());
+    };
+    map.keys().find(|k| !RENDER_KEYS.contains(&k.as_str())).map(|k| {
+        format!(
+            "a protocol error: the render answer has the key \"{}\", which it does not have (its keys: {})",
+            crate::escape::truncate(k, 60),
+            RENDER_KEYS.join(", ")
+        )
     })
 }
 
@@ -551,34 +550,6 @@ mod tests {
             assert!(seen.iter().all(|&n| n == 1), "{w}x{h}");
         }
         assert!(tiles(0, 5).is_empty());
-    }
-
-    #[test]
-    fn checked_rows_are_one_band_in_the_period_chosen_by_the_seed() {
-        for (w, h) in [(320, 180), (400, 400), (5000, 3), (7, 1000), (1, 1)] {
-            let band = tiles(w, h)[0][3] - tiles(w, h)[0][1];
-            let mut covered = vec![0usize; h];
-            for seed in 0..CHECKED_BAND_PERIOD as u64 {
-                let (chosen, rows) = checked_tiles(w, h, seed);
-                assert!(!rows.is_empty(), "{w}x{h} seed {seed}");
-                // Whole rows: every pixel of a chosen row is in exactly one chosen tile.
-                let pixels: usize = chosen.iter().map(|t| (t[2] - t[0]) * (t[3] - t[1])).sum();
-                assert_eq!(pixels, rows.len() * w, "{w}x{h} seed {seed}");
-                assert!(rows.windows(2).all(|r| r[0] < r[1]));
-                // About one row in the period, never more than a band over it.
-                assert!(
-                    rows.len() <= h.div_ceil(CHECKED_BAND_PERIOD) + band,
-                    "{w}x{h}"
-                );
-                for &r in &rows {
-                    covered[r] += 1;
-                }
-            }
-            // Over the period's seeds every row is checked (when the image has that many bands).
-            if h.div_ceil(band) >= CHECKED_BAND_PERIOD {
-                assert!(covered.iter().all(|&n| n == 1), "{w}x{h}: {covered:?}");
-            }
-        }
     }
 
     /// The answer of a pixel at the worst length the course adapter writes (`repr` of a float

@@ -285,7 +285,7 @@ fn failure(
 
 /// What fails the check on a vector that is not scored: a time-out or a dead process, which no
 /// answer excuses.
-fn unscored_failure(outcome: &Outcome) -> Option<(FailureKind, String)> {
+pub fn unscored_failure(outcome: &Outcome) -> Option<(FailureKind, String)> {
     let note = "on a vector that is not scored, but a candidate must answer every vector";
     match outcome {
         Outcome::Timeout { .. } => Some((

@@ -129,9 +129,8 @@ impl CheckReport {
         if c.watertight > 0 {
             let _ = writeln!(
                 s,
-                "watertight groups: {} judged, {} cracked (a ray through an edge or vertex that \
-                 shapes share hit none of them)",
-                c.watertight, c.watertight_cracked
+                "watertight groups: {}",
+                super::watertight::groups_summary(c.watertight, c.watertight_cracked)
             );
         }
         if c.left_unrun() > 0 {

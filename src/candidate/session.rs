@@ -452,13 +452,16 @@ impl Session {
             self.collect(cases, &pending, &mut outcomes, &index);
         }
         // A run can end between two of the watchdog's ticks (code that fills its /tmp at import
-        // and then answers every case with the error): measure once more while it lives, and
-        // say what it passed.
+        // and then answers every case with the error): measure once more while it lives. What
+        // it passed is said in the notes whichever found it: a tick that comes after the last
+        // answer stops the code with no case left to die of it.
         if self.sandbox.violation().is_none() {
             self.sandbox.measure_now();
-            if let Some(violation) = self.sandbox.violation() {
-                self.notes.push(violation);
-            }
+        }
+        if let Some(violation) = self.sandbox.violation()
+            && !self.notes.contains(&violation)
+        {
+            self.notes.push(violation);
         }
         Ok(outcomes
             .into_iter()
@@ -551,10 +554,7 @@ impl Session {
             };
             match next {
                 Ok(Line::Parsed(ParsedLine::Result { id: got, text })) if got == id => {
-                    return match serde_json::from_str::<serde_json::Value>(&text) {
-                        Ok(mut v) => CallOutcome::Result(v["result"].take()),
-                        Err(e) => CallOutcome::Failed(format!("a malformed answer: {e}")),
-                    };
+                    return result_of(&text);
                 }
                 Ok(Line::Parsed(ParsedLine::Answer {
                     id: got, answer, ..
@@ -562,7 +562,7 @@ impl Session {
                     let answer = self.keep(answer);
                     return match answer.error {
                         Some(error) => CallOutcome::Error(error),
-                        None => CallOutcome::Failed(
+                        None => CallOutcome::Protocol(
                             "it answered with an intersection's answer, not a \"result\"".into(),
                         ),
                     };
@@ -572,12 +572,12 @@ impl Session {
                     problem,
                     quoted,
                 })) if got.as_deref().is_none_or(|g| g == id) => {
-                    return CallOutcome::Failed(format!(
+                    return CallOutcome::Protocol(format!(
                         "a malformed answer ({problem}): the line was {quoted}"
                     ));
                 }
                 Ok(Line::Oversize(head)) => {
-                    return CallOutcome::Failed(oversize_message(&head, MAX_LINE_BYTES));
+                    return CallOutcome::Protocol(oversize_message(&head, MAX_LINE_BYTES));
                 }
                 Ok(Line::Parsed(_)) => {}
                 Ok(Line::Partial(head)) => partial = Some(head),
@@ -816,6 +816,25 @@ impl Session {
     }
 }
 
+/// The outcome of an answer line holding a `result` (its text): the `result`, or a protocol
+/// error when the line holds a key beside `id` and `result` (an answer's keys are fixed: a
+/// marker such as `"unsteered"` next to them is not ignored).
+fn result_of(text: &str) -> CallOutcome {
+    match serde_json::from_str::<serde_json::Value>(text) {
+        Ok(serde_json::Value::Object(mut map)) => {
+            match map.keys().find(|k| *k != "id" && *k != "result") {
+                Some(k) => CallOutcome::Protocol(format!(
+                    "the answer has the key \"{}\" beside \"id\" and \"result\", which the protocol does not name",
+                    crate::escape::truncate(k, 60)
+                )),
+                None => CallOutcome::Result(map.remove("result").unwrap_or_default()),
+            }
+        }
+        Ok(_) => CallOutcome::Protocol("the answer is not a JSON object".into()),
+        Err(e) => CallOutcome::Protocol(format!("a malformed answer: {e}")),
+    }
+}
+
 /// What one request sent with [`Session::call`] got.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CallOutcome {
@@ -825,9 +844,13 @@ pub enum CallOutcome {
     Error(CandidateError),
     /// No answer within the time given: the candidate was killed (the next call restarts it).
     TimedOut,
-    /// No answer: the candidate died, could not start, broke the protocol, or the session's
-    /// time budget is used up; why.
+    /// No answer: the candidate died, could not start, or the session's time budget is used
+    /// up; why.
     Failed(String),
+    /// An answer that breaks the protocol: a malformed line, an intersection's answer, a key
+    /// beside `id` and `result`; why. A failure of the request, counted apart by the callers
+    /// (a person should look at it: the bundled adapter never makes one).
+    Protocol(String),
 }
 
 enum CountKind {

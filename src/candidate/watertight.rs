@@ -81,6 +81,15 @@ pub fn judge_groups(cases: &[Case], outcomes: &[Outcome]) -> Vec<Group> {
     groups
 }
 
+/// The watertight groups of a run in words, as `check` and `grade` both say them:
+/// `16 judged, 16 cracked (a ray through an edge or vertex that shapes share hit none of them)`.
+pub fn groups_summary(judged: usize, cracked: usize) -> String {
+    format!(
+        "{judged} judged, {cracked} cracked (a ray through an edge or vertex that shapes share \
+         hit none of them)"
+    )
+}
+
 /// The failure message of a cracked group.
 pub fn crack_message(group: &Group, cases: &[Case]) -> String {
     let ids: Vec<&str> = group

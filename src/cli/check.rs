@@ -177,7 +177,9 @@ impl Target {
                     python::PythonError::Sandbox(e) => with_hint(e),
                     other => other.into(),
                 })?;
-                CandidateCommand::python_course_with(dir, Some(&python), false)?
+                // What the submission prints goes to stderr, as when grading: a debug print
+                // is not an answer, and `check` and `grade` give one verdict.
+                CandidateCommand::python_course_with(dir, Some(&python), true)?
             }
             (_, Some(cmd)) => {
                 if sandbox.python.is_some() {
@@ -317,6 +319,7 @@ fn current_submission() -> anyhow::Result<PathBuf> {
 }
 
 pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
+    use rtoracle::functions::report::CheckDocument;
     if let Some(folder) = args.folder.take() {
         check_submission_folder(&folder, "")?;
         args.target.python_course = Some(folder);
@@ -380,7 +383,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         report.intersections.judged_by = Some(judged_by);
         report.intersections.required = args.require.clone();
         let text = if args.json {
-            report.to_json()
+            report.document().to_json()
         } else {
             report.to_text(args.show)
         };
@@ -395,7 +398,14 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     report.judged_by = Some(judged_by);
     report.required = args.require.clone();
     let text = if args.json {
-        report.to_json()
+        let why = match (&folder, args.week) {
+            (None, _) => "an adapter: the intersection vectors only",
+            (Some(_), Some(_)) => "--week 4: the intersection vectors only",
+            (Some(_), None) => {
+                "no file of a later week in the folder: the intersection vectors only"
+            }
+        };
+        CheckDocument::intersections(&report, why).to_json()
     } else {
         report.to_text(args.show)
     };

@@ -236,26 +236,21 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
 /// and where the gradebook is on stderr.
 fn run_merge(args: &Args) -> anyhow::Result<ExitCode> {
     let merged = rtoracle::grade::merge::merge_shards(&args.merge, &args.out)?;
-    for row in &merged.rows {
-        match &row.result {
-            Ok(r) => outln!(
-                "{}: {} / {}",
-                terminal_line(&row.name),
-                r.score,
-                r.max_score
-            )?,
+    for e in &merged {
+        match &e.result {
+            Ok(r) => outln!("{}: {} / {}", e.name.terminal_line(), r.score, r.max_score)?,
             Err(msg) => outln!(
                 "{}: not graded: {}",
-                terminal_line(&row.name),
+                e.name.terminal_line(),
                 terminal_line(msg)
             )?,
         }
     }
-    let graded = merged.rows.iter().filter(|r| r.result.is_ok()).count();
+    let graded = merged.iter().filter(|e| e.result.is_ok()).count();
     errln!(
         "merged {} shards: graded {graded} of {} submissions; gradebook in {}",
         args.merge.len(),
-        merged.rows.len(),
+        merged.len(),
         args.out.join("gradebook.csv").display()
     );
     Ok(ExitCode::SUCCESS)
@@ -266,10 +261,10 @@ fn print_batch(entries: &[batch::BatchEntry], args: &Args) -> anyhow::Result<()>
     let graded = entries.iter().filter(|e| e.result.is_ok()).count();
     for e in entries {
         match &e.result {
-            Ok(r) => outln!("{}: {} / {}", terminal_line(&e.name), r.score, r.max_score)?,
+            Ok(r) => outln!("{}: {} / {}", e.name.terminal_line(), r.score, r.max_score)?,
             Err(msg) => outln!(
                 "{}: not graded: {}",
-                terminal_line(&e.name),
+                e.name.terminal_line(),
                 terminal_line(msg)
             )?,
         }
@@ -309,6 +304,9 @@ fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::R
             round2(c.max_score),
             c.status.name()
         )?;
+        if let Some(raised) = rtoracle::grade::report::exception_of(c) {
+            outln!("  {}", raised.truncated(300).terminal_line())?;
+        }
     }
     outln!(
         "{:<width$} {:>6} / {:<6}",
@@ -316,9 +314,15 @@ fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::R
         report.score,
         report.max_score
     )?;
+    if let Some(fatal) = &report.code.fatal {
+        outln!(
+            "code: {}",
+            fatal.first_line().truncated(300).terminal_line()
+        )?;
+    }
     errln!(
         "graded {} in {:.2} s; reports in {}",
-        terminal_line(&report.submission),
+        report.submission.terminal_line(),
         report.execution_time,
         args.out.display()
     );

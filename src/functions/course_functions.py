@@ -4,7 +4,7 @@ own modules bring numpy and Pillow).
 The course adapter (course_adapter.py) loads this file from its own folder and hands it every
 request whose "op" is one of OPS (docs/PROTOCOL.md, "Function requests"). `answer(request)`
 calls the submission's own function, unmodified, and returns the answer's "result" object; an
-exception (the submission's, or NotFound / BadReturn / RandomExhausted raised here) becomes the
+exception (the submission's, or NotFound / BadReturn raised here) becomes the
 answer's "error".
 
 Finding functions. The course (weeks 5 to 10, its real code) puts reflect, refract, schlick and
@@ -32,15 +32,15 @@ convention (init_camera taking the lens's aperture instead of its defocus angle:
 lens is given as the aperture 2 focus tan(angle / 2)), the answer lists it in "departures"
 (codes rtoracle words: "aperture").
 
-Random numbers. A request's "replace" object gives the values that the course's random
-functions return for the call: "random_double" (numbers u in [0, 1]; a call
-random_double(lo, hi) returns lo + u (hi - lo)), "random_vec3_unit",
-"random_cosine_hemisphere_on_z", "random_in_unit_disk" (vectors), "rng" (numbers the camera's
-own generator returns from .random()). Each is replaced, for the call, in every module that
-holds it (`rtu.random_double` and a `from RT_utility import random_double` alike); a call past
-the values given raises RandomExhausted, and the answer says how many of each were drawn
-("draws"). Sampling requests ("n", "seed") seed numpy's global generator, Python's random and
-every np.random.default_rng() made during the call with the seed instead.
+Random numbers. A request's "replace" object steers the course's random numbers for the call:
+"random_double" gives numbers u in [0, 1] that the course's module-level random_double(lo, hi)
+returns as lo + u (hi - lo), in turn, replaced in every module that holds it; the course's Vec3
+static helpers (random_vec3_unit, random_vec3_in_unit_disk, random_cosine_hemisphere_on_z) draw
+through it, so they are steered too. "rng" gives the numbers of the camera's own numpy Generator.
+Past the values given, numbers come from the seeded generators (see Replaced). The answer never
+says what was drawn: the grader judges what the code returned (docs/weekly-checks.md).
+Sampling requests ("n", "seed") and steered ones ("seed") seed numpy's global generator,
+Python's random and every np.random.default_rng() made during the call with the seed instead.
 """
 
 import glob
@@ -70,10 +70,6 @@ class NotFound(Exception):
 
 class BadReturn(Exception):
     """A function returned something the course's never returns (None from a stub, say)."""
-
-
-class RandomExhausted(Exception):
-    """The code drew more random numbers than the request gave."""
 
 
 _state = {"dir": ".", "modules": None, "failed": None}
@@ -420,98 +416,114 @@ def make_scene(objects):
 # ---------------------------------------------------------------------------------------------
 # Replacing the random functions for one call.
 
-class _Values:
-    def __init__(self, name, values, wrap):
-        self.name = name
-        self.values = list(values)
-        self.wrap = wrap
-        self.drawn = 0
-
-    def next(self):
-        if self.drawn >= len(self.values):
-            raise RandomExhausted(
-                "%s was called more than the %d times the request allows"
-                % (self.name, len(self.values)))
-        v = self.values[self.drawn]
-        self.drawn += 1
-        return v
-
-
-class _FixedGenerator:
-    """Stands for the camera's numpy Generator: .random() and .uniform() return given values."""
+class _Stream:
+    """The values a request gives for one random source, in order; None past them (the caller
+    then draws from the seeded generator instead)."""
 
     def __init__(self, values):
-        self.values = values
+        self.values = [float(v) for v in values]
+        self.drawn = 0
+
+    def take(self):
+        self.drawn += 1
+        if self.drawn <= len(self.values):
+            return self.values[self.drawn - 1]
+        return None
+
+
+class _SteeredGenerator:
+    """Stands for the camera's numpy Generator (week 9's `camera_rng`): .random() and
+    .uniform() return the request's values, then the real generator's."""
+
+    def __init__(self, stream, real):
+        self._stream = stream
+        self._real = real
 
     def random(self, *args, **kwargs):
-        return self.values.next()
+        if args or kwargs:
+            return self._real.random(*args, **kwargs)
+        u = self._stream.take()
+        return self._real.random() if u is None else u
 
-    def uniform(self, low=0.0, high=1.0, *args, **kwargs):
-        return low + self.values.next() * (high - low)
+    def uniform(self, low=0.0, high=1.0, size=None):
+        if size is not None:
+            return self._real.uniform(low, high, size)
+        u = self._stream.take()
+        return self._real.uniform(low, high) if u is None else low + u * (high - low)
+
+    def __getattr__(self, name):
+        return getattr(self._real, name)
 
 
 class Replaced:
-    """Replaces the course's random functions named in `spec` for a `with` block."""
+    """Steers the course's random numbers for a `with` block.
 
-    VECTORS = ("random_vec3_unit", "random_cosine_hemisphere_on_z", "random_in_unit_disk")
+    `spec` maps "random_double" to numbers u in [0, 1]: the course's module-level
+    `random_double(min, max)` returns min + u (max - min) for each in turn. It is replaced in
+    every module of the submission that holds it (`rtu.random_double`, a `from RT_utility import
+    random_double`), and since the course's `Vec3` static helpers (`random_vec3_unit`,
+    `random_vec3_in_unit_disk`, `random_cosine_hemisphere_on_z`, ...) call the module-level
+    name, they are steered too, rejection loops included. "rng" gives the numbers of the
+    camera's own numpy Generator (`generator(real)` wraps one). Past the values given, draws come
+    from the seeded generator (the original `random_double`, numpy's global one): code that
+    draws more, or otherwise, than the course's still runs, and is judged by what it does.
+    """
 
     def __init__(self, spec):
         self.spec = spec or {}
         self.undo = []
-        self.counters = {}
+        self.streams = {}
 
     def __enter__(self):
         for name, values in self.spec.items():
-            if name == "rng":
-                self.counters[name] = _Values(name, [float(v) for v in values], None)
-                continue
-            if name == "random_double":
-                counter = _Values(name, [float(v) for v in values], None)
-
-                def replacement(min=0.0, max=1.0, _c=counter):
-                    return min + _c.next() * (max - min)
-            elif name in self.VECTORS:
-                counter = _Values(name, [vec3(v) for v in values], None)
-
-                def replacement(*args, _c=counter):
-                    return _c.next()
-            else:
+            if name not in ("random_double", "rng"):
                 raise ValueError("cannot replace %r" % name)
-            self.counters[name] = counter
-            original = getattr(module("RT_utility"), name, None)
-            self._swap(name, original, replacement)
+            self.streams[name] = _Stream(values)
+        if "random_double" in self.streams:
+            self._steer_random_double(self.streams["random_double"])
         return self
 
-    def _swap(self, name, original, replacement):
+    def _steer_random_double(self, stream):
+        util = module("RT_utility")
+        original = getattr(util, "random_double", None) if util is not None else None
+
+        def fallback(lo, hi):
+            if callable(original):
+                return original(lo, hi)
+            import numpy as np
+            return np.random.uniform(lo, hi)
+
+        def random_double(min=0.0, max=1.0):
+            u = stream.take()
+            if u is None:
+                return fallback(min, max)
+            return min + u * (max - min)
+
         swapped = False
         for _, m in modules():
-            value = getattr(m, name, None)
-            if value is not None and (value is original or m is module("RT_utility")):
-                self.undo.append((m, name, value))
-                setattr(m, name, replacement)
+            value = getattr(m, "random_double", None)
+            if value is not None and (value is original or m is util):
+                self.undo.append((m, value))
+                setattr(m, "random_double", random_double)
                 swapped = True
-        if not swapped:
-            util = module("RT_utility")
-            if util is not None:
-                self.undo.append((util, name, None))
-                setattr(util, name, replacement)
+        if not swapped and util is not None:
+            self.undo.append((util, None))
+            setattr(util, "random_double", random_double)
 
-    def generator(self):
-        c = self.counters.get("rng")
-        return _FixedGenerator(c) if c is not None else None
-
-    def draws(self):
-        return {name: c.drawn for name, c in self.counters.items()}
+    def generator(self, real):
+        """The camera's Generator `real`, steered by "rng" (itself when the spec has none)."""
+        stream = self.streams.get("rng")
+        return real if stream is None else _SteeredGenerator(stream, real)
 
     def __exit__(self, *exc):
-        for m, name, value in reversed(self.undo):
+        for m, value in reversed(self.undo):
             if value is None:
                 try:
-                    delattr(m, name)
+                    delattr(m, "random_double")
                 except AttributeError:
                     pass
             else:
-                setattr(m, name, value)
+                setattr(m, "random_double", value)
         return False
 
 
@@ -553,9 +565,9 @@ def op_reflect(req):
 
 def op_refract(req):
     f = find_function("refract", (), "RT_material")
-    with Replaced({"random_double": req.get("random", [])}) as r:
+    with Seeded(req.get("seed", 0)), Replaced({"random_double": req.get("random", [])}):
         out = f(vec3(req["v"]), vec3(req["n"]), float(req["ratio"]))
-    return {"vector": out_vec(out, "refract"), "draws": r.draws()}
+    return {"vector": out_vec(out, "refract")}
 
 
 def op_schlick(req):
@@ -650,12 +662,12 @@ def op_scatter(req):
     ray = make_ray(req["ray"])
     hit = make_hit(req["hit"], ray, m)
     what = type(m).__name__ + ".scattering"
-    with Seeded(req.get("seed", 0)), Replaced(req.get("replace")) as r:
+    with Seeded(req.get("seed", 0)), Replaced(req.get("replace")):
         out = scatter_once(m, ray, hit, what)
     if out is None:
-        return {"scattered": False, "draws": r.draws()}
+        return {"scattered": False}
     return {"scattered": True, "origin": out[0], "direction": out[1], "time": out[2],
-            "attenuation": out[3], "draws": r.draws()}
+            "attenuation": out[3]}
 
 
 def onb_axis(o, name):
@@ -831,12 +843,22 @@ def op_sample_scatter(req):
     return {"samples": samples}
 
 
+def steer_camera(cam, steered):
+    """Steers the camera's own numpy Generator (week 9's camera_rng) by the request's "rng"."""
+    import numpy as np
+    for name in ("camera_rng", "rng"):
+        real = getattr(cam, name, None)
+        if isinstance(real, np.random.Generator):
+            setattr(cam, name, steered.generator(real))
+
+
 def op_sample_camera_ray(req):
     n = sample_count(req)
     samples = []
     departures = []
-    with Seeded(req["seed"]):
+    with Seeded(req["seed"]), Replaced(req.get("replace")) as steered:
         cam = make_camera(req["camera"], departures)
+        steer_camera(cam, steered)
         i, j = (int(c) for c in req["pixel"])
         stratum = req.get("stratum")
         if stratum is not None:

@@ -1,12 +1,74 @@
-//! A week's function checks in words, for `rtoracle check` (the JSON form is [`WeekReport`]'s
-//! serde).
+//! A week's function checks in words, for `rtoracle check`, and the one JSON document
+//! `rtoracle check --json` prints for any week ([`CheckDocument`]).
 //!
 //! Everything the candidate controls (error messages, answers quoted in a problem) is escaped
 //! for the terminal ([`crate::escape::terminal_line`], [`crate::escape::terminal_text`]).
 
+use serde::Serialize;
+
 use super::run::{FunctionResult, Status, WeekReport};
 use super::samplers::Standing;
+use super::score::WeekScore;
+use crate::candidate::CheckReport;
 use crate::escape::{terminal_line, terminal_text};
+
+/// What `rtoracle check --json` prints says it is: [`CheckDocument::schema`].
+pub const CHECK_SCHEMA: &str = "rtoracle-check";
+
+/// The version of [`CheckDocument`]'s layout: 2 since the document has one shape for every
+/// week (version 1, unversioned, was the intersections' report at the top for week 4 and this
+/// document without `schema`, `version` and `verdict` for later weeks; `docs/commands.md`
+/// says how to read both).
+pub const CHECK_VERSION: u32 = 2;
+
+/// The one JSON document of `rtoracle check --json`, whatever the week: the intersections'
+/// report, and the week's function checks and their score (`null` for week 4 and for an
+/// adapter, which have none). Its JSON Schema is `docs/schemas/check.schema.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckDocument<'a> {
+    /// [`CHECK_SCHEMA`].
+    pub schema: &'static str,
+    /// [`CHECK_VERSION`].
+    pub version: u32,
+    /// The week checked as: 4 (the intersection vectors only) to 10.
+    pub week: u8,
+    /// How the week was found (`--week 6`, the marks in the folder's files), or why it is 4.
+    pub week_from: String,
+    /// `pass` or `fail`: the exit code's verdict (0 or 1).
+    pub verdict: &'static str,
+    /// The intersection vectors' report.
+    pub intersections: &'a CheckReport,
+    /// Sphere vectors not scored because the course's own `get_uv` raised on them (weeks 7 to
+    /// 10; 0 otherwise).
+    pub pole_crashes_excused: usize,
+    /// The week's function checks (`null` for week 4).
+    pub functions: Option<&'a WeekReport>,
+    /// The function checks scored by the week's groups (`null` for week 4).
+    pub score: Option<&'a WeekScore>,
+}
+
+impl<'a> CheckDocument<'a> {
+    /// The document of a week-4 check (or an adapter's): intersections only; `week_from` says
+    /// why it is week 4.
+    pub fn intersections(report: &'a CheckReport, week_from: impl Into<String>) -> Self {
+        CheckDocument {
+            schema: CHECK_SCHEMA,
+            version: CHECK_VERSION,
+            week: 4,
+            week_from: week_from.into(),
+            verdict: if report.passed() { "pass" } else { "fail" },
+            intersections: report,
+            pole_crashes_excused: 0,
+            functions: None,
+            score: None,
+        }
+    }
+
+    /// The document as pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a check document always serialises")
+    }
+}
 
 fn status_word(s: Status) -> &'static str {
     match s {

@@ -16,8 +16,47 @@ pub enum Reply {
     NotRun(String),
     /// No answer within the time allowed (the candidate was restarted).
     TimedOut,
-    /// No answer: the candidate died, could not start, or broke the protocol.
+    /// No answer: the candidate died, could not start, or its time budget is used up.
     Failed(String),
+    /// An answer that breaks the protocol: a malformed line, a key its op's answer does not
+    /// have ([`answer_keys`]), a wrong number of samples. A failure, never a skip, and counted
+    /// for a person to look at: the bundled adapter never makes one, so it is a broken or a
+    /// hijacked adapter.
+    Protocol(String),
+}
+
+/// The keys of the `result` of each function request (`docs/PROTOCOL.md`, "Function
+/// requests"); a check also allows every key its expectations name. Nothing else: a key such as
+/// `"unsteered"` is a protocol error. `"departures"` (where the camera is built) only adds words
+/// to the report ([`super::departures::listed`]); it never earns a point.
+pub fn answer_keys(op: &str) -> &'static [&'static str] {
+    match op {
+        "reflect" | "refract" | "halfvector" => &["vector"],
+        "schlick" => &["value"],
+        "sphere_uv" => &["uv"],
+        "quad_uv" | "intersect_at_time" => &["hit", "t", "point", "normal", "front_face", "uv"],
+        "move_sphere" => &["center"],
+        "texture" | "shade" => &["color"],
+        "brdf" => &["value", "color"],
+        "scatter" => &["scattered", "origin", "direction", "time", "attenuation"],
+        "onb" => &["u", "v", "w", "local"],
+        "camera" => &[
+            "center",
+            "u",
+            "v",
+            "w",
+            "pixel00",
+            "pixel_du",
+            "pixel_dv",
+            "defocus_radius",
+            "height",
+            "departures",
+        ],
+        "occlusion" => &["occluded"],
+        "sample_camera_ray" => &["samples", "departures"],
+        op if op.starts_with("sample_") => &["samples"],
+        _ => &[],
+    }
 }
 
 /// Something that answers function requests.
@@ -58,6 +97,7 @@ impl FunctionRunner for SessionRunner<'_> {
             CallOutcome::Error(e) => Reply::Error(e),
             CallOutcome::TimedOut => Reply::TimedOut,
             CallOutcome::Failed(why) => Reply::Failed(why),
+            CallOutcome::Protocol(why) => Reply::Protocol(why),
         }
     }
 }

@@ -24,7 +24,7 @@
 use std::sync::OnceLock;
 
 use glam::DVec3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::simulate;
 use super::stats::{TestResult, binomial, chi_square};
@@ -45,7 +45,7 @@ type CellOf = Box<dyn Fn(&Sample) -> usize + Send + Sync>;
 type Draw = Box<dyn Fn(&mut PixelSampler) -> Sample + Send + Sync>;
 
 /// What a hypothesis stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Standing {
     /// What the course's code does.
@@ -92,13 +92,14 @@ pub struct Hypothesis {
 }
 
 /// How a set of samples fits a hypothesis.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
     /// Samples that break the invariant.
     pub invariant_failures: usize,
     /// The first of them: its index and what is wrong.
     pub first_failure: Option<(usize, String)>,
     /// The test of the cell counts (of the samples that keep the invariant).
+    #[serde(deserialize_with = "super::stats::read_test")]
     pub test: Option<TestResult>,
 }
 
@@ -129,6 +130,11 @@ impl Hypothesis {
             probs,
             draw,
         }
+    }
+
+    /// Whether one sample keeps this hypothesis's invariant (what is wrong when it does not).
+    pub fn invariant_holds(&self, sample: &Sample) -> Result<(), String> {
+        (self.invariant)(sample)
     }
 
     /// A sample drawn under this hypothesis.

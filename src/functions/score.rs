@@ -131,7 +131,7 @@ pub fn week_groups(week: Week) -> &'static [GroupSpec] {
             "functions.jitter",
             "Jittered camera rays",
             30.0,
-            &["jitter"],
+            &["jitter", "camera-ray"],
         ),
     ];
     const W10: &[GroupSpec] = &[
@@ -139,7 +139,7 @@ pub fn week_groups(week: Week) -> &'static [GroupSpec] {
             "functions.defocus",
             "The lens of the jittered rays",
             50.0,
-            &["lens"],
+            &["lens", "camera-ray"],
         ),
         group(
             "functions.motion",

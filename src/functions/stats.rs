@@ -5,7 +5,7 @@
 //! functions), a maintained crate rather than a home-made series: the thresholds sit at
 //! `1e-4`, far in the tails, where a rough approximation would misstate the false-alarm rate.
 
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use statrs::distribution::{Binomial, ChiSquared, ContinuousCDF, DiscreteCDF};
 
 /// The false-alarm rate of each statistical test by default: an honest sampler fails one test
@@ -30,6 +30,33 @@ pub struct TestResult {
     pub p_value: f64,
     /// The false-alarm rate the test rejects at.
     pub alpha: f64,
+}
+
+/// A [`TestResult`] read back (a merge of shards reads the reports they wrote): its test's
+/// name must be one this module writes.
+pub(crate) fn read_test<'de, D: Deserializer<'de>>(d: D) -> Result<Option<TestResult>, D::Error> {
+    #[derive(Deserialize)]
+    struct Owned {
+        test: String,
+        statistic: f64,
+        dof: f64,
+        p_value: f64,
+        alpha: f64,
+    }
+    let Some(o) = Option::<Owned>::deserialize(d)? else {
+        return Ok(None);
+    };
+    let test = ["chi-square", "binomial"]
+        .into_iter()
+        .find(|n| *n == o.test)
+        .ok_or_else(|| serde::de::Error::custom(format!("unknown test {:?}", o.test)))?;
+    Ok(Some(TestResult {
+        test,
+        statistic: o.statistic,
+        dof: o.dof,
+        p_value: o.p_value,
+        alpha: o.alpha,
+    }))
 }
 
 impl TestResult {

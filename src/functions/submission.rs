@@ -44,6 +44,21 @@ impl WeekCheck {
         self.intersections.passed() && self.functions.passed()
     }
 
+    /// The one JSON document of `rtoracle check --json` for this check.
+    pub fn document(&self) -> super::report::CheckDocument<'_> {
+        super::report::CheckDocument {
+            schema: super::report::CHECK_SCHEMA,
+            version: super::report::CHECK_VERSION,
+            week: self.week.number(),
+            week_from: self.week_from.clone(),
+            verdict: if self.passed() { "pass" } else { "fail" },
+            intersections: &self.intersections,
+            pole_crashes_excused: self.pole_crashes_excused,
+            functions: Some(&self.functions),
+            score: Some(&self.score),
+        }
+    }
+
     /// The report as one JSON object.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a report always serialises")

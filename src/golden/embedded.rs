@@ -89,16 +89,10 @@ const EMBEDDED: &[(&str, &[u8])] = &[
 /// sampling) with the counts the built-in rubrics render them at (`week_rubrics`): their
 /// goldens at those counts are committed and compiled in too, as
 /// `golden/<scene>.spp<N>.exr`, so grading them renders no golden.
-pub const SPP_VARIANTS: &[(&str, u32)] =
-    &[("week09-blinn", 5), ("week10-dof", 5), ("week10-moving", 5)];
+pub const SPP_VARIANTS: &[(&str, u32)] = &[("week10-dof", 5), ("week10-moving", 5)];
 
 /// The compiled-in goldens of [`SPP_VARIANTS`], in its order.
 const EMBEDDED_VARIANTS: &[(&str, &str, &[u8])] = &[
-    (
-        "week09-blinn",
-        "week09-blinn.spp5.exr",
-        include_bytes!("../../golden/week09-blinn.spp5.exr"),
-    ),
     (
         "week10-dof",
         "week10-dof.spp5.exr",

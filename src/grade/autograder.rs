@@ -16,8 +16,9 @@
 //! - A secret suite: [`secret_seed`] draws the seed from the OS (`/dev/urandom`, no dependency)
 //!   when the rubric's seed is 0 (the public one) and no `--seed` is given; [`with_seed`] writes
 //!   it into the packaged rubric, which `setup.sh` installs readable only by root (mode 600).
-//!   Every seed draws the same families of cases, so fairness does not depend on it; the seed
-//!   is in each `report.json` (`reproducibility.code_checker`), so any grade can be re-run.
+//!   Every seed draws the same families of cases, so fairness does not depend on it. The seed
+//!   never leaves the grader ([`crate::secret`]): each `report.json` names it by its digest
+//!   (`reproducibility.code_checker`), so a grade re-run with the rubric can be matched to it.
 //!
 //! Gradescope's images are Ubuntu on x86_64 with glibc, so the binary packed must be built for
 //! `x86_64-unknown-linux-gnu` (or `-musl`) against a glibc no newer than the image's; the package

@@ -20,21 +20,22 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use super::batch_copies::flag_shared_noise;
+use super::batch_entry::{ENTRY_FILE, EntryFile};
 use super::copies::CopyFinding;
 use super::inputs::{CodeChecker, ImageChecker};
 use super::report::Format;
 use super::result::{CheckStatus, GradeError, GradeReport, round2};
 use super::rubric::Rubric;
 use super::write::{REPORT_FOLDER, grade_into};
-use crate::escape::{csv_cell, markdown_inline};
+use crate::escape::{Untrusted, csv_cell, markdown_inline};
 use crate::oracle::vectors::ShapeKind;
 use crate::output::OutputDir;
 
 /// One submission of a batch.
 #[derive(Debug)]
 pub struct BatchEntry {
-    /// The sub-folder's name.
-    pub name: String,
+    /// The sub-folder's name (the submission's).
+    pub name: Untrusted,
     /// Its report, or why grading it failed.
     pub result: Result<GradeReport, String>,
 }
@@ -202,7 +203,7 @@ pub fn grade_batch_shard(
                     path: output.shown(&name),
                     message: e.to_string(),
                 })?;
-                grade_into(
+                let report = grade_into(
                     sub,
                     rubric,
                     code,
@@ -210,7 +211,13 @@ pub fn grade_batch_shard(
                     &output,
                     Path::new(&name),
                     formats,
-                )
+                )?;
+                // What a merge of shards needs of it: the report as graded, its fingerprints.
+                output.write(
+                    Path::new(&name).join(ENTRY_FILE),
+                    &EntryFile::of(&report).to_bytes(),
+                )?;
+                Ok(report)
             }));
             bar.inc(1);
             let result = match result {
@@ -218,15 +225,22 @@ pub fn grade_batch_shard(
                 Ok(Err(e)) => Err(e.to_string()),
                 Err(_) => Err("the grader panicked on this submission".to_string()),
             };
-            BatchEntry { name, result }
+            BatchEntry {
+                name: name.into(),
+                result,
+            }
         })
         .collect();
     bar.finish_and_clear();
     let mut entries = entries;
+    // In name order, as a merge of shards has them.
+    entries.sort_by(|a, b| a.name.cmp(&b.name));
     flag_copies(&mut entries, &output, formats)?;
     let file = BatchFile {
-        format: BATCH_FORMAT.to_string(),
+        schema: BATCH_SCHEMA.to_string(),
+        version: BATCH_VERSION,
         rubric: BatchRubric::of(rubric),
+        graded_with: GradedWith::of(rubric, code, images, formats),
         shard,
         batch,
         rows: entries.iter().map(BatchRow::of).collect(),
@@ -238,22 +252,23 @@ pub fn grade_batch_shard(
 
 /// Flags the submissions whose images share their noise with another's
 /// ([`flag_shared_noise`]) and writes their reports again.
-fn flag_copies(
+pub(crate) fn flag_copies(
     entries: &mut [BatchEntry],
     output: &OutputDir,
     formats: &[Format],
 ) -> Result<(), GradeError> {
     let mut named: Vec<(&str, &mut GradeReport)> = entries
         .iter_mut()
-        .filter_map(|BatchEntry { name, result }| Some((name.as_str(), result.as_mut().ok()?)))
+        .filter_map(|BatchEntry { name, result }| {
+            Some((name.as_file_name(), result.as_mut().ok()?))
+        })
         .collect();
     let pairs = flag_shared_noise(&mut named);
-    let flagged: std::collections::BTreeSet<&String> =
-        pairs.iter().flat_map(|p| &p.submissions).collect();
-    for (name, report) in named
+    let flagged: std::collections::BTreeSet<&str> = pairs
         .iter()
-        .filter(|(n, _)| flagged.contains(&n.to_string()))
-    {
+        .flat_map(|p| p.submissions.iter().map(Untrusted::as_file_name))
+        .collect();
+    for (name, report) in named.iter().filter(|(n, _)| flagged.contains(n)) {
         for &f in formats {
             output.write(
                 Path::new(name).join(f.file_name()),
@@ -264,18 +279,28 @@ fn flag_copies(
     Ok(())
 }
 
-/// What `batch.json` says it is (and which version of its layout).
-pub const BATCH_FORMAT: &str = "rtoracle-batch-1";
+/// What `batch.json` says it is.
+pub const BATCH_SCHEMA: &str = "rtoracle-batch";
 
-/// What the gradebook and summary need of the rubric.
+/// The version of `batch.json`'s layout: 2 since it says what the batch was graded with and
+/// each submission's folder keeps its [`ENTRY_FILE`] (version 1 had `"format":
+/// "rtoracle-batch-1"` instead of `schema` and `version`; its shards cannot be merged with
+/// this rtoracle: grade them again).
+pub const BATCH_VERSION: u32 = 2;
+
+/// What the gradebook and summary need of the rubric, and what tells one rubric from another.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BatchRubric {
     /// Its name.
     pub name: String,
     /// Its groups' ids, in order (the gradebook's columns).
     pub groups: Vec<String>,
+    /// Each group's points, in the same order (the weights).
+    pub points: Vec<f64>,
     /// Points available.
     pub max_score: f64,
+    /// The SHA-256 of the rubric's TOML.
+    pub sha256: String,
 }
 
 impl BatchRubric {
@@ -284,7 +309,48 @@ impl BatchRubric {
         BatchRubric {
             name: rubric.name.clone(),
             groups: rubric.groups.iter().map(|g| g.id.clone()).collect(),
+            points: rubric.groups.iter().map(|g| g.points).collect(),
             max_score: rubric.max_score(),
+            sha256: rubric.sha256.clone(),
+        }
+    }
+}
+
+/// What a batch was graded with besides its rubric: shards graded otherwise cannot be merged.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GradedWith {
+    /// rtoracle's version.
+    pub tool_version: String,
+    /// The SHA-256 of the vectors run (the rubric's seed's suite, or `--vectors`): a digest of
+    /// the seed, never the seed (empty without code groups).
+    pub vectors_sha256: String,
+    /// The code checker and its options (the time-out per vector).
+    pub code_checker: String,
+    /// The image checker.
+    pub image_checker: String,
+    /// The report formats written (`--format`).
+    pub formats: Vec<String>,
+}
+
+impl GradedWith {
+    /// What a batch of `rubric` graded with `code`, `images` and `formats` records.
+    pub fn of(
+        rubric: &Rubric,
+        code: &dyn CodeChecker,
+        images: &dyn ImageChecker,
+        formats: &[Format],
+    ) -> GradedWith {
+        let has_code = rubric.groups.iter().any(|g| g.shape.is_some());
+        GradedWith {
+            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+            vectors_sha256: if has_code {
+                code.vectors_sha256()
+            } else {
+                String::new()
+            },
+            code_checker: code.describe(),
+            image_checker: images.describe(),
+            formats: formats.iter().map(|f| f.name().to_string()).collect(),
         }
     }
 }
@@ -304,7 +370,7 @@ pub struct RowCheck {
     /// still fail).
     pub failed: bool,
     /// The failing vectors it showed the student: id and message.
-    pub failures: Vec<(String, String)>,
+    pub failures: Vec<(String, Untrusted)>,
     /// Its group's id.
     #[serde(default)]
     pub group: String,
@@ -337,13 +403,17 @@ pub struct RowScores {
     pub fatal: bool,
     /// Every definite vector it failed.
     pub failed_vectors: Vec<(String, ShapeKind)>,
+    /// Answers that broke the protocol ([`super::result::CodeRun::protocol_errors`]): the
+    /// gradebook's status then asks for a review.
+    #[serde(default)]
+    pub protocol_errors: usize,
 }
 
 /// One submission of a batch as its gradebook and summary use it (what `batch.json` keeps).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BatchRow {
-    /// The sub-folder's name.
-    pub name: String,
+    /// The sub-folder's name (the submission's).
+    pub name: Untrusted,
     /// Its scores, or why grading it failed.
     pub result: Result<RowScores, String>,
 }
@@ -386,6 +456,7 @@ impl BatchRow {
                     .collect(),
                 fatal: r.code.fatal.is_some(),
                 failed_vectors: r.code.failed_vectors.clone(),
+                protocol_errors: r.code.protocol_errors,
             });
         BatchRow {
             name: entry.name.clone(),
@@ -394,14 +465,19 @@ impl BatchRow {
     }
 }
 
-/// `batch.json`: the rubric, the share graded (none: all), every submission folder of the batch
-/// (graded here or not) and the rows of those graded here, in name order.
+/// `batch.json`: the rubric, what it was graded with, the share graded (none: all), every
+/// submission folder of the batch (graded here or not) and the rows of those graded here, in
+/// name order.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BatchFile {
-    /// [`BATCH_FORMAT`].
-    pub format: String,
+    /// [`BATCH_SCHEMA`].
+    pub schema: String,
+    /// [`BATCH_VERSION`].
+    pub version: u32,
     /// The rubric's facts.
     pub rubric: BatchRubric,
+    /// What it was graded with.
+    pub graded_with: GradedWith,
     /// The share graded.
     pub shard: Option<Shard>,
     /// Every submission folder of the batch, in name order.
@@ -442,7 +518,7 @@ pub fn rows_gradebook_csv(rubric: &BatchRubric, rows: &[BatchRow]) -> String {
     }
     csv.push_str(",status\n");
     for e in rows {
-        csv.push_str(&csv_cell(&e.name));
+        csv.push_str(&e.name.csv_cell());
         match &e.result {
             Ok(r) => {
                 let groups: BTreeMap<&str, f64> =
@@ -457,7 +533,15 @@ pub fn rows_gradebook_csv(rubric: &BatchRubric, rows: &[BatchRow]) -> String {
                     let points = groups.get(g.as_str()).copied().unwrap_or(0.0);
                     let _ = write!(csv, ",{}", csv_cell(&points.to_string()));
                 }
-                csv.push_str(",ok\n");
+                if r.protocol_errors > 0 {
+                    let _ = writeln!(
+                        csv,
+                        ",review: {} protocol errors (a broken or hijacked adapter)",
+                        r.protocol_errors
+                    );
+                } else {
+                    csv.push_str(",ok\n");
+                }
             }
             Err(msg) => {
                 let _ = write!(csv, ",,{}", csv_cell(&rubric.max_score.to_string()));
@@ -479,10 +563,10 @@ const VECTORS_SHOWN: usize = 10;
 /// within their shape, then shape by shape, so a tie never hides a shape behind another's
 /// alphabetically earlier ids.
 fn most_failed(
-    vectors: BTreeMap<String, (ShapeKind, usize, String)>,
+    vectors: BTreeMap<String, (ShapeKind, usize, Untrusted)>,
     n: usize,
-) -> Vec<(String, usize, String)> {
-    let mut by_shape: BTreeMap<ShapeKind, Vec<(String, usize, String)>> = BTreeMap::new();
+) -> Vec<(String, usize, Untrusted)> {
+    let mut by_shape: BTreeMap<ShapeKind, Vec<(String, usize, Untrusted)>> = BTreeMap::new();
     for (id, (shape, count, msg)) in vectors {
         by_shape.entry(shape).or_default().push((id, count, msg));
     }
@@ -528,7 +612,7 @@ pub fn rows_summary_md(rubric: &BatchRubric, entries: &[BatchRow]) -> String {
             let _ = writeln!(
                 md,
                 "- {}: {}",
-                markdown_inline(&e.name),
+                e.name.markdown_inline(),
                 markdown_inline(e.result.as_ref().err().map_or("", |s| s))
             );
         }
@@ -583,7 +667,7 @@ fn copies_section(md: &mut String, entries: &[BatchRow]) {
         let _ = writeln!(
             md,
             "- {}: {} is {what} (scored 0).",
-            markdown_inline(name),
+            name.markdown_inline(),
             markdown_inline(file)
         );
     }
@@ -594,8 +678,8 @@ fn copies_section(md: &mut String, entries: &[BatchRow]) {
             let _ = writeln!(
                 md,
                 "| `{group}` | {} and {} | {differing} of {common} |",
-                markdown_inline(&a),
-                markdown_inline(&b)
+                a.markdown_inline(),
+                b.markdown_inline()
             );
         }
     }
@@ -650,8 +734,8 @@ fn score_distribution(md: &mut String, graded: &[&RowScores], max: f64) {
 fn common_failures(md: &mut String, graded: &[&RowScores]) {
     let mut checks: BTreeMap<String, (String, usize)> = BTreeMap::new();
     // Per vector: its shape, how many submissions failed it (having run it), one message.
-    let mut vectors: BTreeMap<String, (ShapeKind, usize, String)> = BTreeMap::new();
-    let mut examples: BTreeMap<String, String> = BTreeMap::new();
+    let mut vectors: BTreeMap<String, (ShapeKind, usize, Untrusted)> = BTreeMap::new();
+    let mut examples: BTreeMap<String, Untrusted> = BTreeMap::new();
     let mut fatal = 0usize;
     for r in graded {
         if r.fatal {
@@ -674,7 +758,7 @@ fn common_failures(md: &mut String, graded: &[&RowScores]) {
         for (id, shape) in failed {
             vectors
                 .entry(id.clone())
-                .or_insert((shape, 0, String::new()))
+                .or_insert((shape, 0, Untrusted::default()))
                 .1 += 1;
         }
     }
@@ -682,7 +766,7 @@ fn common_failures(md: &mut String, graded: &[&RowScores]) {
         *example = examples
             .get(id)
             .cloned()
-            .unwrap_or_else(|| "(not among the failures shown to any student)".to_string());
+            .unwrap_or_else(|| "(not among the failures shown to any student)".into());
     }
     md.push_str("\n## Most common failures\n\n");
     if checks.is_empty() {
@@ -705,7 +789,7 @@ fn common_failures(md: &mut String, graded: &[&RowScores]) {
                 md,
                 "| `{}` | {count} | {} |",
                 id.replace('`', "'"),
-                markdown_inline(&msg)
+                msg.markdown_inline()
             );
         }
     }
@@ -748,13 +832,19 @@ mod tests {
         for i in 0..10 {
             v.insert(
                 format!("a-sphere-{i:02}"),
-                (ShapeKind::Sphere, 3, String::new()),
+                (ShapeKind::Sphere, 3, Untrusted::default()),
             );
         }
         for i in 0..2 {
-            v.insert(format!("quad-{i:02}"), (ShapeKind::Quad, 3, String::new()));
+            v.insert(
+                format!("quad-{i:02}"),
+                (ShapeKind::Quad, 3, Untrusted::default()),
+            );
         }
-        v.insert("a-sphere-top".into(), (ShapeKind::Sphere, 5, String::new()));
+        v.insert(
+            "a-sphere-top".into(),
+            (ShapeKind::Sphere, 5, Untrusted::default()),
+        );
         let listed: Vec<String> = most_failed(v, 10).into_iter().map(|r| r.0).collect();
         assert_eq!(listed[0], "a-sphere-top");
         assert!(listed.contains(&"quad-00".to_string()), "{listed:?}");
@@ -776,7 +866,7 @@ mod tests {
                 definite: true,
                 expected: serde_json::Value::Null,
                 actual: serde_json::Value::Null,
-                message: format!("missed {i}"),
+                message: format!("missed {i}").into(),
                 repro: String::new(),
             })
             .collect();
@@ -835,8 +925,8 @@ mod tests {
         for e in &entries {
             assert_eq!(
                 e.result.is_ok(),
-                e.name == "a",
-                "{}: {:?}",
+                e.name.is("a"),
+                "{:?}: {:?}",
                 e.name,
                 e.result
             );
@@ -858,7 +948,10 @@ mod tests {
         let (_dir, out, entries) = batch_of(&["a", "b", "c"], &code);
         // The output folder inside the batch folder is not taken for a submission.
         assert_eq!(
-            entries.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(),
+            entries
+                .iter()
+                .map(|e| e.name.as_file_name())
+                .collect::<Vec<_>>(),
             ["a", "b", "c"]
         );
         assert!(entries[1].result.is_err());
@@ -911,7 +1004,7 @@ mod tests {
         .unwrap();
         let rows: Vec<(&str, bool)> = entries
             .iter()
-            .map(|e| (e.name.as_str(), e.result.is_ok()))
+            .map(|e| (e.name.as_file_name(), e.result.is_ok()))
             .collect();
         assert_eq!(
             rows,

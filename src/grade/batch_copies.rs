@@ -14,7 +14,7 @@ pub struct SharedPair {
     /// The image group's id.
     pub group: String,
     /// The two submissions, by name, in batch order.
-    pub submissions: [String; 2],
+    pub submissions: [crate::escape::Untrusted; 2],
     /// How their noise compares.
     pub noise: NoiseMatch,
 }
@@ -42,7 +42,10 @@ pub fn flag_shared_noise(reports: &mut [(&str, &mut GradeReport)]) -> Vec<Shared
     }
     let mut out = Vec::new();
     for (group, i, j, noise) in pairs {
-        let names = [reports[i].0.to_string(), reports[j].0.to_string()];
+        let names = [
+            crate::escape::Untrusted::from(reports[i].0),
+            crate::escape::Untrusted::from(reports[j].0),
+        ];
         for (me, other) in [(i, &names[1]), (j, &names[0])] {
             let finding = CopyFinding::SharedWith {
                 submission: other.clone(),
@@ -69,7 +72,7 @@ fn add_finding(report: &mut GradeReport, group: &str, finding: CopyFinding) {
     };
     if !image.copies.iter().any(|c| !c.zeroes()) {
         let sentence = finding.sentence(&image.file);
-        check.message = format!("{} {sentence}", check.message);
+        check.message.push_str(&format!(" {sentence}"));
     }
     image.copies.push(finding);
 }

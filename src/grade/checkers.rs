@@ -30,7 +30,9 @@ use crate::oracle::vectors::{Case, Class, ShapeKind};
 /// the answers.
 #[derive(Clone, Debug)]
 pub struct CourseCodeChecker {
-    /// Seed of the built-in suite.
+    /// The rubric's secret seed: the built-in suite is that of the seed derived from it for the
+    /// purpose `"vectors"` ([`crate::secret`]), so a seed printed by a hostile submission (a
+    /// render's, a sampler's) does not give the suite (`rtoracle vectors --seed`).
     pub seed: u64,
     /// Vectors to run instead of the built-in suite (a vector file the course pinned), with a
     /// label for the report (e.g. its path).
@@ -93,7 +95,7 @@ impl CourseCodeChecker {
     fn suite(&self) -> Vec<Case> {
         match &self.vectors {
             Some((_, cases)) => cases.clone(),
-            None => default_suite(self.seed),
+            None => default_suite(crate::secret::derive(self.seed, "vectors")),
         }
     }
 
@@ -143,7 +145,10 @@ impl CodeChecker for CourseCodeChecker {
     fn describe(&self) -> String {
         let suite = match &self.vectors {
             Some((label, cases)) => format!("{} vectors from {label}", cases.len()),
-            None => format!("built-in suite seed {}", self.seed),
+            None => format!(
+                "built-in suite of the rubric's seed ({})",
+                crate::secret::digest(self.seed)
+            ),
         };
         format!(
             "course adapter (as `rtoracle check --python-course`), {suite}, {} ms per vector",
@@ -178,8 +183,9 @@ impl CodeChecker for CourseCodeChecker {
     }
 
     fn check(&self, submission: &Path, groups: &[ShapeKind]) -> CodeOutcome {
-        let cases: Vec<Case> = self
-            .suite()
+        let suite = self.suite();
+        let sizes = watertight_sizes(&suite);
+        let cases: Vec<Case> = suite
             .into_iter()
             .filter(|c| groups.contains(&c.shape.kind()))
             .collect();
@@ -206,15 +212,7 @@ impl CodeChecker for CourseCodeChecker {
         let paths = PathStripper::new(&session, submission);
         out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
         let failure = if let Some(e) = &session.hello().error {
-            let text = if e.traceback.trim().is_empty() {
-                e.to_string()
-            } else {
-                e.traceback.trim_end().to_string()
-            };
-            Some(format!(
-                "importing the submission failed:\n{}",
-                paths.strip(&text)
-            ))
+            Some(import_failure(e, &paths))
         } else {
             session.start_failure().map(|why| {
                 format!(
@@ -246,7 +244,8 @@ impl CodeChecker for CourseCodeChecker {
                         }
                         None => cases,
                     };
-                    self.tally(&cases, &outcomes, &mut out, &paths)
+                    self.tally(&cases, &outcomes, &mut out, &paths);
+                    tally_unanswered_and_cracks(&cases, &outcomes, &sizes, &mut out);
                 }
                 Err(e) => fatal(&mut out, e.to_string()),
             },
@@ -255,6 +254,117 @@ impl CodeChecker for CourseCodeChecker {
         out.sandbox = serde_json::to_value(session.sandbox_facts()).unwrap_or_default();
         out
     }
+}
+
+/// What the reports say when the submission cannot be imported: the exception and where the
+/// submission raised it (`SyntaxError: expected ':' (RT_object.py, line 19)`), then Python's
+/// traceback, with the submission's file names.
+fn import_failure(e: &crate::candidate::CandidateError, paths: &PathStripper) -> String {
+    let mut text = format!(
+        "importing the submission failed: {}",
+        paths.strip(&e.to_string())
+    );
+    if !e.traceback.trim().is_empty() {
+        text.push('\n');
+        text.push_str(&paths.strip(e.traceback.trim_end()));
+    }
+    text
+}
+
+/// How many members each watertight group of `suite` has, by the group's id.
+fn watertight_sizes(suite: &[Case]) -> std::collections::HashMap<String, usize> {
+    let mut sizes = std::collections::HashMap::new();
+    for c in suite {
+        if let Some(w) = &c.expect.watertight {
+            *sizes.entry(w.group.clone()).or_insert(0) += 1;
+        }
+    }
+    sizes
+}
+
+/// What fails `rtoracle check` besides a definite vector, scored the same way here (so `check`
+/// and `grade` give one verdict and one explanation; docs/grading.md, "One verdict"): a vector
+/// that is not scored but on which the code hung or killed Python (a candidate must answer
+/// every vector) counts as a vector of its exact answer's kind answered wrong; a watertight
+/// group of class `hit` counts as one vector where the ray hits, right when the ray hit one of
+/// its shapes, wrong when every member ran and the ray went through the crack between them (a
+/// group with a member of a shape the rubric does not grade cannot crack). Both are counted
+/// under the shape of their first member, and their failures are shown as scored ones.
+fn tally_unanswered_and_cracks(
+    cases: &[Case],
+    outcomes: &[Outcome],
+    sizes: &std::collections::HashMap<String, usize>,
+    out: &mut CodeOutcome,
+) {
+    use crate::candidate::watertight::{GroupResult, crack_message, judge_groups};
+    let summary = |case: &Case, outcome: &Outcome, kind, message: String| FailureSummary {
+        id: case.id.clone(),
+        shape: case.shape.kind(),
+        tags: case.expect.tags.clone(),
+        kind,
+        definite: true,
+        expected: serde_json::to_value(&case.expect).unwrap_or_default(),
+        actual: match outcome {
+            Outcome::Answered { answer, .. } => serde_json::to_value(answer).unwrap_or(Value::Null),
+            _ => Value::Null,
+        },
+        message: message.into(),
+        repro: python_repro(case),
+    };
+    let mut extra = Vec::new();
+    for (case, outcome) in cases.iter().zip(outcomes) {
+        if case.expect.class.is_definite() {
+            continue;
+        }
+        let Some((kind, message)) = crate::candidate::report::unscored_failure(outcome) else {
+            continue;
+        };
+        let counts = out
+            .per_group
+            .get_mut(&case.shape.kind())
+            .expect("asked for");
+        match outcome {
+            Outcome::Timeout { .. } => counts.unscored_timeouts += 1,
+            _ => counts.unscored_crashes += 1,
+        }
+        counts
+            .tally
+            .record(credit::expects_hit(case), credit::Mark::Wrong);
+        extra.push(summary(case, outcome, kind, message));
+    }
+    for g in judge_groups(cases, outcomes) {
+        // A group with a member of a shape not graded holds when the others hit, as in
+        // `check` when a shape is not supported; it cannot be said to crack.
+        let whole = sizes.get(&g.id) == Some(&g.members.len());
+        if g.result == GroupResult::Unjudged || (g.result == GroupResult::Cracked && !whole) {
+            continue;
+        }
+        let first = &cases[g.members[0]];
+        let counts = out
+            .per_group
+            .get_mut(&first.shape.kind())
+            .expect("asked for");
+        counts.watertight += 1;
+        if g.result == GroupResult::Held {
+            counts.tally.record(true, credit::Mark::Right);
+            continue;
+        }
+        counts.watertight_cracked += 1;
+        counts.tally.record(true, credit::Mark::Wrong);
+        let message = crack_message(&g, cases);
+        extra.push(summary(
+            first,
+            &outcomes[g.members[0]],
+            FailureKind::Mismatch,
+            message,
+        ));
+    }
+    // The definite failures first (by shape), as the tally leaves them, then these.
+    let definite = out.failures.iter().take_while(|f| f.definite).count();
+    let rest = out.failures.split_off(definite);
+    out.failures.extend(extra);
+    out.failures.sort_by_key(|f| f.shape);
+    out.failures.extend(rest);
 }
 
 /// Marks every vector not run, for `msg`: nothing of the code could be checked.
@@ -386,7 +496,7 @@ impl CourseCodeChecker {
                 definite,
                 expected: serde_json::to_value(&case.expect).unwrap_or_default(),
                 actual,
-                message: paths.strip(&message),
+                message: paths.strip(&message).into(),
                 repro: python_repro(case),
             };
             if definite {
@@ -456,15 +566,7 @@ fn course_functions(
     };
     let paths = PathStripper::new(&session, submission);
     let failure = if let Some(e) = &session.hello().error {
-        let text = if e.traceback.trim().is_empty() {
-            e.to_string()
-        } else {
-            e.traceback.trim_end().to_string()
-        };
-        Some(format!(
-            "importing the submission failed:\n{}",
-            paths.strip(&text)
-        ))
+        Some(import_failure(e, &paths))
     } else {
         session.start_failure().map(|why| {
             format!(
@@ -580,7 +682,7 @@ mod tests {
     }
 
     fn definite(kind: ShapeKind) -> usize {
-        default_suite(0)
+        default_suite(crate::secret::derive(0, "vectors"))
             .iter()
             .filter(|c| c.shape.kind() == kind && c.expect.class.is_definite())
             .count()

@@ -173,8 +173,8 @@ pub enum CopyFinding {
     },
     /// In a batch: shares its noise with another submission's image (flagged for review).
     SharedWith {
-        /// The other submission.
-        submission: String,
+        /// The other submission (its folder's name).
+        submission: crate::escape::Untrusted,
         /// How their noise compares.
         #[serde(flatten)]
         noise: NoiseMatch,

@@ -141,6 +141,38 @@ pub struct Credit {
 /// The rule's name in `report.json`.
 pub const RULE: &str = "hit_credit_times_miss_credit";
 
+/// A check's [`Credit`] read back (a merge of shards reads the reports they wrote): its rule
+/// must be [`RULE`].
+pub(crate) fn read_credit<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<Credit>, D::Error> {
+    #[derive(Deserialize)]
+    struct Owned {
+        rule: String,
+        #[serde(flatten)]
+        tally: ClassTally,
+        hit_credit: f64,
+        miss_credit: f64,
+        fraction: f64,
+    }
+    let Some(o) = Option::<Owned>::deserialize(d)? else {
+        return Ok(None);
+    };
+    if o.rule != RULE {
+        return Err(serde::de::Error::custom(format!(
+            "unknown scoring rule {:?}",
+            o.rule
+        )));
+    }
+    Ok(Some(Credit {
+        rule: RULE,
+        tally: o.tally,
+        hit_credit: o.hit_credit,
+        miss_credit: o.miss_credit,
+        fraction: o.fraction,
+    }))
+}
+
 /// The credit of `tally`; `all_or_nothing` groups earn 1 only when every vector is right.
 pub fn credit(tally: ClassTally, all_or_nothing: bool) -> Credit {
     let ratio = |part: f64, whole: usize| {

@@ -82,7 +82,6 @@ impl CodeChecker for FakeCode {
                     data: vec![[0.5; 3]; camera.width * camera.height],
                     film: None,
                     made_by: Default::default(),
-                    class_rows: None,
                 })
             })
             .collect()
@@ -106,6 +105,19 @@ impl ImageChecker for FakeImage {
     }
     fn golden_sha256(&self, scene: &str) -> String {
         format!("golden-{scene}")
+    }
+    /// A variant passes (the fake reads no pixel).
+    fn check_variant(
+        &self,
+        _: &super::inputs::RenderedImage,
+        _: &crate::scene::SceneDescription,
+    ) -> ImageOutcome {
+        ImageOutcome {
+            verdict: ImageVerdict::Pass,
+            metrics: serde_json::json!({}),
+            diagnosis: None,
+            heatmap: None,
+        }
     }
 }
 

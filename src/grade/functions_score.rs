@@ -159,7 +159,7 @@ fn group_checks(g: &Group, rubric: &Rubric, outcome: &FunctionsOutcome) -> Vec<C
                 score,
                 max_score: share,
                 status,
-                message,
+                message: message.into(),
                 visibility: g.visibility,
                 tags: vec!["functions".to_string(), id.clone()],
                 counts: None,
@@ -212,7 +212,7 @@ fn unscored_check(unscored: &[&FunctionResult], rubric: &Rubric) -> CheckResult 
         } else {
             CheckStatus::Failed
         },
-        message,
+        message: message.into(),
         visibility: Visibility::Visible,
         tags: vec!["functions".to_string(), "unscored".to_string()],
         counts: None,
@@ -254,6 +254,8 @@ mod tests {
                 .collect(),
             statistics: None,
             notes: vec!["not run: the code time budget ran out".into()],
+            by_behaviour: 0,
+            partners: &[],
         }
     }
 
@@ -273,7 +275,14 @@ mod tests {
     /// points; an outcome that could not run scores every function 0 with the reason.
     #[test]
     fn functions_groups_score_by_equal_shares() {
-        let text = crate::grade::week_rubrics::builtin_rubric_toml("week05").unwrap();
+        // The week-5 rubric with the function groups of this test (the built-in one scores only
+        // the direct term).
+        let builtin = crate::grade::week_rubrics::builtin_rubric_toml("week05").unwrap();
+        let lights = "[[group]]\nid = \"functions.lights\"";
+        let at = builtin.find(lights).unwrap();
+        let end = at + builtin[at..].find("\n\n").unwrap();
+        let groups = "[[group]]\nid = \"functions.lights\"\nname = \"lights\"\nkind = \"functions\"\nfunctions = [\"occlusion\", \"direct-term\"]\npoints = 35\n\n[[group]]\nid = \"functions.lambertian\"\nname = \"lambertian\"\nkind = \"functions\"\nfunctions = [\"lambertian\", \"lambertian-lobe\"]\npoints = 28\n\n[[group]]\nid = \"functions.background\"\nname = \"background\"\nkind = \"functions\"\nfunctions = [\"background\"]\npoints = 7";
+        let text = format!("{}{groups}{}", &builtin[..at], &builtin[end..]);
         let rubric = Rubric::from_toml(&text, "t").unwrap();
         let older = "older_direct_term_one_over_d";
         let all = vec![

@@ -11,6 +11,12 @@
 //! scene's own `samples_per_pixel` (the count its students are told to use), with a golden of
 //! [`golden_spp`] of it; built-in scenes use the options' count (20, the course's). A golden's
 //! SHA-256 is that of its EXR bytes.
+//!
+//! The grader's own renders (a render group's scene and its variant) are judged as renders of
+//! exactly their spp: besides `compare`'s verdict, one too clean for its spp fails
+//! ([`crate::grade::noise_floor`], reported as `metrics.noise_floor`). A variant's reference is
+//! rendered on the spot at `max(`[`VARIANT_REFERENCE_SPP`]`, 100 N)` samples per pixel, with its
+//! variance, once per variant and checker (a batch asks every submission the same variant).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -23,7 +29,14 @@ use crate::compare::{
     CandidateImage, CompareError, CompareOptions, Golden, check_size, compare_image, write_heatmap,
 };
 use crate::golden::{FoundGolden, GoldenScene, golden_of, golden_spp, sha256_hex};
+use crate::grade::noise_floor::too_clean;
 use crate::image_io::decode_exr;
+use crate::scene::SceneDescription;
+
+/// The least samples per pixel of the reference's render of a variant (made on the spot, once
+/// per variant and batch): `max(1024, 100 N)` for renders of `N`. A variant is a quarter of its
+/// scene's pixels, so this costs about a sixteenth of a 4096-spp golden.
+pub const VARIANT_REFERENCE_SPP: u32 = 1024;
 
 /// Grades images with [`compare_image`] against the golden of each scene: for built-in scenes
 /// the embedded one (or one rendered once and cached), for scene files the rubric's golden or
@@ -161,7 +174,8 @@ impl CompareImageChecker {
 
 impl CompareImageChecker {
     /// Compares `candidate` (named `name` in messages), a render of `spp` samples per pixel, with
-    /// the golden of `scene`: the verdict, the metrics, the diagnosis and the heatmap.
+    /// the golden of `scene`: the verdict, the metrics, the diagnosis and the heatmap; with
+    /// `floor`, a candidate too clean for `spp` fails ([`crate::grade::noise_floor`]).
     fn judge(
         &self,
         candidate: &CandidateImage,
@@ -169,6 +183,7 @@ impl CompareImageChecker {
         spp: u32,
         name: &str,
         heatmap_out: &Path,
+        floor: bool,
     ) -> ImageOutcome {
         let golden = match self.render_golden(scene, spp) {
             Ok((g, _)) => g,
@@ -176,11 +191,32 @@ impl CompareImageChecker {
                 return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
             }
         };
-        self.judge_against(candidate, &golden, spp, name, Some(heatmap_out))
+        self.judge_against(candidate, &golden, spp, name, Some(heatmap_out), floor)
+    }
+
+    /// The reference of a variant (`variant` rendered now at `spp` samples per pixel, with its
+    /// variance, as a golden is), kept for the batch: every submission of a rubric and seed is
+    /// asked the same variant.
+    fn variant_golden(&self, variant: &SceneDescription, spp: u32) -> Result<Arc<Golden>, String> {
+        let key = format!("variant:{}@{spp}", crate::golden::scene_sha256(variant));
+        let mut cache = self.goldens.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((g, _)) = cache.get(&key) {
+            return Ok(Arc::clone(g));
+        }
+        let scene = GoldenScene::from_description("the variant", variant.clone(), None)
+            .map_err(|e| e.to_string())?;
+        let film = crate::golden::render_golden(&scene, spp, false).map_err(|e| e.to_string())?;
+        let golden = Golden::from_film(&film, Some("the variant".into()))
+            .map_err(|e| e.to_string())?
+            .with_vfov(Some(variant.camera.vfov));
+        let golden = Arc::new(golden);
+        cache.insert(key, (Arc::clone(&golden), String::new()));
+        Ok(golden)
     }
 
     /// Compares `candidate` (named `name`), a render of `spp` samples per pixel, with `golden`,
-    /// writing the heatmap to `heatmap_out` when one is given.
+    /// writing the heatmap to `heatmap_out` when one is given; with `floor`, a candidate that
+    /// passes but is too clean for `spp` fails ([`too_clean`]).
     fn judge_against(
         &self,
         candidate: &CandidateImage,
@@ -188,6 +224,7 @@ impl CompareImageChecker {
         spp: u32,
         name: &str,
         heatmap_out: Option<&Path>,
+        floor: bool,
     ) -> ImageOutcome {
         let (w, h) = candidate.size();
         if (w, h) != (golden.width, golden.height) {
@@ -246,16 +283,48 @@ impl CompareImageChecker {
                 None => noisy,
             });
         }
+        let mut metrics = serde_json::to_value(&comparison).unwrap_or_default();
+        let mut passed = comparison.passed();
+        if floor {
+            let found = too_clean(candidate, golden, spp, options.lambda, options.encoding);
+            if let Some(f) = found.as_ref().filter(|f| f.too_clean && passed) {
+                passed = false;
+                diagnosis = Some(f.sentence());
+            }
+            if let (Some(f), Some(map)) = (found, metrics.as_object_mut()) {
+                map.insert(
+                    "noise_floor".into(),
+                    serde_json::to_value(f).unwrap_or_default(),
+                );
+            }
+        }
         ImageOutcome {
-            verdict: if comparison.passed() {
+            verdict: if passed {
                 ImageVerdict::Pass
             } else {
                 ImageVerdict::Fail
             },
-            metrics: serde_json::to_value(&comparison).unwrap_or_default(),
+            metrics,
             diagnosis,
             heatmap,
         }
+    }
+}
+
+/// The candidate a render is judged as: a program's film as the PNG it would have written, a
+/// description's render as the linear means it is.
+fn candidate_of(render: &RenderedImage) -> CandidateImage {
+    match &render.film {
+        Some(film) => CandidateImage::Rgb8 {
+            width: render.width,
+            height: render.height,
+            data: film.clone(),
+        },
+        None => CandidateImage::Linear {
+            width: render.width,
+            height: render.height,
+            data: render.data.clone(),
+        },
     }
 }
 
@@ -318,55 +387,34 @@ impl ImageChecker for CompareImageChecker {
         scene: &SceneSource,
         heatmap_out: &Path,
     ) -> ImageOutcome {
-        // A program's film is judged as the PNG it would have written; a description's render
-        // as the linear means it is.
-        let candidate = match &render.film {
-            Some(film) => CandidateImage::Rgb8 {
-                width: render.width,
-                height: render.height,
-                data: film.clone(),
-            },
-            None => CandidateImage::Linear {
-                width: render.width,
-                height: render.height,
-                data: render.data.clone(),
-            },
-        };
-        self.judge(&candidate, scene, render.spp, "the render", heatmap_out)
+        let candidate = candidate_of(render);
+        self.judge(
+            &candidate,
+            scene,
+            render.spp,
+            "the render",
+            heatmap_out,
+            true,
+        )
     }
 
-    fn check_rows(
-        &self,
-        scene: &SceneSource,
-        spp: u32,
-        width: usize,
-        rows: &[usize],
-        data: &[[f32; 3]],
-    ) -> ImageOutcome {
-        let golden = match self
-            .render_golden(scene, spp)
-            .map_err(|e| e.to_string())
-            .and_then(|(g, _)| {
-                if g.width == width {
-                    g.rows(rows).map_err(|e| e.to_string())
-                } else {
-                    Err(format!(
-                        "the rows are {width} pixels wide, the golden {}",
-                        g.width
-                    ))
-                }
-            }) {
+    fn check_variant(&self, render: &RenderedImage, variant: &SceneDescription) -> ImageOutcome {
+        let m = VARIANT_REFERENCE_SPP.max(render.spp.saturating_mul(100));
+        let golden = match self.variant_golden(variant, m) {
             Ok(g) => g,
             Err(e) => {
-                return ImageOutcome::unusable(format!("no golden for {}: {e}", scene.label()));
+                return ImageOutcome::unusable(format!("no reference for the variant: {e}"));
             }
         };
-        let candidate = CandidateImage::Linear {
-            width,
-            height: rows.len(),
-            data: data.to_vec(),
-        };
-        self.judge_against(&candidate, &golden, spp, "the rows", None)
+        let candidate = candidate_of(render);
+        self.judge_against(
+            &candidate,
+            &golden,
+            render.spp,
+            "the variant's render",
+            None,
+            true,
+        )
     }
 
     fn check_scene(
@@ -402,6 +450,7 @@ impl ImageChecker for CompareImageChecker {
             self.candidate_spp(scene),
             &name,
             heatmap_out,
+            false,
         )
     }
 }

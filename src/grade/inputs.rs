@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use super::credit::ClassTally;
 use crate::oracle::vectors::ShapeKind;
+use crate::scene::SceneDescription;
 
 pub use super::rubric::{SceneFile, SceneSource};
 
@@ -135,20 +136,16 @@ pub trait ImageChecker: Sync {
         judge_as_png(render, |png| self.check_scene(png, scene, heatmap_out))
     }
 
-    /// Judges some rows of a render of `scene` at `spp` samples per pixel (`data`: the rows
-    /// stacked top to bottom, `width` pixels each, linear RGB) against the same rows of the
-    /// golden [`check_render`](Self::check_render) would use. The default cannot judge rows
-    /// and says so ([`ImageVerdict::Unusable`]).
-    fn check_rows(
-        &self,
-        scene: &SceneSource,
-        spp: u32,
-        width: usize,
-        rows: &[usize],
-        data: &[[f32; 3]],
-    ) -> ImageOutcome {
-        let _ = (scene, spp, width, rows, data);
-        ImageOutcome::unusable(format!("{} cannot judge rows of a render", self.describe()))
+    /// Judges the grader's render of a *variant* of a scene (the scene seen from a camera the
+    /// grader moved, `variant` its description at the render's spp) against a reference of the
+    /// same variant, which the checker renders on the spot: a variant has no golden made in
+    /// advance. The default cannot render one and says so ([`ImageVerdict::Unusable`]).
+    fn check_variant(&self, render: &RenderedImage, variant: &SceneDescription) -> ImageOutcome {
+        let _ = (render, variant);
+        ImageOutcome::unusable(format!(
+            "{} cannot render the reference of a variant",
+            self.describe()
+        ))
     }
 }
 
@@ -174,6 +171,23 @@ pub struct GroupCounts {
     pub ambiguous: usize,
     /// Ambiguous vectors whose answer equals the exact one.
     pub ambiguous_passed: usize,
+    /// Vectors not scored (ambiguous or `any`) on which the code did not answer in time: each
+    /// counts as a scored vector answered wrong (a candidate must answer every vector, as
+    /// `rtoracle check` requires).
+    #[serde(default)]
+    pub unscored_timeouts: usize,
+    /// Vectors not scored on which the interpreter died: each counts as a scored vector
+    /// answered wrong.
+    #[serde(default)]
+    pub unscored_crashes: usize,
+    /// Watertight groups judged (of class `hit`, every member run; counted under the shape of
+    /// their first member): each counts as one scored vector where the ray hits.
+    #[serde(default)]
+    pub watertight: usize,
+    /// Of those, the groups whose ray hit none of their shapes (an open edge): each is a hit
+    /// vector answered wrong, and the check fails, as `rtoracle check` does.
+    #[serde(default)]
+    pub watertight_cracked: usize,
     /// The definite vectors by what they expect and how they were answered: what the scoring
     /// rule ([`credit`](super::credit)) reads. `report.json` shows it in the check's `credit`.
     /// A checker that leaves it empty is scored as if every vector hit (in proportion to the
@@ -206,8 +220,8 @@ pub struct FailureSummary {
     pub expected: serde_json::Value,
     /// The answer received, as JSON (`null` when there was none).
     pub actual: serde_json::Value,
-    /// One line saying what differs.
-    pub message: String,
+    /// One line saying what differs (quoting what the code answered or raised: untrusted).
+    pub message: crate::escape::Untrusted,
     /// A ready-to-run Python snippet reproducing the case with the course's API.
     pub repro: String,
 }

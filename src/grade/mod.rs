@@ -29,6 +29,7 @@
 pub mod autograder;
 pub mod batch;
 pub mod batch_copies;
+pub mod batch_entry;
 pub mod bench;
 pub mod checkers;
 pub mod copies;
@@ -40,6 +41,7 @@ pub mod image_checker;
 pub mod inputs;
 pub mod intake;
 pub mod merge;
+pub mod noise_floor;
 pub mod pack;
 pub mod render;
 pub mod report;

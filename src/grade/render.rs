@@ -17,23 +17,27 @@
 //! another size), the group falls back to the description, within the same time limit, and
 //! says why.
 //!
-//! A film the program saves could be any picture the submission carries (the reference's own
-//! render, a classmate's). So after a program's film, the submission's own classes render again,
-//! from the grader's description of the scene, a band of about one row in
-//! [`crate::candidate::render::CHECKED_BAND_PERIOD`] (which band follows the seed), and the film
-//! earns its points only if those rows match the reference's same rows too: a correct picture
-//! over classes that compute something else scores 0, and says so. Classes that cannot render
-//! the rows make the group unusable, with the reason.
+//! A film, a render or a picture could be one the submission carries (the reference's own
+//! render made at home, a classmate's), answered by a `main.py` that saves it or by a module
+//! that replaces the adapter's renderer. So every render group is also rendered as a *variant*
+//! ([`variant_of`]): the same scene from a camera the grader moves (`look_from` and `look_at`
+//! moved by 3 to 6% and 1 to 3% of their distance, the field of view scaled by 3 to 6% either
+//! way, in directions and amounts drawn from [`variant_key`], which follows the rubric's secret
+//! seed and the group), at half the width. The submission renders it the same way as the scene
+//! (its `main.py` function moves its camera in `init_camera`), the reference renders the same
+//! variant on the spot ([`ImageChecker::check_variant`]), and the group earns its points only
+//! when both the scene and its variant match. A picture made before the grade cannot show a
+//! camera drawn during it.
 //!
 //! What this module promises the reports: the outcome's `metrics` hold the comparison of the
 //! render (as an uploaded image's would) plus `source` (`"render"`), `render` (`spp`,
 //! `seconds`, `width`, `height`, `made_by` (`"main_function"` or `"description"`), the group's
 //! `main_function` and, when it was not used, `main_function_not_used` with the reason; or
-//! `not_run` with the reason; after a program's film, `class_rows` with the `rows` rendered
-//! again by the classes, their `verdict`, its `diagnosis`, and whether the film alone matched,
-//! `film_matches`) and `upload` (the uploaded
-//! image's verdict, or why there is none); the check's message starts with what was judged
-//! ("The render of your code (4 spp, 7.1 s) ...") and ends with a sentence on the upload.
+//! `not_run` with the reason; `variant` with the camera's `move`, the variant's `width` and
+//! `height`, its `seconds`, its `verdict`, its `diagnosis` and whether the scene alone matched,
+//! `scene_matches`) and `upload` (the uploaded image's verdict, or why there is none); the
+//! check's message starts with what was judged ("The render of your code (4 spp, 7.1 s) ...")
+//! and ends with a sentence on the upload.
 
 use std::path::Path;
 use std::time::Duration;
@@ -43,7 +47,8 @@ use serde_json::{Value, json};
 use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict};
 use super::result::{CheckResult, CheckStatus};
 use super::rubric::{Group, SceneSource};
-use crate::candidate::render::{ClassRows, MadeBy, RenderJob, RenderOutcome, RenderedImage};
+use crate::candidate::render::{CameraMove, MadeBy, RenderJob, RenderOutcome, RenderedImage};
+use crate::escape::Untrusted;
 use crate::scene::SceneDescription;
 
 /// The scene description an image group renders: the built-in's or the rubric's scene file.
@@ -54,70 +59,157 @@ pub(crate) fn scene_description(scene: &SceneSource) -> Result<SceneDescription,
     }
 }
 
+/// The key a group's variant is drawn from: derived from the rubric's secret seed for the
+/// purpose `variant/<group id>` by the keyed one-way function of [`crate::secret`], so neither
+/// a request nor a report tells it.
+pub(crate) fn variant_key(secret: u64, group: &str) -> u64 {
+    crate::secret::derive(secret, &format!("variant/{group}"))
+}
+
+fn splitmix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The variant of `scene` for `key` ([module docs](self)): the camera moved, the image half as
+/// wide (at least 16 pixels), and the move.
+pub(crate) fn variant_of(scene: &SceneDescription, key: u64) -> (SceneDescription, CameraMove) {
+    let mut state = key;
+    let mut uniform = || {
+        state = splitmix(state);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let direction = |uniform: &mut dyn FnMut() -> f64| {
+        let z = 2.0 * uniform() - 1.0;
+        let phi = std::f64::consts::TAU * uniform();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        [r * phi.cos(), r * phi.sin(), z]
+    };
+    let c = &scene.camera;
+    let distance = (0..3)
+        .map(|k| (c.look_at[k] - c.look_from[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        .max(1e-3);
+    let from = direction(&mut uniform);
+    let from_len = distance * (0.03 + 0.03 * uniform());
+    let at = direction(&mut uniform);
+    let at_len = distance * (0.01 + 0.02 * uniform());
+    let sign = if uniform() < 0.5 { -1.0 } else { 1.0 };
+    let vfov_scale = 1.0 + sign * (0.03 + 0.03 * uniform());
+    let camera_move = CameraMove {
+        look_from: from.map(|x| x * from_len),
+        look_at: at.map(|x| x * at_len),
+        vfov_scale,
+    };
+    let mut moved = camera_move.apply(scene);
+    moved.image.width = (scene.image.width / 2).max(16);
+    (moved, camera_move)
+}
+
+/// What one render group asks of the submission: the scene at the group's spp, and its variant.
+pub(crate) struct Planned<'g> {
+    scene: SceneDescription,
+    variant: SceneDescription,
+    camera_move: CameraMove,
+    spp: u32,
+    limit: Duration,
+    program: Option<&'g str>,
+}
+
 /// The render jobs of the rubric's render groups, in `groups`' order: `Err` for a group whose
 /// scene cannot be had (it is not rendered).
-#[allow(clippy::type_complexity)]
-pub(crate) fn jobs_of<'g>(
-    groups: &[&'g Group],
-) -> Vec<Result<(SceneDescription, u32, Duration, Option<&'g str>), String>> {
+pub(crate) fn jobs_of<'g>(groups: &[&'g Group], seed: u64) -> Vec<Result<Planned<'g>, String>> {
     groups
         .iter()
         .map(|g| {
             let scene = g.scene_source().ok_or("the group has no scene")?;
             let d = scene_description(&scene)?;
+            let spp = g.render_spp();
             // A scene of the course's jittered sampling is sent as it is at the render's spp.
-            let d = crate::golden::at_spp(&d, g.render_spp()).unwrap_or(d);
-            Ok((
-                d,
-                g.render_spp(),
-                Duration::from_secs_f64(g.render_seconds()),
-                g.main_function.as_deref(),
-            ))
+            let at = |d: SceneDescription| crate::golden::at_spp(&d, spp).unwrap_or(d);
+            let (variant, camera_move) = variant_of(&d, variant_key(seed, &g.id));
+            Ok(Planned {
+                scene: at(d),
+                variant: at(variant),
+                camera_move,
+                spp,
+                limit: Duration::from_secs_f64(g.render_seconds()),
+                program: g.main_function.as_deref(),
+            })
         })
         .collect()
 }
 
-/// Renders the render groups of one submission through `render` (the code checker's), one
-/// outcome per group, timed.
+/// A render group's renders: the scene's, and its variant's with what the variant is.
+pub(crate) struct GroupRender {
+    /// The render of the group's scene.
+    pub(crate) scene: RenderOutcome,
+    /// The variant's render, its description (moved, at the render's spp) and the move; `None`
+    /// when the group's scene could not be had.
+    pub(crate) variant: Option<(RenderOutcome, SceneDescription, CameraMove)>,
+}
+
+/// Renders the render groups of one submission through `render` (the code checker's), the scene
+/// and its variant of each group, timed. `secret` is the rubric's seed, never sent: each job's
+/// seed is derived from it for the purpose `render/<group id>` ([`crate::secret`]), and the
+/// variants are drawn from it ([`variant_key`]).
 pub(crate) fn render_groups(
     groups: &[&Group],
-    seed: u64,
+    secret: u64,
     render: impl FnOnce(&[RenderJob]) -> Vec<RenderOutcome>,
-) -> Vec<RenderOutcome> {
-    let wanted = jobs_of(groups);
-    let ok: Vec<RenderJob> = wanted
+) -> Vec<GroupRender> {
+    let wanted = jobs_of(groups, secret);
+    let mut jobs: Vec<RenderJob> = Vec::new();
+    for (p, g) in wanted
         .iter()
-        .filter_map(|w| w.as_ref().ok())
-        .map(|(scene, spp, limit, program)| RenderJob {
+        .zip(groups)
+        .filter_map(|(w, g)| w.as_ref().ok().map(|p| (p, g)))
+    {
+        let job = |scene, variant| RenderJob {
             scene,
-            spp: *spp,
-            seed,
-            time_limit: *limit,
-            program: *program,
-        })
-        .collect();
-    let mut done = if ok.is_empty() {
+            spp: p.spp,
+            seed: crate::secret::derive32(secret, &format!("render/{}", g.id)).into(),
+            time_limit: p.limit,
+            program: p.program,
+            variant,
+        };
+        jobs.push(job(&p.scene, None));
+        jobs.push(job(&p.variant, Some(p.camera_move)));
+    }
+    let mut done = if jobs.is_empty() {
         Vec::new()
     } else {
-        render(&ok)
+        render(&jobs)
     }
     .into_iter();
+    let mut next = || {
+        done.next()
+            .unwrap_or_else(|| RenderOutcome::Invalid("the checker rendered nothing".into()))
+    };
     wanted
-        .iter()
+        .into_iter()
         .map(|w| match w {
-            Ok(_) => done
-                .next()
-                .unwrap_or_else(|| RenderOutcome::Invalid("the checker rendered nothing".into())),
-            Err(why) => RenderOutcome::Declined(why.clone()),
+            Ok(p) => GroupRender {
+                scene: next(),
+                variant: Some((next(), p.variant, p.camera_move)),
+            },
+            Err(why) => GroupRender {
+                scene: RenderOutcome::Declined(why),
+                variant: None,
+            },
         })
         .collect()
 }
 
 /// The outcome of a render group: the render's judgement (or why there is none), with the
-/// upload's judgement kept in its metrics.
+/// upload's judgement kept in its metrics; the points need the variant's render to match its
+/// reference too.
 pub(crate) fn judge(
     g: &Group,
-    render: RenderOutcome,
+    render: GroupRender,
     upload: ImageOutcome,
     images: &dyn ImageChecker,
     heatmap_out: &Path,
@@ -128,16 +220,13 @@ pub(crate) fn judge(
         "verdict": &upload.verdict,
         "diagnosis": &upload.diagnosis,
     });
-    let (mut outcome, render_json) = match &render {
+    let (mut outcome, mut render_json) = match &render.scene {
         RenderOutcome::Rendered(image) => {
             let scene = g.scene_source().expect("validated");
-            let outcome = images.check_render(image, &scene, heatmap_out);
-            let mut made = rendered_json(image);
-            let outcome = match &image.class_rows {
-                Some(rows) => tie_to_classes(outcome, image, rows, &scene, images, &mut made),
-                None => outcome,
-            };
-            (outcome, made)
+            (
+                images.check_render(image, &scene, heatmap_out),
+                rendered_json(image),
+            )
         }
         failed => {
             let why = failed.reason().unwrap_or_default();
@@ -147,6 +236,18 @@ pub(crate) fn judge(
             )
         }
     };
+    if let (RenderOutcome::Rendered(_), Some((variant, description, camera_move))) =
+        (&render.scene, &render.variant)
+    {
+        outcome = tie_to_variant(
+            outcome,
+            variant,
+            description,
+            camera_move,
+            images,
+            &mut render_json,
+        );
+    }
     let mut metrics = match std::mem::take(&mut outcome.metrics) {
         Value::Object(map) => map,
         _ => serde_json::Map::new(),
@@ -158,56 +259,66 @@ pub(crate) fn judge(
     outcome
 }
 
-/// A program's film earns its points only when the submission's classes, rendering some of its
-/// rows again from the scene's description ([`ClassRows`]), match the reference there too: a
-/// `main.py` that saves a picture it carries, not one its code computes, fails here. Records
-/// the rows' verdict in `made["class_rows"]`; a film that already fails is left as it is.
-fn tie_to_classes(
-    film: ImageOutcome,
-    image: &RenderedImage,
-    rows: &ClassRows,
-    scene: &SceneSource,
+/// The scene's render earns its points only when the variant's render (the same scene from the
+/// moved camera, [`variant_of`]) matches the reference's render of the same variant too: a
+/// picture carried in cannot. Records the variant's judgement in `made["variant"]`; a render
+/// that already fails is left as it is.
+fn tie_to_variant(
+    scene: ImageOutcome,
+    variant: &RenderOutcome,
+    description: &SceneDescription,
+    camera_move: &CameraMove,
     images: &dyn ImageChecker,
     made: &mut Value,
 ) -> ImageOutcome {
-    let judged = match &rows.rendered {
-        Ok(data) => images.check_rows(scene, image.spp, image.width, &rows.rows, data),
-        Err(why) => ImageOutcome::unusable(why.clone()),
+    let camera = description.camera(None);
+    // A scene that already fails is not redeemed by its variant: its reference is not rendered.
+    let judged = match variant {
+        _ if scene.verdict != ImageVerdict::Pass => {
+            ImageOutcome::unusable("not judged: the render of the scene itself does not match")
+        }
+        RenderOutcome::Rendered(image) => images.check_variant(image, description),
+        failed => ImageOutcome::unusable(failed.reason().unwrap_or_default()),
     };
-    let what = format!(
-        "{} of its {} rows rendered again from the grader's description of the scene with your classes",
-        rows.rows.len(),
-        image.height
-    );
-    made["class_rows"] = json!({
-        "rows": rows.rows.len(),
+    made["variant"] = json!({
+        "move": camera_move,
+        "width": camera.width,
+        "height": camera.height,
+        "seconds": match variant {
+            RenderOutcome::Rendered(image) => json!((image.seconds * 1000.0).round() / 1000.0),
+            _ => Value::Null,
+        },
         "verdict": &judged.verdict,
         "diagnosis": &judged.diagnosis,
-        "film_matches": film.verdict == ImageVerdict::Pass,
+        "scene_matches": scene.verdict == ImageVerdict::Pass,
     });
-    if film.verdict != ImageVerdict::Pass {
-        return film;
+    if scene.verdict != ImageVerdict::Pass {
+        return scene;
     }
+    let what = format!(
+        "its render of the same scene from a camera the grader moved ({}x{} pixels; a picture made before the grade cannot show it)",
+        camera.width, camera.height
+    );
     let tail = "an image earns its points only when it is what your code computes";
     match judged.verdict {
-        ImageVerdict::Pass => film,
+        ImageVerdict::Pass => scene,
         ImageVerdict::Fail => ImageOutcome {
             verdict: ImageVerdict::Fail,
             diagnosis: Some(format!(
-                "{what} differ from the reference{}: {tail}",
+                "{what} differs from the reference's render of it{}: {tail}",
                 judged
                     .diagnosis
                     .as_deref()
                     .map_or(String::new(), |d| format!(" ({})", d.trim_end_matches('.')))
             )),
-            ..film
+            ..scene
         },
         ImageVerdict::Unusable(why) => ImageOutcome {
             verdict: ImageVerdict::Unusable(format!(
-                "your classes could not render the scene to tie the image to your code ({what}: {}); {tail}",
+                "{what} could not be judged ({}); {tail}",
                 why.trim_end_matches('.')
             )),
-            ..film
+            ..scene
         },
     }
 }
@@ -306,15 +417,15 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
         (format!("{file} differs"), format!("{what} differs")),
     ] {
         if let Some(rest) = message.strip_prefix(&from) {
-            message = format!("{to}{rest}");
+            message = Untrusted::from(to).join("", &rest);
             break;
         }
     }
-    // A film that matches but is not what the classes compute: say that it matched.
-    if render["class_rows"]["film_matches"] == true && check.status != CheckStatus::Passed {
+    // A render that matches but whose variant does not: say that it matched.
+    if render["variant"]["scene_matches"] == true && check.status != CheckStatus::Passed {
         if let Some(d) = image.diagnosis.as_deref() {
             if message.starts_with(&format!("{what} differs")) {
-                message = format!("{what} matches the reference, but it scores 0: {d}.");
+                message = format!("{what} matches the reference, but it scores 0: {d}.").into();
             }
         }
     }
@@ -328,7 +439,9 @@ pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
         ),
         _ => match upload["verdict"]["reason"].as_str() {
             Some(why) if why.contains("missing") => {
-                format!(" No {file} was uploaded (none is needed: the grader renders your code).")
+                format!(
+                    " {file} is missing from the submission; it costs nothing: the grader renders your code."
+                )
             }
             Some(why) => format!(
                 " Your uploaded {file} could not be compared ({}); uploads earn no points.",

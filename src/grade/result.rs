@@ -6,18 +6,19 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::copies::{CopyFinding, Fingerprint};
 use super::inputs::{FailureKind, FailureSummary, GroupCounts, ImageVerdict};
 use super::rubric::Visibility;
+use crate::escape::Untrusted;
 use crate::output::OutputError;
 
 /// How many failing vectors of a group the reports show.
 pub const FAILURES_SHOWN: usize = 5;
 
 /// How a check came out.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CheckStatus {
     /// Full marks.
@@ -43,7 +44,7 @@ impl CheckStatus {
 }
 
 /// One image's comparison, as the reports show it.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ImageResult {
     /// The file in the submission.
     pub file: String,
@@ -61,12 +62,12 @@ pub struct ImageResult {
     pub heatmap: Option<String>,
     /// What the copy checks found: the course's image, the reference's render, or (in a batch)
     /// another submission's image sharing its noise.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub copies: Vec<CopyFinding>,
 }
 
 /// One check: a line of the gradebook's detail and a test on Gradescope.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CheckResult {
     /// Starts with the group's id: `sphere.intersect`, `image.week04-quad`.
     pub id: String,
@@ -80,8 +81,10 @@ pub struct CheckResult {
     pub max_score: f64,
     /// How it came out.
     pub status: CheckStatus,
-    /// What happened, in plain words.
-    pub message: String,
+    /// What happened, in plain words: the harness's, with what the submission said or named
+    /// in it (a render's exception, its code's error), so all of it is untrusted and written
+    /// out only escaped.
+    pub message: Untrusted,
     /// Who sees it on Gradescope.
     pub visibility: Visibility,
     /// Tags (`code`, `sphere`, `image`, ...).
@@ -90,10 +93,14 @@ pub struct CheckResult {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counts: Option<GroupCounts>,
     /// How a code check's points were counted: the rule, its components and the share earned.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::credit::read_credit"
+    )]
     pub credit: Option<super::credit::Credit>,
     /// The first failing vectors, with reproductions.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failures: Vec<FailureSummary>,
     /// The comparison, for image checks.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -105,7 +112,7 @@ pub struct CheckResult {
 }
 
 /// What was checked and with what, so a grade can be reproduced.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Reproducibility {
     /// rtoracle's version.
     pub tool_version: String,
@@ -127,12 +134,12 @@ pub struct Reproducibility {
 }
 
 /// Everything known about the code run, beyond the checks.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CodeRun {
-    /// Why nothing could run, if so.
-    pub fatal: Option<String>,
+    /// Why nothing could run, if so (Python's words).
+    pub fatal: Option<Untrusted>,
     /// The end of what the code wrote to stderr.
-    pub stderr_tail: String,
+    pub stderr_tail: Untrusted,
     /// The sandbox's facts.
     pub sandbox: serde_json::Value,
     /// The known mistakes that explain the code's failures, per shape.
@@ -141,10 +148,15 @@ pub struct CodeRun {
     pub triangle_winding: Option<crate::candidate::check::Winding>,
     /// Why the week's function checks could not run at all, when they could not.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub functions_fatal: Option<String>,
+    pub functions_fatal: Option<Untrusted>,
     /// The last lines the code wrote to stderr during the function checks (truncated).
-    #[serde(skip_serializing_if = "String::is_empty")]
-    pub functions_stderr_tail: String,
+    #[serde(default, skip_serializing_if = "Untrusted::is_empty")]
+    pub functions_stderr_tail: Untrusted,
+    /// Answers that broke the protocol (to function, render and intersection requests: a
+    /// malformed answer, a key its answer does not have, a wrong number of samples). The
+    /// bundled adapter never makes one, so a count above 0 means a broken or hijacked adapter:
+    /// the gradebook's status says to look at the submission.
+    pub protocol_errors: usize,
     /// Every definite vector it failed (not only the few each check shows), for a batch's
     /// summary; not written into report.json.
     #[serde(skip)]
@@ -152,10 +164,10 @@ pub struct CodeRun {
 }
 
 /// The result model every report format is written from.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GradeReport {
-    /// The submission folder's name.
-    pub submission: String,
+    /// The submission folder's name (the submission's).
+    pub submission: Untrusted,
     /// The rubric's name.
     pub rubric: String,
     /// Where the rubric came from (`built-in` or its file).
@@ -240,8 +252,11 @@ pub fn smallest_failure(failures: &[FailureSummary]) -> Option<&FailureSummary> 
 
 /// The sentence a code check's message ends with when a vector failed (the report writers that
 /// show the case in their own way take it off again).
-pub(crate) fn smallest_case_sentence(f: &FailureSummary) -> String {
-    format!(" Smallest failing case, {}: {}.", f.id, f.message)
+pub(crate) fn smallest_case_sentence(f: &FailureSummary) -> Untrusted {
+    let mut s = Untrusted::from(format!(" Smallest failing case, {}: ", f.id));
+    s.push(&f.message);
+    s.push_str(".");
+    s
 }
 
 /// What makes a failure easy to show a student, smallest first: an answer (not a timeout),

@@ -116,11 +116,11 @@ impl StagedImage {
 fn render_check(
     g: &Group,
     upload: ImageOutcome,
-    render: RenderOutcome,
+    render: super::render::GroupRender,
     images: &dyn ImageChecker,
     out_dir: &Path,
 ) -> super::result::CheckResult {
-    let copy = match &render {
+    let copy = match &render.scene {
         RenderOutcome::Rendered(image) => {
             let scene = g.scene_source().expect("validated");
             let fp = Fingerprint::of(&super::inputs::encoded(image));
@@ -132,7 +132,7 @@ fn render_check(
     let judged = super::render::judge(g, render, upload, images, &heatmap);
     let mut check = image_check(g, judged, copy.clone(), out_dir);
     match &copy {
-        Some(c) => check.message = c.render_sentence(),
+        Some(c) => check.message = c.render_sentence().into(),
         None => super::render::explain(&mut check, g),
     }
     check
@@ -208,6 +208,7 @@ pub fn grade(
             )
         },
     );
+    let protocol_errors = protocol_errors(&outcome, functions.as_ref(), &renders);
     let mut image_outcomes = image_outcomes.into_iter();
     let mut renders = renders.into_iter();
     let mut checks = Vec::new();
@@ -250,7 +251,7 @@ pub fn grade(
         .and_then(|p| p.file_name().map(|n| n.to_string_lossy().to_string()))
         .unwrap_or_else(|| submission.display().to_string());
     Ok(GradeReport {
-        submission: submission_name,
+        submission: submission_name.into(),
         rubric: rubric.name.clone(),
         rubric_source: rubric.source.clone(),
         score,
@@ -259,16 +260,21 @@ pub fn grade(
         checks,
         fingerprints,
         code: CodeRun {
-            fatal: outcome.fatal.clone(),
-            stderr_tail: outcome.stderr_tail.clone(),
+            fatal: outcome.fatal.clone().map(Into::into),
+            stderr_tail: outcome.stderr_tail.clone().into(),
             sandbox: outcome.sandbox.clone(),
             diagnosis: outcome.diagnosis.clone(),
             triangle_winding: outcome.triangle_winding,
-            functions_fatal: functions.as_ref().and_then(|f| f.fatal.clone()),
+            functions_fatal: functions
+                .as_ref()
+                .and_then(|f| f.fatal.clone())
+                .map(Into::into),
             functions_stderr_tail: functions
                 .as_ref()
                 .map(|f| f.stderr_tail.clone())
-                .unwrap_or_default(),
+                .unwrap_or_default()
+                .into(),
+            protocol_errors,
             failed_vectors: outcome
                 .failures
                 .iter()
@@ -282,6 +288,29 @@ pub fn grade(
         r.execution_time = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
         r
     })
+}
+
+/// How many answers broke the protocol: intersection vectors, function cases and renders.
+fn protocol_errors(
+    outcome: &CodeOutcome,
+    functions: Option<&super::inputs::FunctionsOutcome>,
+    renders: &[super::render::GroupRender],
+) -> usize {
+    let vectors = outcome
+        .failures
+        .iter()
+        .filter(|f| f.kind == FailureKind::Protocol)
+        .count();
+    let cases: usize = functions
+        .and_then(|f| f.report.as_ref())
+        .map_or(0, |r| r.functions.iter().map(|f| f.counts.protocol).sum());
+    vectors
+        + cases
+        + renders
+            .iter()
+            .flat_map(|r| std::iter::once(&r.scene).chain(r.variant.as_ref().map(|v| &v.0)))
+            .filter(|r| r.is_protocol_error())
+            .count()
 }
 
 /// What the report says the grade was made from: tool, rubric, vectors, goldens, scene files
@@ -390,7 +419,7 @@ mod tests {
         assert_eq!(score(&r, "sphere.intersect"), 7.5);
         let c = &r.checks[0];
         assert_eq!(c.status, CheckStatus::Failed);
-        assert!(c.message.contains("1 of 4 sphere test vectors answered correctly (1 raised an exception, 1 timed out, 1 not run)."), "{}", c.message);
+        assert!(c.message.contains("1 of 4 sphere test vectors answered correctly (1 raised an exception, 1 timed out, 1 not run)."), "{:?}", c.message);
     }
 
     fn failure(id: &str, kind: FailureKind) -> FailureSummary {
@@ -402,7 +431,7 @@ mod tests {
             definite: true,
             expected: serde_json::Value::Null,
             actual: serde_json::Value::Null,
-            message: format!("{kind:?}"),
+            message: format!("{kind:?}").into(),
             repro: String::new(),
         }
     }
@@ -430,7 +459,7 @@ mod tests {
             r.checks[0].message.contains(
                 "1 of 3 sphere test vectors answered correctly (1 crashed Python, 1 not run)."
             ),
-            "{}",
+            "{:?}",
             r.checks[0].message
         );
     }
@@ -494,7 +523,7 @@ mod tests {
         assert_eq!(quad_image.status, CheckStatus::Error);
         assert!(
             quad_image.message.contains("week04_quad.png is missing"),
-            "{}",
+            "{:?}",
             quad_image.message
         );
     }

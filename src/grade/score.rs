@@ -56,25 +56,25 @@ pub(crate) fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResul
         (
             0.0,
             CheckStatus::Error,
-            format!("No {shape} vector could be run. {fatal}"),
+            crate::escape::Untrusted::from(format!("No {shape} vector could be run. "))
+                .join("", &fatal.as_str().into()),
         )
     } else if total == 0 {
         (
             group.points,
             CheckStatus::Passed,
-            format!("There are no {shape} vectors to run."),
+            crate::escape::Untrusted::from(format!("There are no {shape} vectors to run.")),
         )
     } else {
         let c = credit(tally, group.all_or_nothing);
-        // Full marks need every vector right, whatever the tally says.
-        let fraction = if passed == total {
-            1.0
-        } else {
-            c.fraction.min(1.0)
-        };
+        // Full marks need every vector right, whatever the tally says, and nothing `check`
+        // fails: a watertight group cracked, a vector not scored left unanswered.
+        let unanswered = counts.unscored_timeouts + counts.unscored_crashes;
+        let all_right = passed == total && counts.watertight_cracked == 0 && unanswered == 0;
+        let fraction = if all_right { 1.0 } else { c.fraction.min(1.0) };
         earned = Some(c);
         let message = code_message(group, outcome, &counts, (passed, total), &failures, &c);
-        let status = if passed == total {
+        let status = if all_right {
             CheckStatus::Passed
         } else {
             CheckStatus::Failed
@@ -113,7 +113,7 @@ fn code_message(
     (passed, total): (usize, usize),
     failures: &[FailureSummary],
     credit: &Credit,
-) -> String {
+) -> crate::escape::Untrusted {
     let shape = group.shape.expect("validated: code groups have a shape");
     let mut parts = Vec::new();
     for (n, what) in [
@@ -132,10 +132,13 @@ fn code_message(
         message.push_str(&format!(" ({})", parts.join(", ")));
     }
     message.push('.');
-    if passed < total {
-        message.push_str(&credit_sentence(credit));
+    message.push_str(&check_fails_sentence(counts));
+    let all_right = passed == total
+        && counts.watertight_cracked + counts.unscored_timeouts + counts.unscored_crashes == 0;
+    if !all_right {
+        message.push_str(&credit_sentence(credit, counts.watertight));
     }
-    if group.all_or_nothing && passed < total {
+    if group.all_or_nothing && !all_right {
         message.push_str(" This group is all-or-nothing.");
     }
     if let Some(d) = outcome.diagnosis.iter().find(|d| d.shape == shape) {
@@ -148,15 +151,48 @@ fn code_message(
         ));
     }
     // Last, so the reports can show the vector's own message apart (it is the candidate's).
+    let mut message = crate::escape::Untrusted::from(message);
     if let Some(f) = smallest_failure(failures) {
-        message.push_str(&smallest_case_sentence(f));
+        message.push(&smallest_case_sentence(f));
     }
     message
 }
 
+/// What `rtoracle check` fails besides a definite vector, in its words: the watertight groups
+/// judged and cracked, the vectors not scored that the code left unanswered (empty when there
+/// is nothing to say).
+fn check_fails_sentence(counts: &GroupCounts) -> String {
+    let mut s = String::new();
+    if counts.watertight_cracked > 0 {
+        s.push_str(&format!(
+            " Watertight groups: {}; each counts as a vector where the ray hits.",
+            crate::candidate::watertight::groups_summary(
+                counts.watertight,
+                counts.watertight_cracked
+            )
+        ));
+    }
+    let (hung, died) = (counts.unscored_timeouts, counts.unscored_crashes);
+    if hung + died > 0 {
+        let mut what = Vec::new();
+        if hung > 0 {
+            what.push(format!("hung on {hung}"));
+        }
+        if died > 0 {
+            what.push(format!("crashed Python on {died}"));
+        }
+        s.push_str(&format!(
+            " Your code {} of the vectors that are not scored, but code must answer every vector: each counts as a vector answered wrong.",
+            what.join(" and ")
+        ));
+    }
+    s
+}
+
 /// How the points of a code check that lost some were counted: the vectors that hit and those
-/// that miss are scored apart, and the group earns the product of the two credits.
-fn credit_sentence(c: &Credit) -> String {
+/// that miss are scored apart, and the group earns the product of the two credits (`watertight`
+/// of the vectors that hit are watertight groups).
+fn credit_sentence(c: &Credit, watertight: usize) -> String {
     let t = &c.tally;
     let partly = t.hits_wrong_normal + t.hits_wrong_front_face + t.hits_t_only;
     let partly = if partly > 0 {
@@ -166,8 +202,13 @@ fn credit_sentence(c: &Credit) -> String {
     } else {
         String::new()
     };
+    let groups = if watertight > 0 {
+        format!(" ({watertight} of them watertight groups)")
+    } else {
+        String::new()
+    };
     format!(
-        " Points: of the {} vectors where the ray hits, {} right{partly} (hit credit {:.2}); of the {} where it misses, {} right (miss credit {:.2}); {:.2} x {:.2} = {:.1}% of the group's points.",
+        " Points: of the {} vectors where the ray hits{groups}, {} right{partly} (hit credit {:.2}); of the {} where it misses, {} right (miss credit {:.2}); {:.2} x {:.2} = {:.1}% of the group's points.",
         t.hits,
         t.hits_right,
         c.hit_credit,
@@ -193,7 +234,8 @@ fn ambiguous_check(group: &Group, outcome: &CodeOutcome, counts: &GroupCounts) -
         message: format!(
             "{} of {} ambiguous {shape} vectors (where rounding decides) gave the exact answer; they are reported, not scored.",
             counts.ambiguous_passed, counts.ambiguous
-        ),
+        )
+        .into(),
         visibility: group.visibility,
         tags: vec!["code".to_string(), shape.name().to_string()],
         counts: None,
@@ -209,6 +251,9 @@ fn ambiguous_check(group: &Group, outcome: &CodeOutcome, counts: &GroupCounts) -
         function: None,
     }
 }
+
+/// How the intake and the image checker say that an image is not in the submission.
+pub(crate) const MISSING: &str = "is missing from the submission";
 
 pub(crate) fn heatmap_name(group: &Group) -> String {
     format!(
@@ -261,7 +306,12 @@ pub(crate) fn image_check(
         (None, ImageVerdict::Unusable(why)) => (
             0.0,
             CheckStatus::Error,
-            if why.starts_with(file.as_str()) {
+            if why.starts_with(file.as_str()) && why.ends_with(MISSING) {
+                format!(
+                    "{why}: it costs this group's {} points, since this rubric judges the uploaded image (upload it).",
+                    round2(group.points)
+                )
+            } else if why.starts_with(file.as_str()) {
                 format!("{why}. It scores 0.")
             } else {
                 format!("{file} could not be compared and scores 0: {why}.")
@@ -285,7 +335,7 @@ pub(crate) fn image_check(
         score,
         max_score: group.points,
         status,
-        message,
+        message: message.into(),
         visibility: group.visibility,
         tags: vec!["image".to_string(), shown.clone()],
         counts: None,

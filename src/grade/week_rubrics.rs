@@ -2,19 +2,23 @@
 //! `--print-rubric week06`, `autograder --rubric week06`), as TOML text a course can print,
 //! edit and give back as a file.
 //!
-//! Week 4's is [`WEEK04_RUBRIC`](super::rubric::WEEK04_RUBRIC). From week 5 on, a week's rubric
-//! holds, out of 100 points:
-//! - **70 points of functions**: the week's function groups ([`crate::functions::score`]'s,
-//!   their points scaled by 0.7), each group's points shared equally by its functions; the
-//!   functions the week's skeleton gives and the earlier weeks' (week 4's intersections
-//!   included) are checked and reported but carry no points;
-//! - **30 points of images**: each of the week's `main.py` scenes rendered by the grader from the
-//!   submission's own code, at a few samples per pixel ([`week_render_spp`]) so that a Python
-//!   submission renders all of a week's scenes in about a minute of one core, judged against the
-//!   golden of that scene at that sample count (a scene whose render the week's skeleton passes
-//!   is judged and shown without points: [`unscored_image`]);
-//! - the week-4 intersection groups at 0 points (`sphere`, `quad`): a regression shows in the
-//!   feedback without costing points.
+//! Week 4's is [`WEEK04_RUBRIC`](super::rubric::WEEK04_RUBRIC). From week 5 on, a week's points
+//! go only to that week's own tasks: what the week's skeleton leaves blank and the instructor's
+//! solution fills in (the course's code, `weekNN/skeleton` against `weekNN/solution`). Out of
+//! 100 points:
+//! - **70 points of functions** ([`week_function_groups`]): the functions the week's students
+//!   write, each group's points shared equally by its functions. The functions the week's
+//!   skeleton already holds (week 6's `refract` and `schlick`, week 9's `ONB` and jitter, ...)
+//!   and the earlier weeks' (week 4's intersections included) are checked and reported but carry
+//!   no points: the skeleton gives them;
+//! - **30 points of images**: the week's `main.py` scenes that the skeleton does not already
+//!   render right ([`unscored_image`] names the others, judged and shown without points), each
+//!   rendered by the grader from the submission's own `main.py` at a few samples per pixel
+//!   ([`week_render_spp`]), and again from a camera the grader moves by an amount drawn from the
+//!   rubric's secret ([`super::render`]): both must match the reference.
+//!
+//! So the unmodified skeleton earns nothing: every scored function is one it stubs, and every
+//! scored image one its stubs (or its `main.py`'s blank materials) make wrong.
 //!
 //! Week 5 checks the course's current direct term (`E min(1, 1/d)`); a rubric with
 //! `accept = ["older_direct_term_one_over_d"]` also passes the earlier version's functions.
@@ -25,7 +29,6 @@ use std::path::Path;
 
 use super::rubric::{Group, GroupKind, Rubric, RubricError, WEEK04_RUBRIC};
 use crate::functions::Week;
-use crate::functions::score::week_groups;
 
 /// The names of the built-in rubrics.
 pub const BUILTIN_RUBRICS: &[&str] = &[
@@ -43,8 +46,8 @@ pub const IMAGE_POINTS: f64 = 30.0;
 pub const WEEK_RENDER_SECONDS: f64 = 120.0;
 
 /// The samples per pixel of the grader's renders of week `week`'s scenes: 2 for weeks 5 to 7
-/// (400-pixel-wide scenes of 24 to 44 us a sample: 4 to 10 s each), 4 for week 8 (320 x 180,
-/// about 50 us a sample: about 12 s each), and 5 for the jittered scenes of weeks 9 and 10:
+/// (400-pixel-wide scenes of 24 to 44 us a sample: 4 to 10 s each), 4 for weeks 8 and 9 (320 x
+/// 180, about 50 us a sample: about 12 s each), and 5 for the jittered scenes of week 10:
 /// `render_jittered` takes `floor(sqrt(5))^2 = 4` samples and their sum is divided by 5, as the
 /// course's film does (a count that is not a square keeps that departure visible in the
 /// golden; at 4 it would vanish). The goldens of those scenes at 5 are compiled in
@@ -52,8 +55,114 @@ pub const WEEK_RENDER_SECONDS: f64 = 120.0;
 pub fn week_render_spp(week: Week) -> u32 {
     match week.number() {
         ..=7 => 2,
-        8 => 4,
+        8 | 9 => 4,
         _ => 5,
+    }
+}
+
+/// A group of a week's functions in its built-in rubric: its id, name, points and the ids of
+/// its functions (`crate::functions::checks`' ids).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FunctionGroup {
+    /// Its id (`functions.materials`).
+    pub id: &'static str,
+    /// A name for people.
+    pub name: &'static str,
+    /// Its points (the week's add up to [`FUNCTION_POINTS`]).
+    pub points: f64,
+    /// The functions it scores, each the week's own task.
+    pub functions: &'static [&'static str],
+}
+
+const fn fg(
+    id: &'static str,
+    name: &'static str,
+    points: f64,
+    functions: &'static [&'static str],
+) -> FunctionGroup {
+    FunctionGroup {
+        id,
+        name,
+        points,
+        functions,
+    }
+}
+
+/// The scored function groups of `week`'s built-in rubric: only what the week's skeleton leaves
+/// blank (measured on the course's code: each of these fails on the unmodified skeleton and
+/// passes on the instructor's solution):
+///
+/// | week | the skeleton's blanks | scored functions |
+/// |---|---|---|
+/// | 5 | the occlusion test and the direct term in `Integrator.compute_scattering` | `direct-term` (`find_occlusion` itself is given) |
+/// | 6 | `reflect`, `Mirror`, `Dielectric` | `reflect`; `mirror`, `dielectric`, `dielectric-choice` (`refract`, `schlick`, the sky are given) |
+/// | 7 | `Metal`'s reflected direction and fuzz, the quad's `set_uv` | `quad-uv`; `metal`, `metal-fuzz` (the textures and the sphere's uv are given) |
+/// | 8 | Phong's and Blinn's BRDF and scattering, Cook-Torrance | `phong`, `blinn`, `cook-torrance` (`halfvector` and the integrator are given) |
+/// | 9 | `random_cosine_hemisphere_on_z`, scattering through the ONB | `cosine-hemisphere`, `lambertian`, `lambertian-lobe` (the ONB and the jitter are given) |
+/// | 10 | the lens and the time of `get_jittered_ray` | `lens`; `ray-time` |
+pub fn week_function_groups(week: Week) -> &'static [FunctionGroup] {
+    const W5: &[FunctionGroup] = &[fg(
+        "functions.lights",
+        "The direct term of point lights, with its shadow test",
+        70.0,
+        &["direct-term"],
+    )];
+    const W6: &[FunctionGroup] = &[
+        fg("functions.optics", "reflect", 10.0, &["reflect"]),
+        fg(
+            "functions.materials",
+            "Mirror and Dielectric",
+            60.0,
+            &["mirror", "dielectric", "dielectric-choice"],
+        ),
+    ];
+    const W7: &[FunctionGroup] = &[
+        fg(
+            "functions.uv",
+            "The texture coordinates of quads",
+            20.0,
+            &["quad-uv"],
+        ),
+        fg(
+            "functions.metal",
+            "Metal and its fuzz",
+            50.0,
+            &["metal", "metal-fuzz"],
+        ),
+    ];
+    const W8: &[FunctionGroup] = &[fg(
+        "functions.brdf",
+        "The Phong, Blinn and Cook-Torrance BRDFs",
+        70.0,
+        &["phong", "blinn", "cook-torrance"],
+    )];
+    const W9: &[FunctionGroup] = &[fg(
+        "functions.sampling",
+        "The cosine hemisphere and Lambertian scattering through the ONB",
+        70.0,
+        &["cosine-hemisphere", "lambertian", "lambertian-lobe"],
+    )];
+    const W10: &[FunctionGroup] = &[
+        fg(
+            "functions.defocus",
+            "The lens of the jittered rays",
+            35.0,
+            &["lens"],
+        ),
+        fg(
+            "functions.motion",
+            "The time of the jittered rays",
+            35.0,
+            &["ray-time"],
+        ),
+    ];
+    match week.number() {
+        5 => W5,
+        6 => W6,
+        7 => W7,
+        8 => W8,
+        9 => W9,
+        _ => W10,
     }
 }
 
@@ -62,12 +171,11 @@ pub fn week_render_spp(week: Week) -> u32 {
 /// `main_function`).
 pub type WeekScene = (&'static str, &'static str, Option<&'static str>);
 
-/// The week's scenes ([`WeekScene`]).
+/// The week's scenes ([`WeekScene`]), each rendered by its `main.py` function.
 ///
-/// Week 7's two scenes have no `main_function`: their `main.py` reads the course's pictures
-/// (`textures/earthmap.jpg`, ...) from the submission's folder, and the goldens are of pictures
-/// the project generates; so they are rendered from their description, with the generated
-/// pictures handed to the submission's `ImageTexture`.
+/// Week 7's `main.py` reads the course's pictures (`./textures/earthmap.png`, ...); the grader
+/// hands it its own pictures instead (the ones its goldens are made with), so the submission's
+/// `ImageTexture` and the reference read the same texels.
 pub fn week_scenes(week: Week) -> &'static [WeekScene] {
     match week.number() {
         5 => &[
@@ -106,8 +214,16 @@ pub fn week_scenes(week: Week) -> &'static [WeekScene] {
             ),
         ],
         7 => &[
-            ("week07-procedural-texture", "week07_texture_sky.png", None),
-            ("week07-earth", "week07_texture_earth_sky.png", None),
+            (
+                "week07-procedural-texture",
+                "week07_texture_sky.png",
+                Some("renderProceduralTexture"),
+            ),
+            (
+                "week07-earth",
+                "week07_texture_earth_sky.png",
+                Some("renderEarth"),
+            ),
         ],
         8 => &[
             ("week08-phong", "week08_brdf_Phong.png", Some("renderPhong")),
@@ -126,16 +242,25 @@ pub fn week_scenes(week: Week) -> &'static [WeekScene] {
 }
 
 /// Why a week's scene is rendered and judged but carries no points in the built-in rubric, when
-/// it does not: an image that the week's skeleton passes measures nothing of the student's.
+/// it does not: an image that the week's unmodified skeleton renders right measures nothing of
+/// the student's work.
 ///
-/// `week10-dof`: the week-10 skeleton's jittered rays have no lens, and at the grader's samples
-/// its render matches the golden (measured at 5 and at 10 spp: the 2-degree lens blurs edges by
-/// about 2 pixels, within the noise of a few samples). The lens is scored by its function check
-/// (35 points) instead.
+/// - `week05-quad`, `week05-quad-light`: no point light, so the week's task (the direct term
+///   of point lights) does not show; the skeleton renders them as the solution does.
+/// - `week10-dof`: the week-10 skeleton's jittered rays have no lens, and at the grader's
+///   samples its render matches the golden (measured at 5 and at 10 spp: the 2-degree lens
+///   blurs edges by about 2 pixels, within the noise of a few samples). The lens is scored by
+///   its function check instead.
 pub fn unscored_image(scene: &str) -> Option<&'static str> {
-    (scene == "week10-dof").then_some(
-        "at the grader's samples the render of the week-10 skeleton, whose jittered rays have no lens, passes this image; the lens is scored by its function check",
-    )
+    match scene {
+        "week05-quad" | "week05-quad-light" => Some(
+            "the scene has no point light, so the week's task (the direct term of point lights) does not show in it, and the week's skeleton renders it right",
+        ),
+        "week10-dof" => Some(
+            "at the grader's samples the render of the week-10 skeleton, whose jittered rays have no lens, passes this image; the lens is scored by its function check",
+        ),
+        _ => None,
+    }
 }
 
 /// The TOML text of the built-in rubric `name` (`week04` ... `week10`), or `None`.
@@ -171,8 +296,9 @@ fn week_rubric_toml(week: Week) -> String {
         points(IMAGE_POINTS)
     );
     t.push_str(
-        "# The functions the week's skeleton gives and the earlier weeks' (week 4's intersections\n\
-         # included) are checked and reported without points.\n",
+        "# Points go only to the week's own tasks (what its skeleton leaves blank): the functions\n\
+         # the skeleton gives and the earlier weeks' (week 4's intersections included) are checked\n\
+         # and reported without points, and so are the images the skeleton already renders right.\n",
     );
     let _ = writeln!(t, "name = \"week{n:02}\"");
     let _ = writeln!(t, "week = {n}");
@@ -188,7 +314,7 @@ fn week_rubric_toml(week: Week) -> String {
     t.push_str(
         "code_time_budget_seconds = 120 # wall time for all of a submission's code checks\n",
     );
-    for g in week_groups(week) {
+    for g in week_function_groups(week) {
         let list: Vec<String> = g.functions.iter().map(|f| format!("{f:?}")).collect();
         let _ = write!(
             t,
@@ -196,7 +322,7 @@ fn week_rubric_toml(week: Week) -> String {
             g.id,
             g.name,
             list.join(", "),
-            points(g.points * FUNCTION_POINTS / 100.0)
+            points(g.points)
         );
     }
     let scenes = week_scenes(week);
@@ -405,14 +531,30 @@ mod tests {
                 .filter(|g| g.kind == GroupKind::Functions)
                 .flat_map(|g| g.functions.iter().flatten().map(String::as_str))
                 .collect();
-            let mut own: Vec<&str> = week_groups(week)
+            let own: Vec<&str> = week_function_groups(week)
                 .iter()
                 .flat_map(|g| g.functions.iter().copied())
                 .collect();
-            own.sort();
-            let mut got = scored.clone();
-            got.sort();
-            assert_eq!(got, own, "{name}");
+            assert_eq!(scored, own, "{name}");
+            let points: f64 = week_function_groups(week).iter().map(|g| g.points).sum();
+            assert!((points - FUNCTION_POINTS).abs() < 1e-9, "{name}: {points}");
+            // Every scored function is one the week checks in its own version, and not one the
+            // checks hold as given by the skeleton.
+            let checks = crate::functions::checks::week_checks(week, 0);
+            for f in &own {
+                let c = checks.iter().find(|c| c.id == *f);
+                let c =
+                    c.unwrap_or_else(|| panic!("{name}: {f} is not a function the week checks"));
+                assert_eq!(c.week, week, "{name}: {f} is an earlier week's");
+                assert!(!c.given, "{name}: {f} is given by the skeleton");
+            }
+            let image_points: f64 = r
+                .groups
+                .iter()
+                .filter(|g| g.kind == GroupKind::Image)
+                .map(|g| g.points)
+                .sum();
+            assert!((image_points - IMAGE_POINTS).abs() < 1e-9, "{name}");
             let images: Vec<&str> = r
                 .groups
                 .iter()

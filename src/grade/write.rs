@@ -12,7 +12,8 @@ use super::run::grade;
 use crate::output::{OutputDir, Replaceable};
 
 /// Whether `name` is a file rtoracle's reports consist of (so an old report folder may be
-/// replaced whole): a report, a heatmap, a batch's gradebook, summary or `batch.json`.
+/// replaced whole): a report, a heatmap, a batch's gradebook, summary or `batch.json`, a
+/// batch submission's `batch-entry.json`.
 fn is_report_file(name: &str) -> bool {
     matches!(
         name,
@@ -23,6 +24,7 @@ fn is_report_file(name: &str) -> bool {
             | "gradebook.csv"
             | "summary.md"
             | "batch.json"
+            | "batch-entry.json"
     ) || (name.starts_with("heatmap-") && name.ends_with(".png"))
 }
 

@@ -35,7 +35,7 @@ pub(crate) struct CameraInput {
 }
 
 impl CameraInput {
-    fn json(&self) -> serde_json::Value {
+    pub(crate) fn json(&self) -> serde_json::Value {
         let s = &self.settings;
         json!({
             "width": self.width, "aspect_ratio": jnum(self.aspect_ratio), "spp": self.spp,
@@ -44,19 +44,19 @@ impl CameraInput {
         })
     }
 
-    fn reference(&self) -> Camera {
+    pub(crate) fn reference(&self) -> Camera {
         Camera::new(&self.settings, self.width, self.aspect_ratio)
     }
 
     /// The reference's frame: `u`, `v`, `w` and the defocus radius.
-    fn frame(&self) -> (DVec3, DVec3, DVec3, f64) {
+    pub(crate) fn frame(&self) -> (DVec3, DVec3, DVec3, f64) {
         let c = self.reference();
         let u = c.pixel_delta_u.normalize();
         let v = -c.pixel_delta_v.normalize();
         (u, v, u.cross(v), c.defocus_disk_u.length())
     }
 
-    fn py(&self) -> String {
+    pub(crate) fn py(&self) -> String {
         let s = &self.settings;
         let v = |a: [f64; 3]| py::vec(DVec3::from(a));
         format!(
@@ -75,7 +75,7 @@ impl CameraInput {
 }
 
 /// Week 10's depth-of-field camera (from (-2, 2, 1) at (0, 0, -1), vfov 60, focus 5, 2 degrees).
-fn dof_camera(spp: u32, defocus_angle: f64) -> CameraInput {
+pub(crate) fn dof_camera(spp: u32, defocus_angle: f64) -> CameraInput {
     CameraInput {
         settings: CameraSettings {
             look_from: [-2.0, 2.0, 1.0],

@@ -2,17 +2,20 @@
 //! Lambertian `n + u`, week 7's `Metal`, week 9's cosine hemisphere, `ONB` and the Lambertian
 //! through it.
 //!
-//! A scattering's formula is checked with the course's random function replaced by given
-//! values (`random_vec3_unit`, `random_cosine_hemisphere_on_z`): the answer is then exact. Code
-//! that does not call that function cannot be steered so: those cases are not scored and the
-//! statistical check of the same scattering (real random numbers, seeded) judges it.
+//! A scattering's formula is checked with the course's `random_double` steered (the values it
+//! returns given by the request, [`super::steer`]): the course's `Vec3.random_vec3_unit()` and
+//! `random_cosine_hemisphere_on_z()` draw through it, so the answer of course-shaped code is
+//! exact. An answer drawn otherwise is judged by what it does: it must keep the invariant of the
+//! statistical check of the same scattering (real random numbers, seeded), and counts as right
+//! only when that check passed.
 
 use glam::DVec3;
 use serde_json::json;
 
 use super::optics::{HitInput, sample_requests, scatter_samples, scattered};
 use super::{
-    Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, stream, week,
+    Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, steer,
+    stream, week,
 };
 use crate::functions::expect::{Class, Expected, Want, numbers};
 use crate::functions::samplers::{
@@ -141,53 +144,69 @@ fn lambertian_hits(seed: u64, id: &str) -> Vec<HitInput> {
 
 const ALBEDO: DVec3 = DVec3::new(0.5, 0.25, 1.0);
 
+/// The `random_double` values of the Lambertian cases: for the first hit `u = x` and `u = -n`
+/// exactly (`n + u = 0`, where the course uses `n`); then random unit vectors, every other one
+/// after a point the rejection loop throws away.
+fn lambertian_values(seed: u64, hits: &[HitInput]) -> Vec<(usize, Vec<f64>)> {
+    let mut r = stream(seed, "lambertian-u");
+    let mut out = Vec::new();
+    for (k, h) in hits.iter().enumerate() {
+        if k == 0 {
+            let (n, _) = h.facing();
+            out.push((k, steer::cube_values(DVec3::new(0.5, 0.0, 0.0))));
+            out.push((k, steer::cube_values(-0.5 * n)));
+        } else {
+            out.push((k, steer::unit_vector_values(&mut r, k % 2 == 1)));
+        }
+    }
+    out
+}
+
 fn lambertian_check(seed: u64) -> FunctionCheck {
     let hits = lambertian_hits(seed, "lambertian");
-    let mut r = stream(seed, "lambertian-u");
     let mut cases = Vec::new();
+    let mut behaviour = Vec::new();
     let (mut normalised, mut hemisphere) = (Vec::new(), Vec::new());
-    for (k, h) in hits.iter().enumerate() {
+    for (k, values) in lambertian_values(seed, &hits) {
+        let h = &hits[k];
         let (n, _) = h.facing();
-        // The first hit also gets u = -n exactly: n + u = 0, where the course uses n.
-        let units = if k == 0 {
-            vec![DVec3::X, -n]
-        } else {
-            vec![simulate::unit_vector(&mut r)]
-        };
-        for u in units {
-            let raw = n + u;
-            let degenerate = raw.abs().max_element() < 1e-8;
-            // Within rounding of the threshold (one component between 0.5e-8 and 2e-8, the
-            // others below): the case is not scored.
-            let near = !degenerate && raw.abs().max_element() < 2e-8;
-            let d = if degenerate { n } else { raw };
-            let tol = 1e-9;
-            let (ray, hit) = h.json();
-            let i = cases.len();
-            cases.push(Case {
-                id: format!("lambertian-{i:04}"),
-                request: json!({"op": "scatter", "material": {"type": "lambertian", "albedo": jvec(ALBEDO)}, "ray": ray, "hit": hit, "replace": {"random_vec3_unit": [jvec(u)]}}),
-                expect: scattered(h.point, d, tol, ALBEDO),
-                class: if near { Class::Ambiguous("n + u within rounding of the 1e-8 threshold".into()) } else { Class::Definite },
-                input: format!("{}, random_vec3_unit() = {}", h.words(), py::list(u)),
-                repro: py::script(
-                    &format!(
-                        "{}\n{}\ns = m.scattering(ray, hit)\n{}",
-                        py::random_vectors("random_vec3_unit", &[u]),
-                        h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO))),
+        let (u, _) = steer::course_unit_vector(&values).expect("values for one unit vector");
+        let raw = n + u;
+        // The course's near_zero: every component below 1e-8.
+        let degenerate = raw.abs().max_element() < 1e-8;
+        // Within rounding of the threshold (one component between 0.5e-8 and 2e-8, the
+        // others below): the case is not scored.
+        let near = !degenerate && raw.abs().max_element() < 2e-8;
+        let d = if degenerate { n } else { raw };
+        let tol = 1e-9;
+        let (ray, hit) = h.json();
+        let i = cases.len();
+        let id = format!("lambertian-{i:04}");
+        cases.push(Case {
+            request: json!({"op": "scatter", "material": {"type": "lambertian", "albedo": jvec(ALBEDO)}, "ray": ray, "hit": hit, "replace": {"random_double": values.iter().map(|&v| jnum(v)).collect::<Vec<_>>()}, "seed": steer::case_seed(seed, &id)}),
+            id,
+            expect: scattered(h.point, d, tol, ALBEDO),
+            class: if near { Class::Ambiguous("n + u within rounding of the 1e-8 threshold".into()) } else { Class::Definite },
+            input: format!("{}, random_double() = {} (random_vec3_unit() = {})", h.words(), py_values(&values), py::list(u)),
+            repro: py::script(
+                &format!(
+                    "{}\n{}\ns = m.scattering(ray, hit)\n{}",
+                    py::random_doubles(&values),
+                    h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO))),
                         py::PRINT_SCATTERED
-                    ),
-                    &py::list(d),
                 ),
-            });
-            normalised
-                .push((!degenerate).then(|| scattered(h.point, raw.normalize(), tol, ALBEDO)));
-            let flipped = if u.dot(n) < 0.0 { -u } else { u };
-            hemisphere.push(
-                (!degenerate && u.dot(n).abs() > 1e-9)
-                    .then(|| scattered(h.point, flipped, tol, ALBEDO)),
-            );
-        }
+                &py::list(d),
+            ),
+        });
+        behaviour.push(steer::scatter_behaviour(SamplerCheck::lambertian_n_plus_u(
+            h.point, n, ALBEDO,
+        )));
+        normalised.push((!degenerate).then(|| scattered(h.point, raw.normalize(), tol, ALBEDO)));
+        let flipped = if u.dot(n) < 0.0 { -u } else { u };
+        hemisphere.push(
+            (!degenerate && u.dot(n).abs() > 1e-9)
+                .then(|| scattered(h.point, flipped, tol, ALBEDO)),
+        );
     }
     FunctionCheck {
         id: "lambertian",
@@ -195,8 +214,8 @@ fn lambertian_check(seed: u64) -> FunctionCheck {
         week: week(5),
         given: false,
         op: "scatter",
-        tolerance: "with random_vec3_unit() given: the direction n + u (n when every component is below 1e-8) within 1e-9, origin the hit point, attenuation the albedo",
-        body: Body::Cases {
+        tolerance: "with random_double() steered: the direction n + random_vec3_unit() (n when every component is below 1e-8) within 1e-9, origin the hit point, attenuation the albedo; an answer drawn otherwise counts when it is n + u for a unit u and lambertian-lobe passes",
+        body: Body::Steered {
             cases,
             variants: vec![
                 Variant {
@@ -212,28 +231,18 @@ fn lambertian_check(seed: u64) -> FunctionCheck {
                     expect: hemisphere,
                 },
             ],
-            normalise: Some(unsteered),
+            partners: &["lambertian-lobe"],
+            behaviour,
+            normalise: None,
         },
         timeout: CASE_TIMEOUT,
     }
 }
 
-/// A scattering answer whose code drew nothing from the replaced function (and scattered) cannot
-/// be judged on its direction: it keeps only `"unsteered"`, which no expectation holds, so the runner reports
-/// it as not scored.
-fn unsteered(answer: serde_json::Value) -> serde_json::Value {
-    if answer.get("scattered") == Some(&serde_json::Value::Bool(false)) {
-        // Absorbed (a stub's None): judged as it is, whatever it drew.
-        return answer;
-    }
-    let drew = answer
-        .get("draws")
-        .and_then(serde_json::Value::as_object)
-        .map(|d| d.values().any(|v| v.as_u64().is_some_and(|k| k > 0)));
-    match drew {
-        Some(false) => json!({"unsteered": true}),
-        _ => answer,
-    }
+/// The values of `random_double` as a Python list.
+fn py_values(values: &[f64]) -> String {
+    let list: Vec<String> = values.iter().map(|&v| py::f(v)).collect();
+    format!("[{}]", list.join(", "))
 }
 
 fn lambertian_lobe_check(seed: u64, cosine: bool) -> FunctionCheck {
@@ -384,37 +393,44 @@ fn lambertian_onb_check(seed: u64) -> FunctionCheck {
     let hits = lambertian_hits(seed, "lambertian-onb");
     let mut r = stream(seed, "lambertian-onb-c");
     let mut cases = Vec::new();
+    let mut behaviour = Vec::new();
     let mut wrong_axis = Vec::new();
     for (k, h) in hits.iter().enumerate() {
         let (n, _) = h.facing();
-        let c = if k == 0 {
-            DVec3::new(0.0, 0.5f64.sqrt(), 0.5f64.sqrt())
+        // random_double() = r1, r2: phi = 2 pi r1, z = sqrt(1 - r2).
+        let (r1, r2) = if k == 0 {
+            (0.25, 0.5)
         } else {
-            simulate::cosine_hemisphere(&mut r)
+            (r.next_f64(), r.next_f64())
         };
+        let c = steer::course_cosine_hemisphere(r1, r2);
         let b = Onb::from_w(n);
         let d = b.local(c);
         let (ray, hit) = h.json();
+        let id = format!("lambertian-onb-{k:04}");
         cases.push(Case {
-            id: format!("lambertian-onb-{k:04}"),
-            request: json!({"op": "scatter", "material": {"type": "lambertian", "albedo": jvec(ALBEDO)}, "ray": ray, "hit": hit, "replace": {"random_cosine_hemisphere_on_z": [jvec(c)]}}),
+            request: json!({"op": "scatter", "material": {"type": "lambertian", "albedo": jvec(ALBEDO)}, "ray": ray, "hit": hit, "replace": {"random_double": [jnum(r1), jnum(r2)]}, "seed": steer::case_seed(seed, &id)}),
+            id,
             expect: scattered(h.point, d, 1e-9, ALBEDO),
             class: if onb_switch_is_close(n) {
                 Class::Ambiguous("|n.x| is within rounding of 0.9, where the ONB's helper vector switches".into())
             } else {
                 Class::Definite
             },
-            input: format!("{}, random_cosine_hemisphere_on_z() = {}", h.words(), py::list(c)),
+            input: format!("{}, random_double() = {}, {} (random_cosine_hemisphere_on_z() = {})", h.words(), py::f(r1), py::f(r2), py::list(c)),
             repro: py::script(
                 &format!(
                     "{}\n{}\ns = m.scattering(ray, hit)\n{}",
-                    py::random_vectors("random_cosine_hemisphere_on_z", &[c]),
+                    py::random_doubles(&[r1, r2]),
                     h.py(&format!("rtm.Lambertian({})", py::color(ALBEDO))),
                     py::PRINT_SCATTERED
                 ),
                 &py::list(d),
             ),
         });
+        behaviour.push(steer::scatter_behaviour(SamplerCheck::lambertian_cosine(
+            h.point, n, ALBEDO,
+        )));
         wrong_axis.push(Some(scattered(
             h.point,
             c.z * b.u + c.y * b.v + c.x * b.w,
@@ -428,8 +444,8 @@ fn lambertian_onb_check(seed: u64) -> FunctionCheck {
         week: week(9),
         given: false,
         op: "scatter",
-        tolerance: "with random_cosine_hemisphere_on_z() given: the direction ONB(n).local(x, y, z) within 1e-9, origin the hit point, attenuation the albedo",
-        body: Body::Cases {
+        tolerance: "with random_double() steered: the direction ONB(n).local(random_cosine_hemisphere_on_z()) within 1e-9, origin the hit point, attenuation the albedo; an answer drawn otherwise counts when it is a unit vector on the normal's side and lambertian-lobe passes",
+        body: Body::Steered {
             cases,
             variants: vec![Variant {
                 name: "lobe_around_wrong_axis",
@@ -437,26 +453,30 @@ fn lambertian_onb_check(seed: u64) -> FunctionCheck {
                 standing: Standing::Mistake,
                 expect: wrong_axis,
             }],
-            normalise: Some(unsteered),
+            partners: &["lambertian-lobe"],
+            behaviour,
+            normalise: None,
         },
         timeout: CASE_TIMEOUT,
     }
 }
 
-/// The hits of the metal checks and their roughness.
-fn metal_inputs(seed: u64) -> Vec<(HitInput, f64, DVec3)> {
-    let s = std::f64::consts::FRAC_1_SQRT_2;
+/// The hits of the metal checks, their roughness and the values of `random_double` (for the
+/// course's `random_vec3_unit()`: x, -y, z and (1, 1, 0) / sqrt(2) first, then random, every
+/// other one after a point the rejection loop throws away).
+fn metal_inputs(seed: u64) -> Vec<(HitInput, f64, Vec<f64>)> {
     let base = HitInput {
         origin: DVec3::new(-1.0, 1.0, 0.0),
         direction: DVec3::new(1.0, -1.0, 0.0),
         point: DVec3::ZERO,
         outward: DVec3::Y,
     };
+    let cube = |x: f64, y: f64, z: f64| steer::cube_values(DVec3::new(x, y, z));
     let mut inputs = vec![
-        (HitInput { ..base }, 0.5, DVec3::X),
-        (HitInput { ..base }, 1.0, DVec3::new(0.0, -1.0, 0.0)),
-        (HitInput { ..base }, 3.0, DVec3::new(0.0, 0.0, 1.0)),
-        (HitInput { ..base }, 0.0, DVec3::new(s, s, 0.0)),
+        (HitInput { ..base }, 0.5, cube(0.5, 0.0, 0.0)),
+        (HitInput { ..base }, 1.0, cube(0.0, -0.5, 0.0)),
+        (HitInput { ..base }, 3.0, cube(0.0, 0.0, 0.5)),
+        (HitInput { ..base }, 0.0, cube(0.5, 0.5, 0.0)),
     ];
     let mut r = stream(seed, "metal");
     for k in 0..6 {
@@ -475,7 +495,7 @@ fn metal_inputs(seed: u64) -> Vec<(HitInput, f64, DVec3)> {
                 outward,
             },
             [0.1, 0.5, 0.9][k % 3],
-            simulate::unit_vector(&mut r),
+            steer::unit_vector_values(&mut r, k % 2 == 0),
         ));
     }
     inputs
@@ -506,8 +526,10 @@ fn metal_check(seed: u64) -> FunctionCheck {
             Vec::new(),
         ),
     ];
-    for (k, (h, roughness, u)) in metal_inputs(seed).into_iter().enumerate() {
+    let mut behaviour = Vec::new();
+    for (k, (h, roughness, values)) in metal_inputs(seed).into_iter().enumerate() {
         let (n, _) = h.facing();
+        let (u, _) = steer::course_unit_vector(&values).expect("values for one unit vector");
         let fuzz = roughness.min(1.0);
         let answer = |mirror: DVec3, fuzz: f64, absorbs: bool| -> (Expected, bool) {
             let d = mirror + fuzz * u;
@@ -530,16 +552,28 @@ fn metal_check(seed: u64) -> FunctionCheck {
         variants[2].2.push(defined(answer(mirror, roughness, true)));
         variants[3].2.push(defined(answer(mirror, fuzz, false)));
         let (ray, hit) = h.json();
+        let id = format!("metal-{k:04}");
+        behaviour.push(steer::scatter_behaviour(SamplerCheck::metal(
+            MetalSetting {
+                point: h.point,
+                normal: n,
+                albedo,
+                mirror,
+                raw_mirror: reflect(h.direction, n),
+                roughness: fuzz,
+                given_roughness: roughness,
+            },
+        )));
         cases.push(Case {
-            id: format!("metal-{k:04}"),
-            request: json!({"op": "scatter", "material": {"type": "metal", "albedo": jvec(albedo), "roughness": jnum(roughness)}, "ray": ray, "hit": hit, "replace": {"random_vec3_unit": [jvec(u)]}}),
+            request: json!({"op": "scatter", "material": {"type": "metal", "albedo": jvec(albedo), "roughness": jnum(roughness)}, "ray": ray, "hit": hit, "replace": {"random_double": values.iter().map(|&v| jnum(v)).collect::<Vec<_>>()}, "seed": steer::case_seed(seed, &id)}),
+            id,
             expect,
             class: if near { Class::Ambiguous("d . n is within rounding of 1e-8".into()) } else { Class::Definite },
-            input: format!("Metal(roughness {}): {}, random_vec3_unit() = {}", py::f(roughness), h.words(), py::list(u)),
+            input: format!("Metal(roughness {}): {}, random_double() = {} (random_vec3_unit() = {})", py::f(roughness), h.words(), py_values(&values), py::list(u)),
             repro: py::script(
                 &format!(
                     "{}\n{}\ns = m.scattering(ray, hit)\n{}",
-                    py::random_vectors("random_vec3_unit", &[u]),
+                    py::random_doubles(&values),
                     h.py(&format!("rtm.Metal({}, {})", py::color(albedo), py::f(roughness))),
                     py::PRINT_SCATTERED
                 ),
@@ -553,8 +587,8 @@ fn metal_check(seed: u64) -> FunctionCheck {
         week: week(7),
         given: false,
         op: "scatter",
-        tolerance: "with random_vec3_unit() given: reflect(unit(d), n) + min(roughness, 1) u within 1e-9; the attenuation the albedo, or 0 where d . n <= 1e-8",
-        body: Body::Cases {
+        tolerance: "with random_double() steered: reflect(unit(d), n) + min(roughness, 1) random_vec3_unit() within 1e-9; the attenuation the albedo, or 0 where d . n <= 1e-8; an answer drawn otherwise counts when it lies min(roughness, 1) from the mirror direction and metal-fuzz passes",
+        body: Body::Steered {
             cases,
             variants: variants
                 .into_iter()
@@ -565,7 +599,9 @@ fn metal_check(seed: u64) -> FunctionCheck {
                     expect,
                 })
                 .collect(),
-            normalise: Some(unsteered),
+            partners: &["metal-fuzz"],
+            behaviour,
+            normalise: None,
         },
         timeout: CASE_TIMEOUT,
     }

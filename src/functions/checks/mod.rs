@@ -24,6 +24,8 @@ pub(crate) mod lambert;
 pub(crate) mod lights;
 pub(crate) mod optics;
 pub(crate) mod py;
+pub(crate) mod steer;
+pub(crate) mod steered_camera;
 pub(crate) mod surface;
 
 /// One request of a deterministic check and what it must answer.
@@ -72,6 +74,22 @@ pub enum Body {
         /// The catalogued mistakes.
         variants: Vec<Variant>,
         /// Applied to each answer before judging.
+        normalise: Option<Normalise>,
+    },
+    /// Cases whose random numbers the requests steer (the values of the course's
+    /// `random_double`, or of the camera's generator), judged as [`steer`] says: right when the
+    /// answer is the course's, or when it keeps its case's behaviour and the statistical
+    /// checks `partners` passed.
+    Steered {
+        /// The cases, simplest first.
+        cases: Vec<Case>,
+        /// The catalogued mistakes.
+        variants: Vec<Variant>,
+        /// The ids of the same function's statistical checks.
+        partners: &'static [&'static str],
+        /// Per case: what an answer that is not the course's must keep.
+        behaviour: Vec<steer::Behaviour>,
+        /// Applied to each answer (after its keys are checked) before judging.
         normalise: Option<Normalise>,
     },
     /// Samples, judged by a [`SamplerCheck`].
@@ -127,6 +145,7 @@ pub fn week_checks(of: Week, seed: u64) -> Vec<FunctionCheck> {
     all.extend(surface::checks(seed));
     all.extend(brdf::checks(seed));
     all.extend(camera::checks(seed));
+    all.extend(steered_camera::checks(seed));
     // For each id, the latest version up to `of`.
     let mut chosen: Vec<FunctionCheck> = Vec::new();
     for check in all.into_iter().filter(|c| c.week <= of) {
@@ -153,7 +172,9 @@ pub fn alternatives(of: Week) -> Vec<&'static str> {
     let mut out: Vec<&'static str> = Vec::new();
     for c in week_checks(of, 0) {
         let named: Vec<(&'static str, Standing)> = match &c.body {
-            Body::Cases { variants, .. } => variants.iter().map(|v| (v.name, v.standing)).collect(),
+            Body::Cases { variants, .. } | Body::Steered { variants, .. } => {
+                variants.iter().map(|v| (v.name, v.standing)).collect()
+            }
             Body::Samples { check, .. } => check
                 .mistakes
                 .iter()

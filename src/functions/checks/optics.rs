@@ -11,7 +11,8 @@ use glam::DVec3;
 use serde_json::json;
 
 use super::{
-    Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, stream, week,
+    Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, steer,
+    stream, week,
 };
 use crate::functions::expect::{Class, Expected, Want};
 use crate::functions::samplers::{
@@ -689,7 +690,7 @@ pub(crate) fn scatter_samples(answer: &serde_json::Value) -> Result<Vec<Sample>,
 
 /// Requests of `total` samples of `numbers` numbers each, in chunks whose answers stay well
 /// under [`crate::candidate::protocol::MAX_RESULT_BYTES`] (about 22 bytes a number), each
-/// with its own seed.
+/// with its own seed, derived from the checks' seed for its purpose ([`crate::secret`]).
 pub(crate) fn sample_requests(
     base: serde_json::Value,
     total: usize,
@@ -699,7 +700,6 @@ pub(crate) fn sample_requests(
 ) -> Vec<serde_json::Value> {
     let chunk =
         (crate::candidate::protocol::MAX_RESULT_BYTES * 2 / 3 / (24 * numbers)).clamp(1, 2000);
-    let mut h = stream(seed, id);
     let mut out = Vec::new();
     let mut left = total;
     while left > 0 {
@@ -707,7 +707,10 @@ pub(crate) fn sample_requests(
         left -= n;
         let mut req = base.clone();
         req["n"] = json!(n);
-        req["seed"] = json!((h.next_f64() * 4_294_967_296.0) as u64);
+        req["seed"] = json!(crate::secret::derive32(
+            seed,
+            &format!("samples/{id}/{}", out.len())
+        ));
         out.push(req);
     }
     out

@@ -54,16 +54,6 @@ pub(crate) fn random_doubles(values: &[f64]) -> String {
     )
 }
 
-/// The lines that make the course's `rtu.Vec3.NAME()` (a static method) return the vectors
-/// `values` in turn.
-pub(crate) fn random_vectors(name: &str, values: &[DVec3]) -> String {
-    let list: Vec<String> = values.iter().map(|&v| vec(v)).collect();
-    format!(
-        "_v = iter([{}])\nrtu.Vec3.{name} = staticmethod(lambda: next(_v))",
-        list.join(", ")
-    )
-}
-
 /// The line that prints what a scattering `s` gave: its ray's origin and direction and its
 /// attenuation, keyed as the answer's fields.
 pub(crate) const PRINT_SCATTERED: &str = "print({'origin': s.scattered_ray.getOrigin().e, 'direction': s.scattered_ray.getDirection().e, 'attenuation': s.attenuation_color.e})";

@@ -10,13 +10,11 @@
 
 use std::fmt::Write;
 
-use crate::escape::{markdown_block, markdown_inline};
+use crate::escape::{Untrusted, markdown_block, markdown_inline};
 use crate::grade::result::smallest_case_sentence;
 use crate::grade::{CheckResult, CheckStatus, FailureKind, FailureSummary, smallest_failure};
 
-/// How an image check that could not run says it when the file is not in the submission
-/// (the intake's and the image checker's own words).
-const MISSING: &str = "is missing from the submission";
+use crate::grade::score::MISSING;
 
 /// Whether `c` is an image check whose file is not in the submission.
 pub(crate) fn is_missing_image(c: &CheckResult) -> bool {
@@ -27,13 +25,24 @@ pub(crate) fn is_missing_image(c: &CheckResult) -> bool {
         })
 }
 
-/// The word for a scored check's result.
+/// Whether `c` is an image check judged on the grader's render of the submission's code.
+fn is_rendered(c: &CheckResult) -> bool {
+    c.image
+        .as_ref()
+        .is_some_and(|i| i.metrics.get("source").and_then(|s| s.as_str()) == Some("render"))
+}
+
+/// The word for a scored check's result: what became of it, never a vague "could not be
+/// checked" (an image not uploaded is "missing" under a rubric that judges uploads; one the
+/// grader could not render from the code is "not rendered", whatever was uploaded).
 pub(crate) fn result_word(c: &CheckResult) -> &'static str {
     match c.status {
         CheckStatus::Passed => "passed",
         CheckStatus::Failed => "failed",
+        CheckStatus::Error if is_rendered(c) => "not rendered",
         CheckStatus::Error if is_missing_image(c) => "missing",
-        CheckStatus::Error => "could not be checked",
+        CheckStatus::Error if c.image.is_some() => "unusable",
+        CheckStatus::Error => "not run",
         CheckStatus::Skipped => "not scored",
     }
 }
@@ -63,13 +72,22 @@ impl RaisedAt {
     }
 }
 
+/// The files rtoracle writes beside the submission's modules in the sandbox (the course
+/// adapter and its drivers): a frame in one of them is never the student's.
+const ADAPTER_FILES: [&str; 3] = [
+    "course_adapter.py",
+    "rtoracle_course_functions.py",
+    "rtoracle_course_program.py",
+];
+
 /// Whether a traceback's file is Python's own (the standard library, an installed package, a
-/// frozen module) rather than one of the submission's.
+/// frozen module) or the grader's adapter, rather than one of the submission's.
 fn is_library(path: &str) -> bool {
     path.starts_with('<')
         || path.contains("/site-packages/")
         || path.contains("/dist-packages/")
         || path.contains("/lib/python")
+        || ADAPTER_FILES.contains(&path.rsplit('/').next().unwrap_or(path))
 }
 
 /// Where a traceback says the exception was raised in the submission's code: its last
@@ -111,21 +129,31 @@ pub(crate) fn raised_at_in(traceback: &str) -> Option<RaisedAt> {
     found
 }
 
-/// Where the exception of a failure that raised one was raised, from the traceback the code
-/// sent with it.
+/// Where the exception of a failure that raised one was raised: the place the code sent with
+/// it (the adapter's `file` and `line`, [`crate::candidate::CandidateError`]), else its
+/// traceback's last frame of the submission ([`raised_at_in`]).
 pub(crate) fn raised_at(f: &FailureSummary) -> Option<RaisedAt> {
     if f.kind != FailureKind::Error {
         return None;
     }
-    let traceback = f.actual.get("error")?.get("traceback")?.as_str()?;
-    raised_at_in(traceback)
+    let error = f.actual.get("error")?;
+    let text = |key: &str| error.get(key).and_then(|v| v.as_str()).map(str::to_string);
+    if let (Some(file), Some(line)) = (text("file"), error.get("line").and_then(|v| v.as_u64())) {
+        return Some(RaisedAt {
+            file: file.rsplit('/').next().unwrap_or_default().to_string(),
+            line,
+            function: text("function"),
+            code: text("code"),
+        });
+    }
+    raised_at_in(error.get("traceback")?.as_str()?)
 }
 
 /// The errors a report has already shown, so that a later section refers to them instead of
 /// saying them again: each error's message and place, and the section that showed it.
 #[derive(Default)]
 pub(crate) struct Shown {
-    errors: Vec<(String, Option<RaisedAt>, String)>,
+    errors: Vec<(Untrusted, Option<RaisedAt>, String)>,
 }
 
 impl Shown {
@@ -188,7 +216,7 @@ fn case_name(f: &FailureSummary) -> String {
 /// earlier section showed is referred to, not repeated; `section` names this one for later ones.
 pub(crate) fn check_body(
     c: &CheckResult,
-    quote: fn(&str) -> String,
+    quote: fn(&Untrusted) -> String,
     shown: &mut Shown,
     section: &str,
 ) -> String {
@@ -198,15 +226,17 @@ pub(crate) fn check_body(
     let mut md = String::new();
     let smallest = smallest_failure(&c.failures);
     let sentence = smallest.map(smallest_case_sentence);
-    // The harness's own sentence (counts, the rubric's names, the comparison's words) is kept as
-    // it reads; the vector's message it ends with is shown below in a block. A code check that
-    // could not run quotes Python in its message: that one is escaped whole.
+    // The check's message, escaped as text (a render's exception, a copy finding and the
+    // comparison's words can all carry the submission's text); the vector's message it ends
+    // with is shown below in a block.
     let own = match &sentence {
-        Some(s) => c.message.strip_suffix(s.as_str()).map(str::to_string),
-        None if c.counts.is_some() && c.status == CheckStatus::Error => None,
-        None => Some(c.message.clone()),
+        Some(s) => c
+            .message
+            .strip_suffix_of(s)
+            .unwrap_or_else(|| c.message.clone()),
+        None => c.message.clone(),
     };
-    md.push_str(&own.unwrap_or_else(|| markdown_inline(&c.message)));
+    md.push_str(&own.markdown_inline());
     md.push('\n');
     let Some(f) = smallest else {
         return md;
@@ -247,7 +277,7 @@ pub(crate) fn check_body(
     } else {
         md.push_str("\nOther failing cases:\n\n");
         for g in others {
-            let _ = writeln!(md, "- {}: {}", case_name(g), markdown_inline(&g.message));
+            let _ = writeln!(md, "- {}: {}", case_name(g), g.message.markdown_inline());
         }
     }
     md
@@ -269,9 +299,9 @@ fn ambiguous_counts(c: &CheckResult, checks: &[CheckResult]) -> Option<(usize, u
 fn function_body(
     c: &CheckResult,
     f: &crate::functions::FunctionResult,
-    quote: fn(&str) -> String,
+    quote: fn(&Untrusted) -> String,
 ) -> String {
-    let mut md = markdown_inline(&c.message);
+    let mut md = c.message.markdown_inline();
     md.push('\n');
     if let Some(failure) = &f.failure {
         let _ = write!(
@@ -280,7 +310,7 @@ fn function_body(
             f.id.replace('`', "'"),
             failure.case.replace('`', "'"),
             markdown_inline(&failure.input),
-            quote(&failure.problem)
+            quote(&Untrusted::from(failure.problem.as_str()))
         );
         md.push_str(&format!(
             "\nTo run it yourself, save this as `repro.py` in your submission folder and run \
@@ -340,7 +370,7 @@ pub(crate) fn ambiguous_body(c: &CheckResult, checks: &[CheckResult]) -> String 
             md,
             "\nFor example {}: {}\n",
             case_name(f),
-            markdown_inline(&f.message)
+            f.message.markdown_inline()
         );
         md.push_str(&repro_markdown(f));
     }

@@ -10,17 +10,17 @@
 use serde_json::{Value, json};
 
 use super::feedback::{Shown, ambiguous_body, check_body, is_ambiguous_note, worth_showing};
-use crate::escape::markdown_inline;
+use crate::escape::Untrusted;
 use crate::grade::{CheckResult, CheckStatus, GradeReport};
 
 /// Text the submission controls, for Gradescope's Markdown: each line escaped with
 /// [`markdown_inline`] (so `<`, `>` and `&` are entities and nothing is a link, a heading or
 /// HTML, even if Gradescope lets raw HTML through), as a quote with hard line breaks, leading
 /// spaces kept as `&nbsp;`.
-pub(crate) fn quoted(s: &str) -> String {
+pub(crate) fn quoted(s: &Untrusted) -> String {
     let mut out = String::new();
     for line in s.trim_end().lines() {
-        let text = markdown_inline(line);
+        let text = line.markdown_inline();
         let body = text.trim_start_matches(' ');
         let indent = text.len() - body.len();
         out.push_str("> ");

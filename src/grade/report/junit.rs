@@ -3,25 +3,12 @@
 
 use std::fmt::Write;
 
+use crate::escape::Untrusted;
 use crate::grade::{CheckStatus, GradeReport};
 
-/// Escapes text for XML content and attribute values, dropping characters XML 1.0 forbids.
+/// Escapes text for XML content and attribute values ([`crate::escape::xml`]).
 pub fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\n' => out.push_str("&#10;"),
-            '\t' | '\r' => out.push_str(&format!("&#{};", c as u32)),
-            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => out.push('\u{FFFD}'),
-            c => out.push(c),
-        }
-    }
-    out
+    crate::escape::xml(text)
 }
 
 /// `junit.xml` text.
@@ -31,7 +18,9 @@ pub fn render(report: &GradeReport) -> String {
     let _ = writeln!(
         x,
         "<testsuites name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"{}\" time=\"{}\">",
-        escape(&format!("rtoracle grade {}", report.submission)),
+        Untrusted::from("rtoracle grade ")
+            .join("", &report.submission)
+            .xml(),
         report.checks.len(),
         count(CheckStatus::Failed),
         count(CheckStatus::Error),
@@ -62,14 +51,17 @@ pub fn render(report: &GradeReport) -> String {
                 escape(&c.id)
             );
             let mut body = c.message.clone();
-            for f in &c.failures {
+            // A function check's smallest failing case: what the code answered or raised.
+            if let Some(failure) = c.function.as_ref().and_then(|f| f.failure.as_ref()) {
                 body.push_str(&format!(
-                    "\n\n{} [{}]: {}\n{}",
-                    f.id,
-                    f.kind.name(),
-                    f.message,
-                    f.repro
+                    "\n\n{} ({}): {}\n{}",
+                    failure.case, failure.input, failure.problem, failure.repro
                 ));
+            }
+            for f in &c.failures {
+                body.push_str(&format!("\n\n{} [{}]: ", f.id, f.kind.name()));
+                body.push(&f.message);
+                body.push_str(&format!("\n{}", f.repro));
             }
             let tag = match c.status {
                 CheckStatus::Passed => None,
@@ -83,14 +75,11 @@ pub fn render(report: &GradeReport) -> String {
                     let _ = writeln!(
                         x,
                         ">\n      <{tag} message=\"{}\" type=\"{}\">{}</{tag}>\n    </testcase>",
-                        escape(&format!(
-                            "{} / {}: {}",
-                            c.score,
-                            c.max_score,
-                            c.message.lines().next().unwrap_or("")
-                        )),
+                        Untrusted::from(format!("{} / {}: ", c.score, c.max_score))
+                            .join("", &c.message.first_line())
+                            .xml(),
                         c.status.name(),
-                        escape(&body)
+                        body.xml()
                     );
                 }
             }
@@ -108,6 +97,6 @@ mod tests {
     #[test]
     fn escaping_covers_markup_quotes_and_control_characters() {
         assert_eq!(escape("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&apos;");
-        assert_eq!(escape("x\u{1}y\nz"), "x\u{FFFD}y&#10;z");
+        assert_eq!(escape("x\u{1}y\nz"), "x\\x01y&#10;z");
     }
 }

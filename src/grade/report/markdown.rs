@@ -17,7 +17,7 @@ use std::fmt::Write;
 use super::feedback::{
     Shown, ambiguous_body, check_body, is_ambiguous_note, result_word, worth_showing,
 };
-use crate::escape::{markdown_block, markdown_inline};
+use crate::escape::Untrusted;
 use crate::grade::rubric::Visibility;
 use crate::grade::{CheckResult, CheckStatus, GradeReport};
 
@@ -28,8 +28,8 @@ pub(crate) fn fmt_points(x: f64) -> String {
 }
 
 /// Text the submission controls as a fenced block nothing inside can close.
-pub(crate) fn fenced(s: &str) -> String {
-    markdown_block(s, "text")
+pub(crate) fn fenced(s: &Untrusted) -> String {
+    s.markdown_block("text")
 }
 
 /// The score and the table of scored checks.
@@ -37,7 +37,7 @@ fn write_table(md: &mut String, report: &GradeReport) {
     let _ = writeln!(
         md,
         "# Feedback for {}: {} / {}\n",
-        markdown_inline(&report.submission),
+        report.submission.markdown_inline(),
         fmt_points(report.score),
         fmt_points(report.max_score),
     );
@@ -107,7 +107,7 @@ fn write_passed_and_heatmaps(md: &mut String, report: &GradeReport) {
     if !passed.is_empty() {
         md.push_str("\n## Passed\n\n");
         for c in passed {
-            let _ = writeln!(md, "- {}: {}", c.name, c.message);
+            let _ = writeln!(md, "- {}: {}", c.name, c.message.markdown_inline());
         }
     }
     let heatmaps: Vec<(&str, &str)> = visible()
@@ -166,7 +166,7 @@ pub fn render(report: &GradeReport) -> String {
             md,
             "\n## Your code could not be run\n\nNo intersection test could run, so the code checks score 0. \
              Python said:\n\n{}\nRun `python3 -c \"import RT_object\"` in your folder to see the same error.\n",
-            markdown_block(fatal.trim_end(), "text")
+            fatal.trim_end().markdown_block("text")
         );
     }
     let mut shown = Shown::default();

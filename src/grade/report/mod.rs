@@ -51,6 +51,16 @@ impl Format {
         Ok(out)
     }
 
+    /// Its name on the command line (`--format`) and in `batch.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Json => "json",
+            Format::Gradescope => "gradescope",
+            Format::Junit => "junit",
+            Format::Markdown => "markdown",
+        }
+    }
+
     /// The file it is written to.
     pub fn file_name(self) -> &'static str {
         match self {
@@ -70,6 +80,30 @@ impl Format {
             Format::Markdown => markdown::render(report),
         }
     }
+}
+
+/// The exception a check's smallest failure raised, as the reports say it (`raised NameError:
+/// name 'root' is not defined (RT_object.py, line 29)`: the submission's text, unescaped), for a
+/// line of its own on the terminal: a code check's smallest failing vector that raised, a
+/// function's smallest failing case that raised, a render that raised.
+pub fn exception_of(check: &super::CheckResult) -> Option<crate::escape::Untrusted> {
+    use crate::escape::Untrusted;
+    if let Some(f) = &check.function {
+        return f
+            .failure
+            .as_ref()
+            .map(|c| Untrusted::from(c.problem.as_str()))
+            .filter(|p| p.starts_with("raised "));
+    }
+    if let Some(image) = &check.image {
+        let why = image.metrics.get("render")?.get("not_run")?.as_str()?;
+        return Untrusted::from(why)
+            .strip_prefix("the render ")
+            .filter(|w| w.starts_with("raised "));
+    }
+    let f = super::smallest_failure(&check.failures)?;
+    (f.kind == super::FailureKind::Error && f.message.starts_with("raised "))
+        .then(|| f.message.clone())
 }
 
 /// Writes `report` in each of `formats` into the existing folder `out_dir` (each file whole or

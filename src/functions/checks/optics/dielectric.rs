@@ -84,8 +84,27 @@ fn dielectric_answer(
     )
 }
 
+/// What any answer of a dielectric case must keep: the reflected or the refracted direction
+/// (the invariant of `dielectric-choice`, in this case's setting).
+fn dielectric_behaviour(c: &DielectricInput, albedo: DVec3) -> steer::Behaviour {
+    let (n, front) = c.hit.facing();
+    let ratio = if front { 1.0 / c.ior } else { c.ior };
+    let v = c.hit.direction.normalize();
+    let cos = course_cos(v, n);
+    let tir = ratio * (1.0 - cos * cos).sqrt() > 1.0;
+    steer::scatter_behaviour(SamplerCheck::dielectric(DielectricSetting {
+        point: c.hit.point,
+        albedo,
+        reflected: reflect(v, n),
+        refracted: (!tir).then(|| refracted(v, n, ratio, cos)),
+        p_reflect: if tir { 1.0 } else { schlick(cos, ratio) },
+        p_wrong_cosine: schlick((1.0 - cos * cos).sqrt(), ratio),
+    }))
+}
+
 pub(super) fn dielectric_check(seed: u64) -> FunctionCheck {
     let albedo = DVec3::ONE;
+    let mut behaviour = Vec::new();
     let mut cases = Vec::new();
     let mut variants: Vec<(&'static str, &'static str, Vec<Option<Expected>>)> = vec![
         (
@@ -117,9 +136,11 @@ pub(super) fn dielectric_check(seed: u64) -> FunctionCheck {
         push(2, dielectric_answer(c, albedo, false, false, true));
         let (ray, hit) = c.hit.json();
         let (_, front) = c.hit.facing();
+        behaviour.push(dielectric_behaviour(c, albedo));
+        let id = format!("dielectric-{k:04}");
         cases.push(Case {
-            id: format!("dielectric-{k:04}"),
-            request: json!({"op": "scatter", "material": {"type": "dielectric", "albedo": jvec(albedo), "ior": jnum(c.ior)}, "ray": ray, "hit": hit, "replace": {"random_double": [jnum(c.u), jnum(c.u), jnum(c.u), jnum(c.u)]}}),
+            request: json!({"op": "scatter", "material": {"type": "dielectric", "albedo": jvec(albedo), "ior": jnum(c.ior)}, "ray": ray, "hit": hit, "replace": {"random_double": [jnum(c.u), jnum(c.u), jnum(c.u), jnum(c.u)]}, "seed": steer::case_seed(seed, &id)}),
+            id,
             expect,
             class: class_of(branch),
             input: format!(
@@ -146,8 +167,8 @@ pub(super) fn dielectric_check(seed: u64) -> FunctionCheck {
         week: week(6),
         given: false,
         op: "scatter",
-        tolerance: "the direction's components within 1e-9 (more near grazing refraction); cases within rounding of a decision are not scored",
-        body: Body::Cases {
+        tolerance: "with random_double() steered: the direction's components within 1e-9 (more near grazing refraction); cases within rounding of a decision are not scored; an answer drawn otherwise counts when it is the reflected or the refracted direction and dielectric-choice passes",
+        body: Body::Steered {
             cases,
             variants: variants
                 .into_iter()
@@ -158,6 +179,8 @@ pub(super) fn dielectric_check(seed: u64) -> FunctionCheck {
                     expect,
                 })
                 .collect(),
+            partners: &["dielectric-choice"],
+            behaviour,
             normalise: None,
         },
         timeout: CASE_TIMEOUT,
