@@ -20,11 +20,14 @@
 //!   common mistakes, heatmaps and reports.
 //! - [`grade`]: rubrics, grading a submission or a batch, the report formats (JSON, Gradescope,
 //!   JUnit, Markdown), and the Gradescope autograder package.
+//! - [`physics`]: physics checks that need no golden: a renderer's materials (sampling, pdf,
+//!   weights, energy, reciprocity) through the protocol's material requests.
 //! - [`candidate`]: checking other implementations (adapter protocol, the course's Python API,
 //!   sandboxed processes, reports, fuzzing, a trait for Rust tracers).
 //! - [`escape`]: untrusted text kept as text in every format (terminal, Markdown, HTML, CSV).
 //! - [`interrupt`]: Ctrl-C and SIGTERM clean up what was started or half-written.
 //! - [`output`]: output files and folders checked before the work, written whole or not at all.
+//! - [`secret`]: the seeds a candidate sees, derived from the rubric's secret by HMAC-SHA256.
 //! - [`sandbox`]: how untrusted code (candidates, students' submissions) is started: a fresh
 //!   folder, a cleared environment, limits, its own process group, no network, never as root.
 #![warn(missing_docs)]
@@ -41,6 +44,8 @@ pub mod image_io;
 pub mod interrupt;
 pub mod oracle;
 pub mod output;
+pub mod physics;
 pub mod render;
 pub mod sandbox;
 pub mod scene;
+pub mod secret;

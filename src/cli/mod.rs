@@ -12,6 +12,7 @@ mod fuzz;
 mod golden;
 mod grade;
 mod num;
+mod physics;
 mod render;
 mod scenes;
 mod vectors;
@@ -48,7 +49,19 @@ enum Command {
     Check(check::Args),
     /// Differential fuzzing of an implementation against the oracle, with shrinking.
     Fuzz(fuzz::Args),
-    /// Compare a rendered image with a golden, telling Monte Carlo noise from bugs.
+    /// Physics checks that need no golden: a renderer's materials (sampling, pdf, weights,
+    /// energy, reciprocity) through the protocol's material requests.
+    ///
+    /// Exit codes: 0 every law held (findings about a model aside), 1 a law failed or nothing
+    /// could be checked, 2 bad input or a harness error.
+    Physics(physics::Args),
+    /// Compare a rendered image with a golden, telling Monte Carlo noise from bugs; or two
+    /// renders of the same scene with no golden (`compare A B`).
+    ///
+    /// `compare A B` judges A against B by Welch's two-sample t-test at the same four scales and
+    /// the same per-image false-failure rate (1e-4) as against a golden. Each side is an EXR with
+    /// a variance layer and an rtoracle.spp attribute (`rtoracle render --variance`), or a
+    /// folder of EXR renders of the scene with different seeds.
     ///
     /// Exit codes: 0 PASS (the differences are noise), 1 FAIL, 2 bad input.
     Compare(compare::Args),
@@ -96,6 +109,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Explain(args) => explain::run(args),
         Command::Check(args) => check::run(args),
         Command::Fuzz(args) => fuzz::run(args),
+        Command::Physics(args) => physics::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Grade(args) => grade::run(args),
         Command::Autograder(args) => autograder::run(args),

@@ -35,6 +35,10 @@ pub struct Args {
     /// pepsi.jpg, ...) instead of the pictures rtoracle generates.
     #[arg(long, value_name = "DIR")]
     textures: Option<PathBuf>,
+    /// With an .exr output: also write the per-sample variance and deviation layers (what
+    /// `compare A B` reads to compare two renders with no golden).
+    #[arg(long)]
+    variance: bool,
 }
 
 /// `--profile`'s value.
@@ -115,6 +119,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
     rtoracle::output::check_output_file(&output, option)?;
     let format = OutputFormat::of(&output, option)?;
+    if args.variance && !matches!(format, OutputFormat::Exr) {
+        anyhow::bail!(
+            "--variance: {} is not an .exr output (only an EXR holds the variance layers)",
+            output.display()
+        );
+    }
 
     let camera = description.camera(width);
     if camera.width.saturating_mul(camera.height) > MAX_PIXELS {
@@ -133,6 +143,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         samples_per_pixel: spp,
         seed: args.seed,
         progress: true,
+        variance: args.variance,
         ..Default::default()
     };
     let pool = rayon::ThreadPoolBuilder::new()

@@ -497,7 +497,10 @@ fn check_with_no_argument_checks_the_submission_in_the_current_folder() {
     assert_eq!(explicit.status.code(), Some(1));
     let failed = |o: &Output| -> (Value, Value) {
         let v: Value = serde_json::from_slice(&o.stdout).unwrap();
-        (v["by_shape"].clone(), v["failed"].clone())
+        (
+            v["intersections"]["by_shape"].clone(),
+            v["intersections"]["failed"].clone(),
+        )
     };
     assert_eq!(failed(&bare), failed(&explicit));
 
@@ -573,10 +576,10 @@ fn check_require_triangle_fails_a_submission_without_triangles() {
     assert_eq!(broken.status.code(), Some(1));
     let v: Value = serde_json::from_slice(&broken.stdout).unwrap();
     assert_eq!(
-        v["by_shape"]["triangle"]["errors"],
-        v["by_shape"]["triangle"]["total"]
+        v["intersections"]["by_shape"]["triangle"]["errors"],
+        v["intersections"]["by_shape"]["triangle"]["total"]
     );
-    assert_eq!(v["by_shape"]["triangle"]["not_run"], 0);
+    assert_eq!(v["intersections"]["by_shape"]["triangle"]["not_run"], 0);
     assert!(!String::from_utf8_lossy(&broken.stdout).contains("does not support"));
 }
 

@@ -680,6 +680,8 @@ fn check_cli_exit_codes_json_and_text() {
         String::from_utf8_lossy(&out.stderr)
     );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The intersections' report (check --json, version 2).
+    let json = &json["intersections"];
     assert_eq!(json["total"], 300);
     assert_eq!(json["passed"], 300);
     assert_eq!(json["failures"].as_array().unwrap().len(), 0);
@@ -697,6 +699,8 @@ fn check_cli_exit_codes_json_and_text() {
     );
     assert_eq!(out.status.code(), Some(1));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The intersections' report (check --json, version 2).
+    let json = &json["intersections"];
     assert!(json["by_shape"]["sphere"]["failed"].as_u64().unwrap() > 0);
     assert_eq!(json["by_shape"]["quad"]["failed"], 0);
     let f = &json["failures"][0];
@@ -937,6 +941,8 @@ fn the_c_example_adapter_passes_the_sphere_vectors() {
         String::from_utf8_lossy(&out.stderr)
     );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The intersections' report (check --json, version 2).
+    let json = &json["intersections"];
     let sphere = &json["by_shape"]["sphere"];
     assert!(sphere["total"].as_u64().unwrap() > 200);
     assert_eq!(sphere["passed"], sphere["total"]);
@@ -1005,6 +1011,8 @@ fn a_candidate_flooding_stdout_times_out_with_bounded_memory() {
         String::from_utf8_lossy(&out.stderr)
     );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The intersections' report (check --json, version 2).
+    let json = &json["intersections"];
     for group in ["sphere", "quad"] {
         assert_eq!(json["by_shape"][group]["timeouts"], 3, "{group}");
     }
@@ -1108,9 +1116,10 @@ fn check_c(dir: &Path, name: &str, args: &[&str]) -> (Option<i32>, serde_json::V
     let mut all = vec!["check", "--adapter", adapter.as_str(), "--json"];
     all.extend_from_slice(args);
     let out = run_in(dir, &all);
-    let json = serde_json::from_slice(&out.stdout)
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout)
         .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
-    (out.status.code(), json)
+    // The intersections' report (check --json, version 2).
+    (out.status.code(), json["intersections"].clone())
 }
 
 /// The complete C adapter that PROTOCOL.md gives (spheres, quads, triangles, RTIOW style with

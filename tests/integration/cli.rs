@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 use crate::common::{assert_bad_input, rtoracle, run_in};
 
 /// Every subcommand, with the areas of `bench`.
-const SUBCOMMANDS: [&str; 11] = [
+const SUBCOMMANDS: [&str; 12] = [
     "render",
     "scenes",
     "golden",
@@ -29,6 +29,7 @@ const SUBCOMMANDS: [&str; 11] = [
     "explain",
     "check",
     "fuzz",
+    "physics",
     "compare",
     "grade",
     "autograder",
@@ -84,6 +85,7 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("scenes", "--dump", false, false),
     ("scenes", "--profile", false, false),
     ("scenes", "--textures", false, false),
+    ("scenes", "--export", false, false),
     ("golden", "--dir", false, false),
     ("golden", "--spp", true, false),
     ("golden", "--scenes", false, false),
@@ -124,6 +126,18 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("fuzz", "--precision", false, false),
     ("fuzz", "--python", false, false),
     ("fuzz", "--expose", false, false),
+    ("physics", "--python-course", false, false),
+    ("physics", "--adapter", false, false),
+    ("physics", "--python", false, false),
+    ("physics", "--expose", false, false),
+    ("physics", "--material", false, false),
+    ("physics", "--samples", true, false),
+    ("physics", "--seed", true, true),
+    ("physics", "--alpha", true, false),
+    ("physics", "--timeout-ms", true, false),
+    ("physics", "--hello-timeout-ms", true, false),
+    ("physics", "--furnace-spp", true, false),
+    ("physics", "--renders", true, false),
     ("compare", "--scene", false, false),
     ("compare", "--golden", false, false),
     ("compare", "--spp", true, false),
@@ -201,6 +215,7 @@ fn valid_prefix(command: &str) -> Vec<&'static str> {
         "explain" => vec!["explain", "sphere-random-0000"],
         "check" => vec!["check", "--adapter", "cat"],
         "fuzz" => vec!["fuzz", "--adapter", "cat"],
+        "physics" => vec!["physics", "--adapter", "cat"],
         "compare" => vec!["compare", "missing.png", "--scene", "week04-quad"],
         "grade" => vec!["grade", "sub"],
         "autograder" => vec!["autograder", "--out", "a.zip"],
@@ -510,6 +525,10 @@ fn a_closed_stdout_is_a_quiet_exit_for_every_subcommand() {
             &[1],
         ),
         (
+            vec!["physics", "--adapter", &adapter_cmd, "--samples", "100"],
+            &[1],
+        ),
+        (
             vec!["compare", "r.png", "--golden", "g/week04-quad.exr"],
             &[0, 1, 2],
         ),
@@ -726,6 +745,7 @@ fn sigint_during_check_and_grade_leaves_no_sandbox_folder() {
     let runs: Vec<Vec<&str>> = vec![
         vec!["check", "--python-course", &course],
         vec!["fuzz", "--python-course", &course],
+        vec!["physics", "--adapter", "sleep 600"],
         vec!["grade", "sub", "--out", "report"],
     ];
     for args in &runs {

@@ -294,7 +294,7 @@ fn repros(week: u8) -> Vec<Repro> {
     let mut out = Vec::new();
     for check in week_checks(Week::new(week).unwrap(), 0) {
         match &check.body {
-            Body::Cases { cases, .. } => {
+            Body::Cases { cases, .. } | Body::Steered { cases, .. } => {
                 for c in cases {
                     out.push(Repro {
                         id: c.id.clone(),

@@ -384,3 +384,113 @@ fn every_catalogued_mistake_has_a_fix() {
         .collect();
     assert!(missing.is_empty(), "no fix for {missing:?}");
 }
+
+/// A rubric that renders the sphere scene from the code at 1 sample per pixel (quick), and
+/// judges nothing else.
+const RENDER_SPHERE: &str = r#"name = "render-sphere"
+
+[[group]]
+id = "image.week04-sphere"
+name = "Sphere scene image (week04_sphere.png)"
+kind = "image"
+file = "week04_sphere.png"
+scene = "week04-sphere"
+source = "render"
+spp = 1
+render_seconds = 600
+points = 20
+"#;
+
+/// The reports' words for one check (feedback.md, the Gradescope test's output, junit.xml's
+/// message and report.json's), all of them.
+fn words_of(out: &Path, name: &str) -> String {
+    let md = std::fs::read_to_string(out.join("feedback.md")).unwrap();
+    let gs: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let test = gs["tests"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["name"] == name)
+        .unwrap_or_else(|| panic!("no test {name}: {gs:#}"));
+    let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    format!("{md}\n{}\n{junit}", test["output"].as_str().unwrap())
+}
+
+/// A missing upload is called missing, with what it costs under the rubric in force: its
+/// group's points under a rubric that judges uploads; nothing under one that renders the code
+/// (whatever the render gives). Never "could not be checked".
+fn assert_missing_costs(sub: &Path, dir: &Path) {
+    let name = "Sphere scene image (week04_sphere.png)";
+    std::fs::write(
+        dir.join("uploads.toml"),
+        rtoracle::grade::rubric::week04_uploads_toml(),
+    )
+    .unwrap();
+    std::fs::write(dir.join("render.toml"), RENDER_SPHERE).unwrap();
+    for (rubric, cost) in [
+        (
+            "uploads.toml",
+            "it costs this group's 20 points, since this rubric judges the uploaded image",
+        ),
+        (
+            "render.toml",
+            "is missing from the submission; it costs nothing: the grader renders your code",
+        ),
+    ] {
+        let out = dir.join(format!("out-{rubric}"));
+        let run = rtoracle()
+            .current_dir(dir)
+            .arg("grade")
+            .arg(sub)
+            .args(["--rubric", rubric, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(
+            run.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let words = words_of(&out, name);
+        assert!(
+            words.contains("week04_sphere.png is missing from the submission"),
+            "{rubric}: {words}"
+        );
+        assert!(words.contains(cost), "{rubric}: {words}");
+        assert!(!words.contains("could not be checked"), "{rubric}: {words}");
+        let md = std::fs::read_to_string(out.join("feedback.md")).unwrap();
+        if rubric == "uploads.toml" {
+            assert!(
+                md.contains(&format!("| {name} | 0 / 20 | missing |")),
+                "{md}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_missing_upload_says_what_it_costs_under_the_rubric_in_force() {
+    let dir = scratch("missing-costs");
+    materialize("missing-image", &dir.join("missing-image")).unwrap();
+    assert_missing_costs(&dir.join("missing-image"), &dir);
+}
+
+#[test]
+#[cfg_attr(
+    not(rtoracle_course_code),
+    ignore = "set RTORACLE_COURSE_CODE to the course's code to run it"
+)]
+fn a_missing_upload_of_the_course_s_code_says_what_it_costs() {
+    let Some((_guard, sub)) = course_week_copy(
+        "a_missing_upload_of_the_course_s_code_says_what_it_costs",
+        4,
+        CourseTree::Solution,
+    ) else {
+        return;
+    };
+    std::fs::remove_file(sub.join("week04_sphere.png")).unwrap();
+    let dir = scratch("missing-costs-course");
+    assert_missing_costs(&sub, &dir);
+}

@@ -735,13 +735,21 @@ fn render_names_the_profile_and_the_samples_taken() {
     assert!(exr[at..at + 60].windows(8).any(|w| w == b"physical"));
     let out = run_in(
         dir.path(),
+        &["render", "week10-dof", "--spp", "30", "--width", "16"],
+    );
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        // One pass over the course's 10 x 10 strata (renderDoF's 100 spp) however few are asked.
+        stderr.contains("30 spp: 100 jittered samples a pixel, seed"),
+        "{stderr}"
+    );
+    // The course's renderBlinn renders with `render()`: no jitter, no count to explain.
+    let out = run_in(
+        dir.path(),
         &["render", "week09-blinn", "--spp", "30", "--width", "16"],
     );
-    assert!(
-        String::from_utf8(out.stderr)
-            .unwrap()
-            .contains("30 spp: 25 jittered samples a pixel, seed")
-    );
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!stderr.contains("jittered"), "{stderr}");
     let out = run_in(
         dir.path(),
         &["render", "week10-moving", "--spp", "200", "--width", "16"],
@@ -779,7 +787,7 @@ fn render_names_the_profile_and_the_samples_taken() {
 /// texture name; and `--profile`, `--textures` used wrongly.
 #[test]
 fn bad_new_keys_are_one_line_and_exit_2() {
-    let good = builtin("week07-procedural-texture").unwrap().to_toml();
+    let good = builtin("week07-earth").unwrap().to_toml();
     let command = ["render", "scene.toml"];
     let refused = |text: &str, needle: &str| {
         assert_render_refused(&[("scene.toml", text)], &command, needle);
@@ -798,7 +806,7 @@ fn bad_new_keys_are_one_line_and_exit_2() {
             "generated = \"earth\"",
             "file = \"textures/earthmap.png\"",
         ),
-        "textures[3].file = '",
+        "textures[1].file = '",
     );
     refused(
         &with_line(
@@ -810,10 +818,10 @@ fn bad_new_keys_are_one_line_and_exit_2() {
     );
     refused(
         &with_line(&good, "generated = \"earth\"", "generated = \"mars\""),
-        "textures[3].generated is 'mars'",
+        "textures[1].generated is 'mars'",
     );
     refused(
-        &with_line(&good, "texture = \"checker\"", "texture = \"chequer\""),
+        &with_line(&good, "texture = \"checker_bw\"", "texture = \"chequer\""),
         "materials[1].texture names the texture 'chequer', which is not defined",
     );
     refused(
@@ -827,8 +835,8 @@ fn bad_new_keys_are_one_line_and_exit_2() {
     refused(
         &with_line(
             &good,
-            "texture = \"ground\"",
-            "texture = \"ground\"\nior = 1.5",
+            "texture = \"earth\"",
+            "texture = \"earth\"\nior = 1.5",
         ),
         "materials[0].ior does not apply to a textured material",
     );
@@ -890,7 +898,7 @@ fn bad_new_keys_are_one_line_and_exit_2() {
     assert_render_refused(
         &[],
         &["render", "week07-earth", "--textures", "."],
-        "no basketball.jpg or basketball.png",
+        "no earthmap.jpg or earthmap.png there (the course's earth texture)",
     );
     assert_render_refused(
         &[("scene.toml", &good)],
@@ -906,20 +914,25 @@ fn bad_new_keys_are_one_line_and_exit_2() {
 fn a_texture_file_is_read_relative_to_the_scene_file() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("scenes")).unwrap();
-    let picture = rtoracle::scene::generated_picture("earth").unwrap();
-    rtoracle::image_io::write_png(
-        &dir.path().join("scenes/earthmap.png"),
-        &rtoracle::image_io::Rgb8Image {
-            width: picture.width,
-            height: picture.height,
-            data: picture.data,
-        },
-    )
-    .unwrap();
-    let text = builtin("week07-procedural-texture")
+    // Each generated picture under the course's file name (the earth is `earthmap`).
+    for name in rtoracle::scene::GENERATED_PICTURES {
+        let picture = rtoracle::scene::generated_picture(name).unwrap();
+        let stem = if *name == "earth" { "earthmap" } else { name };
+        rtoracle::image_io::write_png(
+            &dir.path().join(format!("scenes/{stem}.png")),
+            &rtoracle::image_io::Rgb8Image {
+                width: picture.width,
+                height: picture.height,
+                data: picture.data,
+            },
+        )
+        .unwrap();
+    }
+    let text = builtin("week07-earth")
         .unwrap()
         .to_toml()
         .replace("generated = \"earth\"", "file = \"earthmap.png\"");
+    assert!(text.contains("file = \"earthmap.png\""), "{text}");
     std::fs::write(dir.path().join("scenes/earth.toml"), text).unwrap();
     let args = ["--spp", "2", "--width", "60", "-o"];
     let from_file = run_in(
@@ -933,28 +946,18 @@ fn a_texture_file_is_read_relative_to_the_scene_file() {
     );
     let builtin = run_in(
         dir.path(),
-        &[
-            &["render", "week07-procedural-texture"][..],
-            &args,
-            &["b.png"],
-        ]
-        .concat(),
+        &[&["render", "week07-earth"][..], &args, &["b.png"]].concat(),
     );
     assert!(builtin.status.success());
     assert_eq!(
         std::fs::read(dir.path().join("a.png")).unwrap(),
         std::fs::read(dir.path().join("b.png")).unwrap()
     );
-    // --textures DIR with the course's name gives the same scene, with the file's absolute path.
+    // --textures DIR with the course's names gives the same scene, with the files' absolute
+    // paths.
     let dumped = run_in(
         dir.path(),
-        &[
-            "scenes",
-            "--dump",
-            "week07-procedural-texture",
-            "--textures",
-            "scenes",
-        ],
+        &["scenes", "--dump", "week07-earth", "--textures", "scenes"],
     );
     let text = String::from_utf8(dumped.stdout).unwrap();
     let path = dir.path().join("scenes/earthmap.png");

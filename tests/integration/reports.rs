@@ -41,7 +41,7 @@ impl CodeChecker for Forged {
             definite: true,
             expected: serde_json::Value::Null,
             actual: serde_json::Value::Null,
-            message: PAYLOAD.to_string(),
+            message: PAYLOAD.into(),
             repro: "print(1)\n".to_string(),
         };
         CodeOutcome {

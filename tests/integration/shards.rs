@@ -8,7 +8,7 @@ use std::path::Path;
 use sha2::{Digest, Sha256};
 
 use crate::common::*;
-use rtoracle::grade::bench::{fixture_names, fixtures_dir, materialize_code};
+use rtoracle::grade::bench::{fixture_names, fixtures_dir, materialize, materialize_code};
 
 /// The week-4 rubric's code groups (no image to render: the shards are what is tested).
 const CODE_ONLY: &str = r#"name = "code-only"
@@ -166,4 +166,222 @@ fn three_shards_merged_equal_the_batch_graded_whole() {
         ],
         "4/3",
     );
+}
+
+/// Every file under `dir` (relative path -> bytes), with what two runs of one batch may differ
+/// in set to 0: the wall-clock times (`execution_time` in the JSON reports and entries, `time`
+/// in junit.xml) and the uid the sandbox drew for each submission (`code.sandbox.uid`).
+fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut std::collections::BTreeMap<String, Vec<u8>>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let path = e.path();
+            if path.is_dir() {
+                walk(root, &path, out);
+                continue;
+            }
+            let rel = path
+                .strip_prefix(root)
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            let bytes = std::fs::read(&path).unwrap();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let bytes = match name.as_str() {
+                "report.json" | "results.json" | "batch-entry.json" => {
+                    let mut v: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+                    zero_times(&mut v);
+                    serde_json::to_vec_pretty(&v).unwrap()
+                }
+                "junit.xml" => {
+                    let text = String::from_utf8(bytes).unwrap();
+                    let mut out = String::new();
+                    let mut rest = text.as_str();
+                    while let Some(i) = rest.find(" time=\"") {
+                        out.push_str(&rest[..i + 7]);
+                        rest = &rest[i + 7..];
+                        let end = rest.find('"').unwrap();
+                        out.push('0');
+                        rest = &rest[end..];
+                    }
+                    out.push_str(rest);
+                    out.into_bytes()
+                }
+                _ => bytes,
+            };
+            out.insert(rel, bytes);
+        }
+    }
+    fn zero_times(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(o) => {
+                for (k, x) in o.iter_mut() {
+                    // The wall-clock time, and the uid the sandbox drew for the run.
+                    if k == "execution_time" || k == "uid" {
+                        *x = 0.into();
+                    } else {
+                        zero_times(x);
+                    }
+                }
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(zero_times),
+            _ => {}
+        }
+    }
+    let mut out = std::collections::BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
+}
+
+/// Merging is as strict as grading whole: two submissions whose images are one copy, graded in
+/// different shards (for N = 2 and N = 3), are flagged in the merged reports and summary as in
+/// the whole batch's, and every file of the merged folder is the whole batch's, byte for byte
+/// (wall-clock times and sandbox uids aside). Shards graded under other weights, other vectors (another seed) or
+/// by another rtoracle are refused with one line and exit 2, before anything is written.
+#[test]
+fn merged_shards_keep_copy_findings_and_refuse_shards_graded_otherwise() {
+    let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shards-copies");
+    let _ = std::fs::remove_dir_all(&root);
+    let subs = root.join("subs");
+    // Two names that no sharding into 2 or 3 puts together.
+    let (a, b) = (0..)
+        .map(|i| (format!("copy-{i}-a"), format!("copy-{i}-b")))
+        .find(|(a, b)| (2..=3).all(|n| shard_of(a, n) != shard_of(b, n)))
+        .unwrap();
+    materialize("honest", &subs.join(&a)).unwrap();
+    copy_tree(&subs.join(&a), &subs.join(&b));
+    for name in ["sphere-bug", "missing-image", "no-gamma", "unimportable"] {
+        materialize(name, &subs.join(name)).unwrap();
+    }
+    std::fs::write(
+        root.join("uploads.toml"),
+        rtoracle::grade::rubric::week04_uploads_toml(),
+    )
+    .unwrap();
+    let vectors = fixtures_dir().join("vectors.jsonl");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "grade",
+            "--batch",
+            "subs",
+            "--rubric",
+            "uploads.toml",
+            "--vectors",
+            vectors.to_str().unwrap(),
+            "--case-timeout-ms",
+            "1000",
+        ];
+        args.extend(extra);
+        grade(&root, &args)
+    };
+    let whole = run(&["--out", "whole"]);
+    // The whole batch flags the pair (the copy check's own rule: the same pixels share their
+    // noise), in both reports and in the summary.
+    let summary = std::fs::read_to_string(root.join("whole/summary.md")).unwrap();
+    assert!(summary.contains(&format!("{a} and {b}")), "{summary}");
+    let report = std::fs::read_to_string(root.join("whole").join(&a).join("report.json")).unwrap();
+    assert!(
+        report.contains("\"shared_with\"") && report.contains(&b),
+        "{report}"
+    );
+    let expected = tree(&root.join("whole"));
+    for n in [2u64, 3] {
+        let mut dirs = Vec::new();
+        for k in 1..=n {
+            let out = format!("shard-{k}-of-{n}");
+            run(&["--shard", &format!("{k}/{n}"), "--out", &out]);
+            dirs.push(out);
+        }
+        let mut args = vec!["grade", "--merge"];
+        args.extend(dirs.iter().rev().map(String::as_str));
+        let merged_dir = format!("merged-{n}");
+        args.extend(["--out", &merged_dir]);
+        let merged = grade(&root, &args);
+        assert_eq!(merged, whole, "the scores on stdout, {n} shards");
+        let got = tree(&root.join(&merged_dir));
+        assert_eq!(
+            got.keys().collect::<Vec<_>>(),
+            expected.keys().collect::<Vec<_>>(),
+            "{n} shards"
+        );
+        for (file, bytes) in &expected {
+            assert!(
+                got[file] == *bytes,
+                "{file} differs after merging {n} shards:\n{}\n---\n{}",
+                String::from_utf8_lossy(bytes),
+                String::from_utf8_lossy(&got[file])
+            );
+        }
+    }
+    // Shards graded otherwise: refused, one line, exit 2, nothing written.
+    let refused = |other: &str, needle: &str| {
+        let out = run_in(
+            &root,
+            &[
+                "grade",
+                "--merge",
+                "shard-1-of-2",
+                other,
+                "--out",
+                "refused",
+            ],
+        );
+        assert_bad_input(&out, needle);
+        assert!(!root.join("refused").exists());
+    };
+    // Other weights, the same total.
+    let weights = rtoracle::grade::rubric::week04_uploads_toml()
+        .replacen("points = 30", "points = 40", 1)
+        .replacen("points = 30", "points = 20", 1);
+    assert_ne!(weights, rtoracle::grade::rubric::week04_uploads_toml());
+    std::fs::write(root.join("weights.toml"), weights).unwrap();
+    grade(
+        &root,
+        &[
+            "grade",
+            "--batch",
+            "subs",
+            "--rubric",
+            "weights.toml",
+            "--vectors",
+            vectors.to_str().unwrap(),
+            "--case-timeout-ms",
+            "1000",
+            "--shard",
+            "2/2",
+            "--out",
+            "weights",
+        ],
+    );
+    refused("weights", "other groups or points");
+    // Other vectors (what another seed gives): a vector fewer.
+    let text = std::fs::read_to_string(&vectors).unwrap();
+    let fewer: String = text.lines().skip(1).map(|l| format!("{l}\n")).collect();
+    std::fs::write(root.join("fewer.jsonl"), fewer).unwrap();
+    grade(
+        &root,
+        &[
+            "grade",
+            "--batch",
+            "subs",
+            "--rubric",
+            "uploads.toml",
+            "--vectors",
+            "fewer.jsonl",
+            "--case-timeout-ms",
+            "1000",
+            "--shard",
+            "2/2",
+            "--out",
+            "seed",
+        ],
+    );
+    refused("seed", "other vectors");
+    // Another rtoracle.
+    copy_tree(&root.join("shard-2-of-2"), &root.join("version"));
+    let path = root.join("version/batch.json");
+    let mut file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    file["graded_with"]["tool_version"] = "0.0.1-other".into();
+    std::fs::write(&path, serde_json::to_string_pretty(&file).unwrap()).unwrap();
+    refused("version", "rtoracle 0.0.1-other");
 }
