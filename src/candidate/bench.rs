@@ -10,11 +10,11 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::command::CandidateCommand;
-use super::error::HarnessError;
 use super::fixtures::python_files_in;
-use super::generate::random_cases;
-use super::options::RunOptions;
+use super::fuzzing::generate::random_cases;
+use super::process::command::CandidateCommand;
+use super::process::error::HarnessError;
+use super::process::options::RunOptions;
 use super::rust::{Reference, check_candidate};
 use crate::oracle::vectors::ShapeKind;
 

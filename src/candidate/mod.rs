@@ -2,63 +2,40 @@
 //! limits and timeouts, the bundled adapter for the course's Python API, judging answers,
 //! reports with Python reproductions, fuzzing with shrinking, and an in-process Rust trait.
 //!
-//! - [`protocol`]: request and answer lines, the hello (`docs/PROTOCOL.md`).
-//! - [`command`]: [`CandidateCommand`], what a candidate runs (an `--adapter` command line or
-//!   the course adapter on a submission folder) and the sandbox made for it; [`options`]:
-//!   [`RunOptions`]; [`error`]: [`HarnessError`]; [`outcome`]: [`Outcome`], what one case got.
-//! - [`session`]: [`Session`] runs a [`CandidateCommand`] in the [sandbox](crate::sandbox) with
-//!   pipelined requests, per-case timeouts, restarts after crashes and the process group killed
-//!   on drop, over the pipes of [`pipe`], judging each line by the strict protocol of [`lines`].
-//! - [`render`](mod@render): the `render` request, a scene rendered tile by tile with the
-//!   candidate's own code, with bounds on what comes back.
-//! - [`python`]: choosing the interpreter of the course adapter (the assignment's modules,
-//!   runnable in the sandbox).
-//! - [`check`]: the verdict for one case; [`report`]: [`CheckReport`] (serde) and
-//!   [`build_report`]; [`report_text`]: its text; [`repro`]: expected answers in words and
-//!   Python reproductions; [`watertight`]: the rule of the watertight groups (a ray through an
-//!   edge shared by two shapes hits at least one).
-//! - [`diagnose`]: the known mistake (a buggy variant of the oracle) that explains the failures.
+//! Three rooms, bottom up, and the path through them on top (this file):
+//!
+//! - [`process`]: a candidate as a process. What it runs ([`CandidateCommand`]: an `--adapter`
+//!   command line or the bundled course adapter on a submission folder), the protocol's lines
+//!   ([`process::protocol`], `docs/PROTOCOL.md`), the [`Session`] that runs it in the
+//!   [sandbox](crate::sandbox) with pipelined requests, per-case time-outs and restarts, the
+//!   `render` request ([`process::render_request`]) and the choice of the course adapter's Python.
+//! - [`judging`]: what an answer is worth. The verdict of one case ([`judging::check`]), the
+//!   watertight rule, the [`CheckReport`] and its text, Python reproductions, and the known
+//!   mistake that explains the failures ([`judging::diagnose`]).
+//! - [`fuzzing`]: random cases classified by the oracle, the fuzz driver and shrinking.
 //! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
-//! - [`generate`], [`shrink`], [`fuzz`](mod@fuzz): random cases, classification through
-//!   [`generate::oracle_expect`], shrinking, the fuzz driver.
-//! - [`bench`](mod@bench): throughput of the harness against baselines measured in the same run;
-//!   [`fixtures`]: the fixture files it (and grading's benchmark) needs, embedded in the binary.
+//! - Here: [`check_command`] and [`check_session`], one candidate checked against a list of
+//!   cases, start to report.
 
 pub mod bench;
-pub mod check;
-pub mod command;
-pub mod diagnose;
-pub mod error;
 pub mod fixtures;
-pub mod fuzz;
-pub mod generate;
-pub mod lines;
-pub mod options;
-pub mod outcome;
-pub mod pipe;
-pub mod protocol;
-pub mod python;
-pub mod render;
-pub mod report;
-pub mod report_text;
-pub mod repro;
+pub mod fuzzing;
+pub mod judging;
+pub mod process;
 pub mod rust;
-pub mod session;
-pub mod shrink;
 #[cfg(test)]
 pub(crate) mod test_cases;
-pub mod watertight;
 
 pub use crate::sandbox::SandboxPolicy;
-pub use check::{FailureKind, Verdict, judge};
-pub use command::CandidateCommand;
-pub use error::HarnessError;
-pub use options::RunOptions;
-pub use outcome::Outcome;
-pub use protocol::{Answer, CandidateError, Hello};
-pub use report::{CheckReport, Counts, Failure, RunInfo, build_report};
+pub use judging::check::{FailureKind, Verdict, judge};
+pub use judging::report::{CheckReport, Counts, Failure, RunInfo, build_report};
+pub use process::command::CandidateCommand;
+pub use process::error::HarnessError;
+pub use process::options::RunOptions;
+pub use process::outcome::Outcome;
+pub use process::protocol::{Answer, CandidateError, Hello};
+pub use process::session::{CallOutcome, Session};
 pub use rust::{Candidate, Reference, check_candidate};
-pub use session::{CallOutcome, Session};
 
 use crate::oracle::vectors::Case;
 

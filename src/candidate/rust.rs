@@ -33,9 +33,9 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use super::outcome::Outcome;
-use super::protocol::Answer;
-use super::report::{CheckReport, RunInfo, build_report};
+use super::judging::report::{CheckReport, RunInfo, build_report};
+use super::process::outcome::Outcome;
+use super::process::protocol::Answer;
 use crate::geometry::{Interval, Shape};
 use crate::oracle::vectors::{Case, RaySpec, ShapeKind, ShapeSpec};
 

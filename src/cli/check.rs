@@ -7,7 +7,9 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::candidate::{CandidateCommand, RunOptions, SandboxPolicy, check_command, python};
+use rtoracle::candidate::{
+    CandidateCommand, RunOptions, SandboxPolicy, check_command, process::python,
+};
 use rtoracle::functions::{FunctionOptions, Week, check_week, detect};
 use rtoracle::oracle::vectors::{Case, read_vectors};
 use rtoracle::oracle::{
@@ -344,7 +346,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
     }
     let (cases, judged_by) = if args.score_ambiguous {
-        let scored = rtoracle::candidate::check::score_ambiguous(cases);
+        let scored = rtoracle::candidate::judging::check::score_ambiguous(cases);
         (
             scored,
             format!("{judged_by}; ambiguous vectors scored by their exact answers"),

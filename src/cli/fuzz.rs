@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rtoracle::candidate::fuzz::{FuzzOptions, fuzz};
+use rtoracle::candidate::fuzzing::fuzz::{FuzzOptions, fuzz};
 use rtoracle::candidate::{RunOptions, Session};
 use rtoracle::oracle::vectors::ShapeKind;
 

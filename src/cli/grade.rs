@@ -209,7 +209,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
             .any(|g| g.kind == rtoracle::grade::GroupKind::Code || g.renders());
     let policy = rubric.sandbox_policy();
     let python = if runs_code {
-        let python = rtoracle::candidate::python::choose(
+        let python = rtoracle::candidate::process::python::choose(
             args.python.as_deref(),
             &rubric.python_requires,
             &policy,

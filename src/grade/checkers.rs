@@ -7,12 +7,12 @@ use std::time::Duration;
 
 use serde_json::Value;
 
-use crate::candidate::check::{
+use crate::candidate::judging::check::{
     FailureKind as CheckKind, Verdict, decide_winding, judge_exact_wound, judge_wound,
 };
-use crate::candidate::python;
-use crate::candidate::render::{RenderJob, RenderOutcome, render_scene};
-use crate::candidate::report::python_repro;
+use crate::candidate::judging::report::python_repro;
+use crate::candidate::process::python;
+use crate::candidate::process::render_request::{RenderJob, RenderOutcome, render_scene};
 use crate::candidate::{
     CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
 };
@@ -296,7 +296,7 @@ fn tally_unanswered_and_cracks(
     sizes: &std::collections::HashMap<String, usize>,
     out: &mut CodeOutcome,
 ) {
-    use crate::candidate::watertight::{GroupResult, crack_message, judge_groups};
+    use crate::candidate::judging::watertight::{GroupResult, crack_message, judge_groups};
     let summary = |case: &Case, outcome: &Outcome, kind, message: String| FailureSummary {
         id: case.id.clone(),
         shape: case.shape.kind(),
@@ -316,7 +316,8 @@ fn tally_unanswered_and_cracks(
         if case.expect.class.is_definite() {
             continue;
         }
-        let Some((kind, message)) = crate::candidate::report::unscored_failure(outcome) else {
+        let Some((kind, message)) = crate::candidate::judging::report::unscored_failure(outcome)
+        else {
             continue;
         };
         let counts = out
@@ -435,7 +436,7 @@ impl CourseCodeChecker {
     ) {
         let winding = decide_winding(cases, outcomes);
         out.triangle_winding = winding;
-        out.diagnosis = crate::candidate::diagnose::diagnose(cases, outcomes, winding);
+        out.diagnosis = crate::candidate::judging::diagnose::diagnose(cases, outcomes, winding);
         let mut definite_failures = Vec::new();
         let mut ambiguous_failures = Vec::new();
         for (case, outcome) in cases.iter().zip(outcomes) {

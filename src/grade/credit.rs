@@ -23,7 +23,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::candidate::Outcome;
-use crate::candidate::check::{NORMAL_TOL, Verdict, Winding};
+use crate::candidate::judging::check::{NORMAL_TOL, Verdict, Winding};
 use crate::oracle::vectors::{Case, Class};
 
 /// The credit of a hit at the right `t`, before its normal and `front_face`.

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use super::*;
 use crate::candidate::Answer;
-use crate::candidate::check::{decide_winding, judge_wound};
+use crate::candidate::judging::check::{decide_winding, judge_wound};
 use crate::oracle::default_suite;
 use crate::oracle::generate::{add, scale};
 use crate::oracle::variants::{self, Variant};

@@ -59,7 +59,7 @@ pub trait CodeChecker: Sync {
     }
 }
 
-pub use crate::candidate::render::{RenderJob, RenderOutcome, RenderedImage};
+pub use crate::candidate::process::render_request::{RenderJob, RenderOutcome, RenderedImage};
 
 /// What running a week's function checks on a submission found.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -240,12 +240,12 @@ pub struct CodeOutcome {
     pub stderr_tail: String,
     /// Facts about the sandbox the code ran in (limits, user, network), for the report.
     pub sandbox: serde_json::Value,
-    /// The known mistakes that explain the failures, per shape ([`crate::candidate::diagnose`]).
+    /// The known mistakes that explain the failures, per shape ([`crate::candidate::judging::diagnose`]).
     #[serde(default)]
-    pub diagnosis: Vec<crate::candidate::diagnose::Diagnosis>,
+    pub diagnosis: Vec<crate::candidate::judging::diagnose::Diagnosis>,
     /// The winding of the submission's triangles, decided from its answers.
     #[serde(default)]
-    pub triangle_winding: Option<crate::candidate::check::Winding>,
+    pub triangle_winding: Option<crate::candidate::judging::check::Winding>,
 }
 
 /// The verdict on one image.

@@ -1,7 +1,7 @@
 //! Image groups rendered from the submission's own code (`source = "render"`, the default).
 //!
 //! For each such group the grader asks the submission, through the protocol's `render` request
-//! ([`crate::candidate::render`]), to render the group's scene at the group's `spp` within its
+//! ([`crate::candidate::process::render_request`]), to render the group's scene at the group's `spp` within its
 //! `render_seconds`, in the sandbox, with one interpreter per submission for all its groups
 //! ([`course_render`]). The render is judged by the image checker against the golden at the spp
 //! it was rendered with ([`ImageChecker::check_render`]); the points come from that judgement.
@@ -47,7 +47,9 @@ use serde_json::{Value, json};
 use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict};
 use super::result::{CheckResult, CheckStatus};
 use super::rubric::{Group, SceneSource};
-use crate::candidate::render::{CameraMove, MadeBy, RenderJob, RenderOutcome, RenderedImage};
+use crate::candidate::process::render_request::{
+    CameraMove, MadeBy, RenderJob, RenderOutcome, RenderedImage,
+};
 use crate::escape::Untrusted;
 use crate::scene::SceneDescription;
 

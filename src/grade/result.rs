@@ -143,9 +143,9 @@ pub struct CodeRun {
     /// The sandbox's facts.
     pub sandbox: serde_json::Value,
     /// The known mistakes that explain the code's failures, per shape.
-    pub diagnosis: Vec<crate::candidate::diagnose::Diagnosis>,
+    pub diagnosis: Vec<crate::candidate::judging::diagnose::Diagnosis>,
     /// The winding of the submission's triangles, when it has any that hit.
-    pub triangle_winding: Option<crate::candidate::check::Winding>,
+    pub triangle_winding: Option<crate::candidate::judging::check::Winding>,
     /// Why the week's function checks could not run at all, when they could not.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub functions_fatal: Option<Untrusted>,

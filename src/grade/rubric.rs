@@ -345,7 +345,7 @@ pub struct Rubric {
     pub code_time_budget_seconds: f64,
     /// The modules the Python that runs the submissions must have (default numpy and PIL, which
     /// the course's `RT_utility.py` imports); `grade` exits 2 when no interpreter has them.
-    #[serde(default = "crate::candidate::python::default_requires")]
+    #[serde(default = "crate::candidate::process::python::default_requires")]
     pub python_requires: Vec<String>,
     /// MiB of memory a submission's code may hold, all its processes and its shared memory
     /// together: past it the sandbox stops the code, the report says why, and the grade of what

@@ -12,7 +12,7 @@ use super::inputs::{
 use super::result::{CodeRun, GradeError, GradeReport, Reproducibility, round2};
 use super::rubric::{Group, GroupKind, Rubric, SceneSource};
 use super::score::{code_check, heatmap_name, image_check};
-use crate::candidate::render::RenderOutcome;
+use crate::candidate::process::render_request::RenderOutcome;
 
 /// The size the image of `scene` must have, when `scene` is a built-in scene.
 pub(crate) fn expected_size(scene: &SceneSource) -> Option<(usize, usize)> {

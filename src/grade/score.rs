@@ -166,7 +166,7 @@ fn check_fails_sentence(counts: &GroupCounts) -> String {
     if counts.watertight_cracked > 0 {
         s.push_str(&format!(
             " Watertight groups: {}; each counts as a vector where the ray hits.",
-            crate::candidate::watertight::groups_summary(
+            crate::candidate::judging::watertight::groups_summary(
                 counts.watertight,
                 counts.watertight_cracked
             )

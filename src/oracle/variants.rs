@@ -614,7 +614,7 @@ pub fn buggy() -> Vec<Variant> {
     ]
 }
 
-// ---- More known mistakes, for the candidate diagnosis (`candidate::diagnose`). ----
+// ---- More known mistakes, for the candidate diagnosis (`candidate::judging::diagnose`). ----
 
 /// The course's sphere (as `sphere-course`) with the roots written `-half_b -+ sqrt_disc / a`
 /// (the division binds tighter).

@@ -239,7 +239,7 @@ impl FurnaceRenderer for CandidateRenderer<'_> {
         spp: u32,
         seed: u64,
     ) -> Result<Vec<[f32; 3]>, String> {
-        use crate::candidate::render::{RenderJob, RenderOutcome, render_scene};
+        use crate::candidate::process::render_request::{RenderJob, RenderOutcome, render_scene};
         let job = RenderJob {
             scene,
             spp,

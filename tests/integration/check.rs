@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use rtoracle::candidate::bench::{assemble_fixture, course_python_or_skip};
-use rtoracle::candidate::generate::random_cases;
+use rtoracle::candidate::fuzzing::generate::random_cases;
 use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
 use rtoracle::oracle::vectors::{Case, ShapeKind};
 
@@ -188,7 +188,7 @@ fn students_triangles_are_run_in_each_constructor_form_and_judged_by_their_own_w
     if !python_ok() {
         return;
     }
-    use rtoracle::candidate::check::Winding;
+    use rtoracle::candidate::judging::check::Winding;
     let tris = triangle_cases();
     let definite = tris.iter().filter(|c| c.expect.class.is_definite()).count();
     assert!(definite > 100, "{definite}");
@@ -332,7 +332,7 @@ fn a_module_the_grader_lacks_is_the_student_s_error_said_plainly() {
     let dir = assemble_fixture("bug_imports_a_module_the_grader_lacks").unwrap();
     std::fs::write(
         dir.path().join("adapter.py"),
-        rtoracle::candidate::command::PYTHON_COURSE_ADAPTER,
+        rtoracle::candidate::process::command::PYTHON_COURSE_ADAPTER,
     )
     .unwrap();
     let mut child = std::process::Command::new(python().unwrap())

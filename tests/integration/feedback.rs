@@ -380,7 +380,7 @@ fn every_catalogued_mistake_has_a_fix() {
         .chain(rtoracle::oracle::variants::buggy_extra())
         .filter(|v| !v.honest)
         .map(|v| v.name)
-        .filter(|name| rtoracle::candidate::diagnose::fix(name).is_none())
+        .filter(|name| rtoracle::candidate::judging::diagnose::fix(name).is_none())
         .collect();
     assert!(missing.is_empty(), "no fix for {missing:?}");
 }

@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use rtoracle::candidate::generate::random_cases;
+use rtoracle::candidate::fuzzing::generate::random_cases;
 use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
 use rtoracle::oracle::vectors::{Case, Class, ShapeKind};
 

@@ -689,7 +689,7 @@ pub(crate) fn scatter_samples(answer: &serde_json::Value) -> Result<Vec<Sample>,
 }
 
 /// Requests of `total` samples of `numbers` numbers each, in chunks whose answers stay well
-/// under [`crate::candidate::protocol::MAX_RESULT_BYTES`] (about 22 bytes a number), each
+/// under [`crate::candidate::process::protocol::MAX_RESULT_BYTES`] (about 22 bytes a number), each
 /// with its own seed, derived from the checks' seed for its purpose ([`crate::secret`]).
 pub(crate) fn sample_requests(
     base: serde_json::Value,
@@ -698,8 +698,8 @@ pub(crate) fn sample_requests(
     seed: u64,
     id: &str,
 ) -> Vec<serde_json::Value> {
-    let chunk =
-        (crate::candidate::protocol::MAX_RESULT_BYTES * 2 / 3 / (24 * numbers)).clamp(1, 2000);
+    let chunk = (crate::candidate::process::protocol::MAX_RESULT_BYTES * 2 / 3 / (24 * numbers))
+        .clamp(1, 2000);
     let mut out = Vec::new();
     let mut left = total;
     while left > 0 {

@@ -19,15 +19,15 @@
 //! all), and naming one of them alone would be a guess.
 //!
 //! The submission's answers are judged against its own triangle winding
-//! ([`check::Winding`](super::check::Winding)); the variants wind as the reference does and are
+//! ([`check::Winding`](crate::candidate::judging::check::Winding)); the variants wind as the reference does and are
 //! judged against the reference's expectation, so a submission's winding never counts as a
 //! symptom.
 
 use serde::{Deserialize, Serialize};
 
-use super::check::{NORMAL_TOL, Winding};
-use super::outcome::Outcome;
-use super::protocol::Answer;
+use crate::candidate::judging::check::{NORMAL_TOL, Winding};
+use crate::candidate::process::outcome::Outcome;
+use crate::candidate::process::protocol::Answer;
 use crate::oracle::variants::{self, VHit, Variant};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
 
@@ -271,7 +271,7 @@ fn variant_symptom(v: &Variant, case: &Case) -> Symptom {
 
 /// Diagnoses each shape group whose definite vectors fail: the known mistake that explains its
 /// failures, if any (see the module docs). `winding` is the submission's triangle winding
-/// ([`decide_winding`](super::check::decide_winding)). Deterministic: the same cases and
+/// ([`decide_winding`](crate::candidate::judging::check::decide_winding)). Deterministic: the same cases and
 /// outcomes give the same diagnosis.
 pub fn diagnose(cases: &[Case], outcomes: &[Outcome], winding: Option<Winding>) -> Vec<Diagnosis> {
     let catalogue = catalogue();

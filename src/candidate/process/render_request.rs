@@ -28,8 +28,8 @@ use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
 
-use super::protocol::{CandidateError, MAX_RESULT_BYTES};
-use super::session::{CallOutcome, Session};
+use crate::candidate::process::protocol::{CandidateError, MAX_RESULT_BYTES};
+use crate::candidate::process::session::{CallOutcome, Session};
 use crate::scene::SceneDescription;
 
 /// The longest answer [`render_scene`] plans a tile for: a pixel's three numbers take at most

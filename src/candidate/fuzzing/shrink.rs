@@ -6,9 +6,9 @@
 //! same kind of failure. Candidates for one number are tried as one batch, so a shrink costs
 //! a few dozen round trips.
 
+use crate::candidate::fuzzing::generate::oracle_expect_with;
 #[cfg(doc)]
-use super::check::FailureKind;
-use super::generate::oracle_expect_with;
+use crate::candidate::judging::check::FailureKind;
 use crate::oracle::Judging;
 use crate::oracle::vectors::{Case, RaySpec, ShapeSpec};
 
@@ -163,7 +163,7 @@ pub fn shrink_with<K: PartialEq>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::candidate::check::FailureKind;
+    use crate::candidate::judging::check::FailureKind;
     use crate::oracle::vectors::Class;
 
     #[test]
@@ -181,7 +181,7 @@ mod tests {
     fn a_failure_that_depends_on_the_radius_shrinks_to_small_numbers() {
         // "Candidate" that fails every hit on a sphere of radius > 1: the minimal case keeps
         // a radius just above 1 and simple coordinates.
-        let case = crate::candidate::generate::random_cases(
+        let case = crate::candidate::fuzzing::generate::random_cases(
             3,
             0,
             200,

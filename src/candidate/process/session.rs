@@ -4,7 +4,7 @@
 //! A [`Session`] makes one [`Sandbox`] (bubblewrap where it works, else limits, its own session
 //! and a uid of its own; never root; see [`crate::sandbox`]) from its [`CandidateCommand`] and
 //! starts every process of the candidate, restarts included, through it (one
-//! [`pipe`](super::pipe) each); when a process is killed or the session ends, every process the
+//! [`pipe`](crate::candidate::process::pipe) each); when a process is killed or the session ends, every process the
 //! candidate started ends too ([`crate::sandbox::Reaper`]).
 //!
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
@@ -16,13 +16,13 @@
 //!
 //! What a session promises:
 //! - **A strict protocol** ([`Session::run`]): every stdout line is judged against the case
-//!   waited for ([`super::lines`]); a malformed answer, an answer with an id in no request, an
+//!   waited for ([`crate::candidate::process::lines`]); a malformed answer, an answer with an id in no request, an
 //!   answer for a later request or an oversize line makes that case a `protocol` error at once
 //!   ([`Outcome::Protocol`]), without a restart; an answer for a case already settled is stray
 //!   output of the waited one, which keeps waiting for its own id, so nothing shifts. The hello
 //!   must say protocol 1 and name only known shapes ([`HarnessError::BadHello`] otherwise).
 //! - **Caps on the harness's side**: lines are parsed on the reader thread and only capped text
-//!   is queued ([`super::pipe`]); each error field is cut to 4 KiB and, past
+//!   is queued ([`crate::candidate::process::pipe`]); each error field is cut to 4 KiB and, past
 //!   [`RUN_DETAIL_BYTES`] per session, to [`SMALL_ERROR_BYTES`] without traceback; stray lines
 //!   are quoted briefly, 8 per case and [`RUN_JUNK_BYTES`] per session.
 //! - **A time budget** ([`RunOptions::budget`]): past it the cases not answered are `not_run`
@@ -39,13 +39,17 @@ use std::sync::mpsc::RecvTimeoutError;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::command::CandidateCommand;
-use super::error::HarnessError;
-use super::lines::{Meaning, RUN_JUNK_BYTES, describe_line, meaning, oversize_message, push_junk};
-use super::options::RunOptions;
-use super::outcome::Outcome;
-use super::pipe::{Line, MAX_LINE_BYTES, Proc, Tail, describe_status};
-use super::protocol::{Answer, CandidateError, HELLO_LINE, Hello, ParsedLine, Request};
+use crate::candidate::process::command::CandidateCommand;
+use crate::candidate::process::error::HarnessError;
+use crate::candidate::process::lines::{
+    Meaning, RUN_JUNK_BYTES, describe_line, meaning, oversize_message, push_junk,
+};
+use crate::candidate::process::options::RunOptions;
+use crate::candidate::process::outcome::Outcome;
+use crate::candidate::process::pipe::{Line, MAX_LINE_BYTES, Proc, Tail, describe_status};
+use crate::candidate::process::protocol::{
+    Answer, CandidateError, HELLO_LINE, Hello, ParsedLine, Request,
+};
 use crate::oracle::vectors::{Case, ShapeKind};
 use crate::sandbox::{Sandbox, SandboxFacts};
 
@@ -180,7 +184,7 @@ impl Session {
         self.broken.as_deref()
     }
 
-    /// The last [`STDERR_TAIL_BYTES`](super::pipe::STDERR_TAIL_BYTES) bytes the candidate wrote to stderr, over all restarts.
+    /// The last [`STDERR_TAIL_BYTES`](crate::candidate::process::pipe::STDERR_TAIL_BYTES) bytes the candidate wrote to stderr, over all restarts.
     pub fn stderr_tail(&self) -> String {
         self.stderr.lock().unwrap_or_else(|e| e.into_inner()).text()
     }
@@ -875,7 +879,7 @@ mod tests {
     /// A submission whose import writes a file into its working folder and reports who and
     /// where it is on stderr.
     fn nosy_submission() -> tempfile::TempDir {
-        let dir = super::super::bench::assemble_fixture("honest_reference").unwrap();
+        let dir = crate::candidate::bench::assemble_fixture("honest_reference").unwrap();
         let object = dir.path().join("RT_object.py");
         let mut text = std::fs::read_to_string(&object).unwrap();
         text.push_str(
@@ -898,7 +902,7 @@ mod tests {
             .into_iter()
             .filter(|c| c.shape.kind() == ShapeKind::Sphere)
             .collect();
-        let report = super::super::check_session(&mut session, &cases).unwrap();
+        let report = crate::candidate::check_session(&mut session, &cases).unwrap();
         assert!(report.passed(), "{}", report.to_text(3));
         let dir = session.sandbox_dir().canonicalize().unwrap();
         let inside = session.sandbox_inside_dir();

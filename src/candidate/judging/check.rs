@@ -14,7 +14,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::outcome::Outcome;
+use crate::candidate::process::outcome::Outcome;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// How far each component of a candidate's normal may be from the expected one.
@@ -229,7 +229,7 @@ pub fn score_ambiguous(cases: Vec<Case>) -> Vec<Case> {
 }
 
 /// Judges a well-delivered answer for a definite `case`.
-pub fn judge_answer(case: &Case, answer: &super::protocol::Answer) -> Verdict {
+pub fn judge_answer(case: &Case, answer: &crate::candidate::process::protocol::Answer) -> Verdict {
     let expect = &case.expect;
     if !expect.class.is_definite() {
         return Verdict::NotScored;
@@ -298,8 +298,8 @@ pub fn judge_answer(case: &Case, answer: &super::protocol::Answer) -> Verdict {
 
 #[cfg(test)]
 mod tests {
-    use super::super::protocol::Answer;
     use super::*;
+    use crate::candidate::process::protocol::Answer;
 
     fn sphere_hit() -> Case {
         crate::candidate::test_cases::basic_cases().remove(0)

@@ -7,12 +7,12 @@
 //! named, at most [`MAX_SKIPPED_NAMED`] of them) are copied into the sandbox folder, so the
 //! candidate never runs in (or writes to) the submission itself, and the adapter is told a
 //! neutral name, never the submission's path. The interpreter is chosen by
-//! [`python`](super::python).
+//! [`python`](crate::candidate::process::python).
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use super::error::HarnessError;
+use crate::candidate::process::error::HarnessError;
 use crate::sandbox::{Sandbox, SandboxPolicy};
 
 /// The name the course adapter has in the sandbox folder.
@@ -42,8 +42,8 @@ pub const PYTHON_COURSE_ADAPTER: &str = include_str!("python_course.py");
 /// material requests' driver (`rtoracle physics`) is appended to it: it extends the driver's
 /// `OPS` and `answer`.
 pub const COURSE_FUNCTIONS_DRIVER: &str = concat!(
-    include_str!("../functions/course_functions.py"),
-    include_str!("../physics/course_materials.py")
+    include_str!("../../functions/course_functions.py"),
+    include_str!("../../physics/course_materials.py")
 );
 
 /// The driver's name in the sandbox folder (the adapter's `FUNCTIONS_FILE`).
@@ -108,7 +108,7 @@ impl CandidateCommand {
     }
 
     /// The bundled adapter for the course's Python API run on the submission folder `dir`. The
-    /// interpreter is [`python::choose`](super::python::choose)'s (with numpy and Pillow, runnable
+    /// interpreter is [`python::choose`](crate::candidate::process::python::choose)'s (with numpy and Pillow, runnable
     /// in the sandbox). The top-level `.py` files of `dir` are copied into the sandbox folder when
     /// the session starts, and the adapter imports them from there. Anything the submission
     /// prints is a protocol error of its case.
@@ -117,7 +117,7 @@ impl CandidateCommand {
     }
 
     /// [`CandidateCommand::python_course`] with a chosen interpreter (`None`: as there; a given one
-    /// is used as it is, so probe it first with [`python::choose`](super::python::choose)), and with
+    /// is used as it is, so probe it first with [`python::choose`](crate::candidate::process::python::choose)), and with
     /// the submission's prints sent to stderr instead (`prints_to_stderr`: what grading wants,
     /// since nothing a student prints may change a grade but the answers).
     pub fn python_course_with(
@@ -138,13 +138,15 @@ impl CandidateCommand {
         })?;
         let python = match python {
             Some(p) => p.to_path_buf(),
-            None => super::python::choose(
+            None => crate::candidate::process::python::choose(
                 None,
-                &super::python::default_requires(),
+                &crate::candidate::process::python::default_requires(),
                 &SandboxPolicy::default(),
             )
             .map_err(|e| match e {
-                super::python::PythonError::Sandbox(e) => HarnessError::Sandbox(e),
+                crate::candidate::process::python::PythonError::Sandbox(e) => {
+                    HarnessError::Sandbox(e)
+                }
                 other => HarnessError::Python(other.to_string()),
             })?,
         };

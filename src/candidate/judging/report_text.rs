@@ -11,8 +11,8 @@
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
-use super::check::FailureKind;
-use super::report::{CheckReport, Counts, Failure};
+use crate::candidate::judging::check::FailureKind;
+use crate::candidate::judging::report::{CheckReport, Counts, Failure};
 use crate::escape::{terminal_line, terminal_text};
 
 impl CheckReport {
@@ -130,7 +130,10 @@ impl CheckReport {
             let _ = writeln!(
                 s,
                 "watertight groups: {}",
-                super::watertight::groups_summary(c.watertight, c.watertight_cracked)
+                crate::candidate::judging::watertight::groups_summary(
+                    c.watertight,
+                    c.watertight_cracked
+                )
             );
         }
         if c.left_unrun() > 0 {
@@ -187,7 +190,7 @@ impl CheckReport {
                 continue;
             };
             s.push('\n');
-            if let Some(fix) = super::diagnose::fix(&d.mistake_id) {
+            if let Some(fix) = crate::candidate::judging::diagnose::fix(&d.mistake_id) {
                 let _ = writeln!(s, "fix for the {} failures: {fix}", d.shape);
             }
             let _ = writeln!(
@@ -336,9 +339,9 @@ fn write_case(s: &mut String, f: &Failure) {
 
 #[cfg(test)]
 mod tests {
-    use crate::candidate::outcome::Outcome;
-    use crate::candidate::protocol::Answer;
-    use crate::candidate::report::{RunInfo, build_report};
+    use crate::candidate::judging::report::{RunInfo, build_report};
+    use crate::candidate::process::outcome::Outcome;
+    use crate::candidate::process::protocol::Answer;
 
     #[test]
     fn one_error_on_every_case_is_said_once_and_candidate_text_is_escaped() {

@@ -1,7 +1,7 @@
 //! The check report's model ([`CheckReport`]): counts overall and per shape group, every
 //! failure with what was asked and what was expected, the candidate's import error and the end
 //! of its stderr, as JSON (serde); [`build_report`] judges every outcome into it. Its text is
-//! [`super::report_text`]'s.
+//! [`crate::candidate::judging::report_text`]'s.
 //!
 //! Counting: `total` is the number of *definite* vectors (overall, or of one shape) and
 //! `total = passed + failed + errors + timeouts + not_run`, where `failed` counts mismatches,
@@ -16,27 +16,29 @@
 //! reason but a shape the candidate said it does not implement (`not_run - unsupported`: after
 //! a group's time-outs or crashes, past the time budget). Such unscored vectors are listed in
 //! `failures` too, with their class in `expected`. And a watertight group whose ray hit none of
-//! its shapes (`watertight_cracked`, of `watertight` groups judged; [`super::watertight`]):
+//! its shapes (`watertight_cracked`, of `watertight` groups judged; [`crate::candidate::judging::watertight`]):
 //! listed in `failures` under its first member's id.
 //!
 //! Every message, traceback, name and stderr line from the candidate was capped by the harness
-//! when it was read ([`super::protocol`], [`super::session`]).
+//! when it was read ([`crate::candidate::process::protocol`], [`crate::candidate::process::session`]).
 //!
 //! A failure keeps the request line as sent and the expected answer in words, which any
 //! adapter author can use, and a Python reproduction against the course's API only for the
-//! bundled course adapter ([`super::repro`]). Vectors not run are summarised per shape and
+//! bundled course adapter ([`crate::candidate::judging::repro`]). Vectors not run are summarised per shape and
 //! reason (`not_run_summary`), not listed one by one.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_exact_wound, judge_wound};
-use super::diagnose::Diagnosis;
-use super::outcome::Outcome;
-use super::protocol::{Answer, CandidateError};
-pub use super::repro::{expected_in_words, python_repro};
-use super::watertight::{GroupResult, crack_message, judge_groups};
+use crate::candidate::judging::check::{
+    FailureKind, Verdict, Winding, decide_winding, judge_exact_wound, judge_wound,
+};
+use crate::candidate::judging::diagnose::Diagnosis;
+pub use crate::candidate::judging::repro::{expected_in_words, python_repro};
+use crate::candidate::judging::watertight::{GroupResult, crack_message, judge_groups};
+use crate::candidate::process::outcome::Outcome;
+use crate::candidate::process::protocol::{Answer, CandidateError};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
 use crate::sandbox::SandboxFacts;
 
@@ -57,7 +59,7 @@ pub struct Counts {
     pub not_run: usize,
     /// `ambiguous` vectors (not scored).
     pub ambiguous: usize,
-    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`](crate::candidate::check::judge_exact)).
+    /// `ambiguous` vectors answered with the exact answer ([`judge_exact`](crate::candidate::judging::check::judge_exact)).
     pub ambiguous_passed: usize,
     /// `any` vectors: degenerate or non-finite inputs, where any answer (or an error) is
     /// accepted (not scored).
@@ -75,7 +77,7 @@ pub struct Counts {
     /// crash fails the check.
     #[serde(default)]
     pub unscored_crashes: usize,
-    /// Watertight groups of class `hit` judged ([`super::watertight`]), counted under the
+    /// Watertight groups of class `hit` judged ([`crate::candidate::judging::watertight`]), counted under the
     /// shape of their first member.
     #[serde(default)]
     pub watertight: usize,
@@ -216,7 +218,7 @@ pub struct CheckReport {
     /// ([`decide_winding`]); `None` when no triangle was hit.
     #[serde(default)]
     pub triangle_winding: Option<Winding>,
-    /// The known mistakes that explain the failures, per shape group ([`super::diagnose`]).
+    /// The known mistakes that explain the failures, per shape group ([`crate::candidate::judging::diagnose`]).
     #[serde(default)]
     pub diagnosis: Vec<Diagnosis>,
     /// What the harness noticed about the candidate's use of the protocol that is no vector's
@@ -249,7 +251,7 @@ pub struct RunInfo {
     /// failures then carry a Python reproduction.
     pub course_api: bool,
     /// What the harness noticed about the candidate's use of the protocol
-    /// ([`Session::notes`](super::session::Session::notes)).
+    /// ([`Session::notes`](crate::candidate::process::session::Session::notes)).
     pub notes: Vec<String>,
 }
 
@@ -279,7 +281,7 @@ fn failure(
         } else {
             String::new()
         },
-        request: super::protocol::Request::for_case(case).to_line(),
+        request: crate::candidate::process::protocol::Request::for_case(case).to_line(),
     }
 }
 
@@ -378,7 +380,7 @@ pub fn build_report(cases: &[Case], outcomes: &[Outcome], info: RunInfo) -> Chec
         restarts: info.restarts,
         sandbox: info.sandbox,
         triangle_winding: winding,
-        diagnosis: super::diagnose::diagnose(cases, outcomes, winding),
+        diagnosis: crate::candidate::judging::diagnose::diagnose(cases, outcomes, winding),
         notes: info.notes,
         required: Vec::new(),
     }

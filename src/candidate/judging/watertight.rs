@@ -5,7 +5,7 @@
 //! answered with an error (the code raised) is not judged: the member's own failure, if any,
 //! is reported by the vector's verdict.
 
-use super::outcome::Outcome;
+use crate::candidate::process::outcome::Outcome;
 use crate::oracle::vectors::{Case, Class};
 
 /// What a group came to.
@@ -119,7 +119,7 @@ pub fn crack_message(group: &Group, cases: &[Case]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::candidate::protocol::Answer;
+    use crate::candidate::process::protocol::Answer;
     use crate::oracle::Judging;
     use crate::oracle::watertight::watertight_cases;
 

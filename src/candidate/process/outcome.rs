@@ -2,7 +2,7 @@
 //! a protocol error, a time-out, a death, a case of a shape the candidate does not implement,
 //! or a case the harness stopped running.
 
-use super::protocol::Answer;
+use crate::candidate::process::protocol::Answer;
 
 /// What the harness got for one case.
 // An answer (with its error's file, line and code) is a few hundred bytes, made once per case
@@ -46,7 +46,7 @@ pub enum Outcome {
         reason: String,
     },
     /// The case was not sent: the candidate said it does not implement the case's shape (its
-    /// hello's `shapes`, or [`Candidate::supports`](super::rust::Candidate::supports)). This
+    /// hello's `shapes`, or [`Candidate::supports`](crate::candidate::rust::Candidate::supports)). This
     /// alone fails no check (unless the shape is required).
     Unsupported {
         /// Why, in words.

@@ -16,8 +16,8 @@ use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::error::HarnessError;
-use super::protocol::{MAX_QUOTE_CHARS, ParsedLine, parse_line, quote_line};
+use crate::candidate::process::error::HarnessError;
+use crate::candidate::process::protocol::{MAX_QUOTE_CHARS, ParsedLine, parse_line, quote_line};
 use crate::sandbox::{Reaper, Sandbox};
 
 /// How many bytes of the candidate's stderr are kept for the report.

@@ -1,4 +1,4 @@
-//! Differential fuzzing: random definite cases (see [`super::generate`]) run through a
+//! Differential fuzzing: random definite cases (see [`crate::candidate::fuzzing::generate`]) run through a
 //! candidate in rounds until a number of cases or a time is reached (whichever first); each
 //! distinct failure, by shape group and [`FuzzKind`] (a hit/miss flip either way, t, normal,
 //! front_face, a raised error, a dead process, a timeout, a protocol error), is shrunk to a
@@ -14,12 +14,14 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::check::{FailureKind, Verdict, Winding, decide_winding, judge_wound};
-use super::diagnose::{Diagnosis, SAMPLE, diagnose};
-use super::error::HarnessError;
-use super::generate::random_cases_with;
-use super::outcome::Outcome;
-use super::repro::{expected_in_words, python_repro};
+use crate::candidate::fuzzing::generate::random_cases_with;
+use crate::candidate::judging::check::{
+    FailureKind, Verdict, Winding, decide_winding, judge_wound,
+};
+use crate::candidate::judging::diagnose::{Diagnosis, SAMPLE, diagnose};
+use crate::candidate::judging::repro::{expected_in_words, python_repro};
+use crate::candidate::process::error::HarnessError;
+use crate::candidate::process::outcome::Outcome;
 use crate::oracle::Judging;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
 
@@ -214,11 +216,11 @@ pub struct FuzzReport {
     pub by_kind: Vec<KindCount>,
     /// One shrunk failure per shape group and kind, in the order found.
     pub failures: Vec<FuzzFailure>,
-    /// The known mistakes that explain the failures, per shape group ([`super::diagnose`], on
+    /// The known mistakes that explain the failures, per shape group ([`crate::candidate::judging::diagnose`], on
     /// the failing cases and a sample of the passing ones).
     pub diagnosis: Vec<Diagnosis>,
     /// What the harness noticed about the candidate's use of the protocol (filled in by the
-    /// caller from [`Session::notes`](super::session::Session::notes)).
+    /// caller from [`Session::notes`](crate::candidate::process::session::Session::notes)).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
 }
@@ -455,7 +457,7 @@ fn shrunk(
                 Err(_) => vec![None; batch.len()],
             }
         };
-        let minimal = super::shrink::shrink_with(
+        let minimal = crate::candidate::fuzzing::shrink::shrink_with(
             &case,
             detail,
             &mut fails,
@@ -497,7 +499,7 @@ fn shrunk(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::candidate::protocol::Answer;
+    use crate::candidate::process::protocol::Answer;
     use crate::candidate::rust::{Candidate, Reference, run_candidate};
     use crate::oracle::vectors::{RaySpec, ShapeSpec};
 

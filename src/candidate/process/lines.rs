@@ -12,7 +12,7 @@
 
 use std::collections::HashMap;
 
-use super::protocol::{Answer, ParsedLine, quote_line};
+use crate::candidate::process::protocol::{Answer, ParsedLine, quote_line};
 use crate::oracle::vectors::Case;
 
 /// Bytes of stray output quoted over one session; past it stray lines are counted, not kept.
@@ -152,7 +152,7 @@ pub(crate) fn oversize_message(head: &str, max_bytes: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::candidate::protocol::MAX_QUOTE_CHARS;
+    use crate::candidate::process::protocol::MAX_QUOTE_CHARS;
 
     #[test]
     fn stray_output_is_quoted_briefly_and_bounded() {
