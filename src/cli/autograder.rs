@@ -2,7 +2,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::grade::{Rubric, autograder, pack};
+use rtoracle::grade::Rubric;
+use rtoracle::grade::autograder::{self, pack};
 
 /// `rtoracle autograder --out autograder.zip [--rubric NAME|FILE.toml] [--binary PATH]`
 #[derive(Debug, clap::Args)]

@@ -62,7 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         return run_merge(&args);
     }
     if let Some(name) = args.print_rubric.as_deref().filter(|n| !n.is_empty()) {
-        let Some(text) = rtoracle::grade::week_rubrics::builtin_rubric_toml(name) else {
+        let Some(text) = rtoracle::grade::rubric::weeks::builtin_rubric_toml(name) else {
             // `grade --print-rubric SUBMISSION` reads the folder as the rubric's name.
             let folder = if Path::new(name).is_dir() {
                 "; it is a folder: to print the rubric in use, write --print-rubric= or put \
@@ -73,7 +73,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             anyhow::bail!(
                 "--print-rubric {}: not a built-in rubric (known: {}){folder}",
                 terminal_line(name),
-                rtoracle::grade::week_rubrics::BUILTIN_RUBRICS.join(", ")
+                rtoracle::grade::rubric::weeks::BUILTIN_RUBRICS.join(", ")
             );
         };
         out!("{text}")?;
@@ -235,7 +235,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
 /// `--merge`: the shards joined into `--out`, each submission's score on stdout, one line each,
 /// and where the gradebook is on stderr.
 fn run_merge(args: &Args) -> anyhow::Result<ExitCode> {
-    let merged = rtoracle::grade::merge::merge_shards(&args.merge, &args.out)?;
+    let merged = rtoracle::grade::batch::merge::merge_shards(&args.merge, &args.out)?;
     for e in &merged {
         match &e.result {
             Ok(r) => outln!("{}: {} / {}", e.name.terminal_line(), r.score, r.max_score)?,

@@ -4,13 +4,30 @@
 //! with a gradebook; and a Gradescope autograder package.
 //!
 //! Grading sees the code under test only through [`CodeChecker`] and the images only through
-//! [`ImageChecker`] ([`inputs`]). The code checker is [`CourseCodeChecker`] ([`checkers`]): the
+//! [`ImageChecker`] ([`checkers`]). The code checker is [`CourseCodeChecker`] ([`checkers::code`]): the
 //! `check` harness running the course adapter in the [sandbox](crate::sandbox); the image
-//! checker is [`CompareImageChecker`] ([`image_checker`]), the noise-aware comparison against
+//! checker is [`CompareImageChecker`] ([`checkers::images`]), the noise-aware comparison against
 //! the golden of a built-in scene (embedded) or of an instructor's scene file (the rubric's, or
 //! rendered once and cached). Image groups are rendered by the grader from the submission's own
-//! code by default ([`render`](mod@render)): the code checker renders, the image checker judges
+//! code by default ([`checkers::rendered`](mod@render)): the code checker renders, the image checker judges
 //! the render.
+//!
+//! Four rooms, and the single-submission path on top:
+//!
+//! - [`rubric`]: the [`Rubric`] (built-in weeks in [`rubric::weeks`], TOML files), partial
+//!   credit ([`rubric::credit`]) and the points of each group ([`rubric::score`]).
+//! - [`checkers`]: the two interfaces and their real implementations: the course's code through
+//!   the `check` harness ([`checkers::code`]), the weekly function checks
+//!   ([`checkers::functions`]), images against their reference ([`checkers::images`]), renders
+//!   asked of the submission's own code ([`checkers::rendered`], [`checkers::noise_floor`]) and
+//!   copied images ([`checkers::copies`]).
+//! - [`batch`]: a folder of submissions in parallel, the gradebook, one shard's entry
+//!   ([`batch::entry`]), the merge of shards ([`batch::merge`]) and the pairs whose noise is
+//!   shared ([`batch::shared_noise`]).
+//! - [`autograder`]: the Gradescope package ([`autograder::pack`]).
+//! - [`report`]: every format written from one [`GradeReport`].
+//! - Here: [`intake`] of a submission's files, the run ([`grade`]), the result model and
+//!   [`grade_to_dir`].
 //!
 //! ```no_run
 //! use rtoracle::grade::{CompareImageChecker, CourseCodeChecker, Format, Rubric, grade_to_dir};
@@ -28,34 +45,19 @@
 
 pub mod autograder;
 pub mod batch;
-pub mod batch_copies;
-pub mod batch_entry;
 pub mod bench;
 pub mod checkers;
-pub mod copies;
-pub mod credit;
-#[cfg(test)]
-pub(crate) mod fakes;
-mod functions_score;
-pub mod image_checker;
-pub mod inputs;
 pub mod intake;
-pub mod merge;
-pub mod noise_floor;
-pub mod pack;
-pub mod render;
 pub mod report;
 mod result;
 pub mod rubric;
 mod run;
-mod score;
-pub mod week_rubrics;
 mod write;
 
-pub use checkers::CourseCodeChecker;
-pub use functions_score::{UNSCORED_ID, function_checks};
-pub use image_checker::CompareImageChecker;
-pub use inputs::{
+pub use checkers::code::CourseCodeChecker;
+pub use checkers::functions::{UNSCORED_ID, function_checks};
+pub use checkers::images::CompareImageChecker;
+pub use checkers::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, FunctionsOutcome, GroupCounts,
     ImageChecker, ImageOutcome, ImageVerdict, SceneFile, SceneSource,
 };

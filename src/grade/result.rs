@@ -8,8 +8,8 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::copies::{CopyFinding, Fingerprint};
-use super::inputs::{FailureKind, FailureSummary, GroupCounts, ImageVerdict};
+use super::checkers::copies::{CopyFinding, Fingerprint};
+use super::checkers::{FailureKind, FailureSummary, GroupCounts, ImageVerdict};
 use super::rubric::Visibility;
 use crate::escape::Untrusted;
 use crate::output::OutputError;
@@ -96,9 +96,9 @@ pub struct CheckResult {
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
-        deserialize_with = "super::credit::read_credit"
+        deserialize_with = "super::rubric::credit::read_credit"
     )]
-    pub credit: Option<super::credit::Credit>,
+    pub credit: Option<super::rubric::credit::Credit>,
     /// The first failing vectors, with reproductions.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failures: Vec<FailureSummary>,

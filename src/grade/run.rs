@@ -5,13 +5,13 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::copies::{CopyFinding, Fingerprint, recognise};
-use super::inputs::{
+use super::checkers::copies::{CopyFinding, Fingerprint, recognise};
+use super::checkers::{
     CodeChecker, CodeOutcome, FailureKind, ImageChecker, ImageOutcome, ImageVerdict,
 };
 use super::result::{CodeRun, GradeError, GradeReport, Reproducibility, round2};
+use super::rubric::score::{code_check, heatmap_name, image_check};
 use super::rubric::{Group, GroupKind, Rubric, SceneSource};
-use super::score::{code_check, heatmap_name, image_check};
 use crate::candidate::process::render_request::RenderOutcome;
 
 /// The size the image of `scene` must have, when `scene` is a built-in scene.
@@ -27,7 +27,7 @@ pub(crate) fn expected_size(scene: &SceneSource) -> Option<(usize, usize)> {
 /// and hands the copy to `images`; whatever the checker says names the file relative to the
 /// submission, never by the grader's paths.
 ///
-/// The image is first checked for a copy ([`copies`](super::copies)): the course's published
+/// The image is first checked for a copy ([`copies`](super::checkers::copies)): the course's published
 /// image or the reference tracer's own render is not compared (it scores 0, the finding says
 /// why); the fingerprint comes back for a batch's comparison of submissions.
 fn check_image(
@@ -116,24 +116,24 @@ impl StagedImage {
 fn render_check(
     g: &Group,
     upload: ImageOutcome,
-    render: super::render::GroupRender,
+    render: super::checkers::rendered::GroupRender,
     images: &dyn ImageChecker,
     out_dir: &Path,
 ) -> super::result::CheckResult {
     let copy = match &render.scene {
         RenderOutcome::Rendered(image) => {
             let scene = g.scene_source().expect("validated");
-            let fp = Fingerprint::of(&super::inputs::encoded(image));
+            let fp = Fingerprint::of(&super::checkers::encoded(image));
             recognise(&fp, &scene).filter(CopyFinding::zeroes)
         }
         _ => None,
     };
     let heatmap = out_dir.join(heatmap_name(g));
-    let judged = super::render::judge(g, render, upload, images, &heatmap);
+    let judged = super::checkers::rendered::judge(g, render, upload, images, &heatmap);
     let mut check = image_check(g, judged, copy.clone(), out_dir);
     match &copy {
         Some(c) => check.message = c.render_sentence().into(),
-        None => super::render::explain(&mut check, g),
+        None => super::checkers::rendered::explain(&mut check, g),
     }
     check
 }
@@ -144,7 +144,7 @@ fn run_code(
     submission: &Path,
     rubric: &Rubric,
     code: &dyn CodeChecker,
-) -> (CodeOutcome, Option<super::inputs::FunctionsOutcome>) {
+) -> (CodeOutcome, Option<super::checkers::FunctionsOutcome>) {
     let shapes = rubric.code_shapes();
     let week = rubric.week.and_then(crate::functions::Week::new);
     let function_options = crate::functions::FunctionOptions {
@@ -201,7 +201,7 @@ pub fn grade(
                         .collect::<Vec<_>>()
                 },
                 || {
-                    super::render::render_groups(&render_groups, rubric.seed, |jobs| {
+                    super::checkers::rendered::render_groups(&render_groups, rubric.seed, |jobs| {
                         code.render(submission, jobs)
                     })
                 },
@@ -215,7 +215,7 @@ pub fn grade(
     let mut fingerprints = Vec::new();
     let mut function_checks = functions
         .as_ref()
-        .map(|f| super::functions_score::function_checks(rubric, f))
+        .map(|f| super::checkers::functions::function_checks(rubric, f))
         .unwrap_or_default();
     for g in &rubric.groups {
         match g.kind {
@@ -293,8 +293,8 @@ pub fn grade(
 /// How many answers broke the protocol: intersection vectors, function cases and renders.
 fn protocol_errors(
     outcome: &CodeOutcome,
-    functions: Option<&super::inputs::FunctionsOutcome>,
-    renders: &[super::render::GroupRender],
+    functions: Option<&super::checkers::FunctionsOutcome>,
+    renders: &[super::checkers::rendered::GroupRender],
 ) -> usize {
     let vectors = outcome
         .failures
@@ -359,8 +359,8 @@ fn reproducibility(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grade::fakes::*;
-    use crate::grade::inputs::{FailureSummary, GroupCounts};
+    use crate::grade::checkers::fakes::*;
+    use crate::grade::checkers::{FailureSummary, GroupCounts};
     use crate::grade::result::{CheckStatus, smallest_failure};
     use crate::grade::rubric::Visibility;
     use crate::grade::rubric::sha256_hex;

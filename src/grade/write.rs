@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::inputs::{CodeChecker, ImageChecker};
+use super::checkers::{CodeChecker, ImageChecker};
 use super::report::Format;
 use super::result::{GradeError, GradeReport};
 use super::rubric::Rubric;
@@ -86,7 +86,7 @@ pub(crate) fn grade_into(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grade::fakes::*;
+    use crate::grade::checkers::fakes::*;
     use crate::output::tests::names;
 
     #[test]

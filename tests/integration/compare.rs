@@ -510,7 +510,7 @@ fn bad_candidates_exit_2_naming_the_file() {
 #[test]
 fn the_grading_image_checker_uses_the_comparison() {
     use rtoracle::grade::CompareImageChecker;
-    use rtoracle::grade::inputs::{ImageChecker, ImageVerdict};
+    use rtoracle::grade::checkers::{ImageChecker, ImageVerdict};
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path();
     let d = rtoracle::scene::builtin("week04-sphere").unwrap();

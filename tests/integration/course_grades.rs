@@ -7,7 +7,7 @@
 //! `report.json`. The expected scores are the promises, not values read from a run: a
 //! solution earns every point, and a skeleton earns none of a week's points, since every
 //! function and image the built-in rubric scores is one the skeleton leaves blank
-//! (`rtoracle::grade::week_rubrics`). Run with `--test-threads=2`: each test starts Python.
+//! (`rtoracle::grade::rubric::weeks`). Run with `--test-threads=2`: each test starts Python.
 
 use std::path::Path;
 

@@ -766,7 +766,7 @@ fn honest_images(dest: &Path, seed: u64) {
         ("week04-quad", "week04_quad.png"),
     ] {
         let d = rtoracle::scene::builtin(scene).unwrap();
-        let img = rtoracle::grade::copies::render_png_pixels(&d, None, seed).unwrap();
+        let img = rtoracle::grade::checkers::copies::render_png_pixels(&d, None, seed).unwrap();
         rtoracle::image_io::write_png(&dest.join(file), &img).unwrap();
     }
 }

@@ -462,7 +462,7 @@ fn week10_rubric_grades_the_course_fairly() {
 #[test]
 fn built_in_rubrics_print_and_read_back() {
     let dir = tempfile::tempdir().unwrap();
-    for name in rtoracle::grade::week_rubrics::BUILTIN_RUBRICS {
+    for name in rtoracle::grade::rubric::weeks::BUILTIN_RUBRICS {
         let out = run_in(dir.path(), &["grade", "--print-rubric", name]);
         assert!(out.status.success(), "{name}");
         let text = String::from_utf8(out.stdout).unwrap();

@@ -14,7 +14,7 @@ use crate::escape::{Untrusted, markdown_block, markdown_inline};
 use crate::grade::result::smallest_case_sentence;
 use crate::grade::{CheckResult, CheckStatus, FailureKind, FailureSummary, smallest_failure};
 
-use crate::grade::score::MISSING;
+use crate::grade::rubric::score::MISSING;
 
 /// Whether `c` is an image check whose file is not in the submission.
 pub(crate) fn is_missing_image(c: &CheckResult) -> bool {

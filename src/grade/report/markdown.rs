@@ -178,7 +178,7 @@ pub fn render(report: &GradeReport) -> String {
 
 #[cfg(test)]
 mod tests {
-    use crate::grade::fakes::{FakeCode, all_pass, counts, fake_images};
+    use crate::grade::checkers::fakes::{FakeCode, all_pass, counts, fake_images};
     use crate::grade::{Rubric, grade, rubric::WEEK04_RUBRIC};
 
     #[test]

@@ -12,8 +12,8 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::copies::Fingerprint;
-use super::result::GradeReport;
+use crate::grade::checkers::copies::Fingerprint;
+use crate::grade::result::GradeReport;
 use crate::oracle::vectors::ShapeKind;
 
 /// The entry's file in a submission's report folder.

@@ -5,8 +5,12 @@
 //! A batch can be spread over machines: `--shard K/N` grades the share [`Shard::holds`] gives
 //! shard K (decided by each folder's name alone, so the same on every machine and whatever other
 //! folders there are), and every batch also writes `batch.json` ([`BatchFile`]: the rows the
-//! gradebook and summary are made from), from which [`super::merge`] joins the shards into the
+//! gradebook and summary are made from), from which [`merge`] joins the shards into the
 //! gradebook and summary an unsharded run writes, byte for byte.
+
+pub mod entry;
+pub mod merge;
+pub mod shared_noise;
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -19,10 +23,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use super::batch_copies::flag_shared_noise;
-use super::batch_entry::{ENTRY_FILE, EntryFile};
-use super::copies::CopyFinding;
-use super::inputs::{CodeChecker, ImageChecker};
+use self::entry::{ENTRY_FILE, EntryFile};
+use self::shared_noise::flag_shared_noise;
+use super::checkers::copies::CopyFinding;
+use super::checkers::{CodeChecker, ImageChecker};
 use super::report::Format;
 use super::result::{CheckStatus, GradeError, GradeReport, round2};
 use super::rubric::Rubric;
@@ -798,8 +802,8 @@ fn common_failures(md: &mut String, graded: &[&RowScores]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grade::fakes::*;
-    use crate::grade::inputs::{FailureKind, FailureSummary};
+    use crate::grade::checkers::fakes::*;
+    use crate::grade::checkers::{FailureKind, FailureSummary};
 
     /// Makes a submission folder with fake images for each of `names` in a new temporary
     /// folder and grades them as a batch with `code` (JSON reports into its `out`). Returns the

@@ -2,7 +2,7 @@
 //! `--print-rubric week06`, `autograder --rubric week06`), as TOML text a course can print,
 //! edit and give back as a file.
 //!
-//! Week 4's is [`WEEK04_RUBRIC`](super::rubric::WEEK04_RUBRIC). From week 5 on, a week's points
+//! Week 4's is [`WEEK04_RUBRIC`](crate::grade::rubric::WEEK04_RUBRIC). From week 5 on, a week's points
 //! go only to that week's own tasks: what the week's skeleton leaves blank and the instructor's
 //! solution fills in (the course's code, `weekNN/skeleton` against `weekNN/solution`). Out of
 //! 100 points:
@@ -15,7 +15,7 @@
 //!   render right ([`unscored_image`] names the others, judged and shown without points), each
 //!   rendered by the grader from the submission's own `main.py` at a few samples per pixel
 //!   ([`week_render_spp`]), and again from a camera the grader moves by an amount drawn from the
-//!   rubric's secret ([`super::render`]): both must match the reference.
+//!   rubric's secret ([`crate::grade::checkers::rendered`]): both must match the reference.
 //!
 //! So the unmodified skeleton earns nothing: every scored function is one it stubs, and every
 //! scored image one its stubs (or its `main.py`'s blank materials) make wrong.
@@ -27,8 +27,8 @@ use std::fmt::Write as _;
 
 use std::path::Path;
 
-use super::rubric::{Group, GroupKind, Rubric, RubricError, WEEK04_RUBRIC};
 use crate::functions::Week;
+use crate::grade::rubric::{Group, GroupKind, Rubric, RubricError, WEEK04_RUBRIC};
 
 /// The names of the built-in rubrics.
 pub const BUILTIN_RUBRICS: &[&str] = &[
@@ -399,7 +399,7 @@ impl Rubric {
 /// The rubric's week-5-to-10 keys and its functions groups, checked when it is read.
 impl Rubric {
     /// The week, `alpha` and `accept`, and that no function is scored by two groups.
-    pub(super) fn validate_week(&self) -> Result<(), RubricError> {
+    pub(in crate::grade) fn validate_week(&self) -> Result<(), RubricError> {
         let week = match self.week {
             None => {
                 if self.alpha.is_some() || !self.accept.is_empty() {
@@ -454,7 +454,7 @@ impl Rubric {
         Ok(())
     }
 
-    pub(super) fn validate_functions_group(&self, g: &Group) -> Result<(), RubricError> {
+    pub(in crate::grade) fn validate_functions_group(&self, g: &Group) -> Result<(), RubricError> {
         if !g.id.starts_with("functions.") {
             return Err(self.invalid(format!(
                 "functions group id {:?} must start with \"functions.\"",

@@ -44,13 +44,13 @@ use std::time::Duration;
 
 use serde_json::{Value, json};
 
-use super::inputs::{ImageChecker, ImageOutcome, ImageVerdict};
-use super::result::{CheckResult, CheckStatus};
-use super::rubric::{Group, SceneSource};
 use crate::candidate::process::render_request::{
     CameraMove, MadeBy, RenderJob, RenderOutcome, RenderedImage,
 };
 use crate::escape::Untrusted;
+use crate::grade::checkers::{ImageChecker, ImageOutcome, ImageVerdict};
+use crate::grade::result::{CheckResult, CheckStatus};
+use crate::grade::rubric::{Group, SceneSource};
 use crate::scene::SceneDescription;
 
 /// The scene description an image group renders: the built-in's or the rubric's scene file.

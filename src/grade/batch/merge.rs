@@ -3,7 +3,7 @@
 //! submissions' report folders, each with its [`ENTRY_FILE`] (the report as graded and its
 //! images' fingerprints), and a `batch.json` ([`BatchFile`]). The merge is as strict as grading
 //! the batch whole: it compares every two submissions' images across the shards (the copy
-//! check of [`flag_shared_noise`](super::batch_copies::flag_shared_noise)) and writes every
+//! check of [`flag_shared_noise`](crate::grade::batch::shared_noise::flag_shared_noise)) and writes every
 //! submission's reports, the gradebook, the summary and `batch.json` from the entries, so the
 //! merged folder is the whole batch's, byte for byte, copy findings included.
 //!
@@ -17,11 +17,13 @@
 
 use std::path::{Path, PathBuf};
 
-use super::batch::{BATCH_SCHEMA, BATCH_VERSION, BatchEntry, BatchFile, BatchRow, flag_copies};
-use super::batch_entry::{ENTRY_FILE, EntryFile};
-use super::report::Format;
-use super::result::GradeError;
-use super::write::REPORT_FOLDER;
+use crate::grade::batch::entry::{ENTRY_FILE, EntryFile};
+use crate::grade::batch::{
+    BATCH_SCHEMA, BATCH_VERSION, BatchEntry, BatchFile, BatchRow, flag_copies,
+};
+use crate::grade::report::Format;
+use crate::grade::result::GradeError;
+use crate::grade::write::REPORT_FOLDER;
 use crate::output::OutputDir;
 
 /// Why shards cannot be merged.

@@ -10,8 +10,8 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use super::rubric::{GroupKind, Rubric};
 use crate::golden::{cache_dir, golden_of, golden_spp};
+use crate::grade::rubric::{GroupKind, Rubric};
 
 /// The folder of the package (beside `rubric.toml`) holding the scene files and goldens.
 pub const PACKED_SCENES: &str = "rtoracle-scenes";
@@ -89,7 +89,7 @@ pub fn pack_rubric(rubric: &Rubric, rubric_text: &str) -> Result<PackedRubric, P
                 let fail = |e: crate::golden::GoldenError| {
                     PackError::Golden(rubric.source.clone(), scene.label.clone(), e.to_string())
                 };
-                let made = super::image_checker::golden_scene_of(scene)
+                let made = crate::grade::checkers::images::golden_scene_of(scene)
                     .and_then(|g| golden_of(&g, spp, cache_dir().as_deref(), true))
                     .map_err(fail)?;
                 rendered += usize::from(made.rendered());

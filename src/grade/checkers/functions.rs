@@ -16,10 +16,10 @@
 //! catalogue's names and sentences). What the submission said (an exception's text) is only in
 //! the function result's `failure.problem`, which the reports quote as untrusted text.
 
-use super::inputs::FunctionsOutcome;
-use super::result::{CheckResult, CheckStatus};
-use super::rubric::{Group, GroupKind, Rubric, Visibility};
 use crate::functions::{FunctionResult, Status};
+use crate::grade::checkers::FunctionsOutcome;
+use crate::grade::result::{CheckResult, CheckStatus};
+use crate::grade::rubric::{Group, GroupKind, Rubric, Visibility};
 
 /// The id of the unscored check that lists the failing functions that carry no points.
 pub const UNSCORED_ID: &str = "functions.unscored";
@@ -277,7 +277,7 @@ mod tests {
     fn functions_groups_score_by_equal_shares() {
         // The week-5 rubric with the function groups of this test (the built-in one scores only
         // the direct term).
-        let builtin = crate::grade::week_rubrics::builtin_rubric_toml("week05").unwrap();
+        let builtin = crate::grade::rubric::weeks::builtin_rubric_toml("week05").unwrap();
         let lights = "[[group]]\nid = \"functions.lights\"";
         let at = builtin.find(lights).unwrap();
         let end = at + builtin[at..].find("\n\n").unwrap();

@@ -3,11 +3,11 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::inputs::{
+use crate::grade::checkers::{
     CodeChecker, CodeOutcome, FailureSummary, GroupCounts, ImageChecker, ImageOutcome, ImageVerdict,
 };
-use super::rubric::SceneSource;
-use super::run::expected_size;
+use crate::grade::rubric::SceneSource;
+use crate::grade::run::expected_size;
 use crate::oracle::vectors::ShapeKind;
 
 /// Answers with fixed counts per shape (and an optional fatal error).
@@ -69,20 +69,22 @@ impl CodeChecker for FakeCode {
     fn render(
         &self,
         _: &Path,
-        jobs: &[super::inputs::RenderJob],
-    ) -> Vec<super::inputs::RenderOutcome> {
+        jobs: &[crate::grade::checkers::RenderJob],
+    ) -> Vec<crate::grade::checkers::RenderOutcome> {
         jobs.iter()
             .map(|job| {
                 let camera = job.scene.camera(None);
-                super::inputs::RenderOutcome::Rendered(super::inputs::RenderedImage {
-                    width: camera.width,
-                    height: camera.height,
-                    spp: job.spp,
-                    seconds: 0.0,
-                    data: vec![[0.5; 3]; camera.width * camera.height],
-                    film: None,
-                    made_by: Default::default(),
-                })
+                crate::grade::checkers::RenderOutcome::Rendered(
+                    crate::grade::checkers::RenderedImage {
+                        width: camera.width,
+                        height: camera.height,
+                        spp: job.spp,
+                        seconds: 0.0,
+                        data: vec![[0.5; 3]; camera.width * camera.height],
+                        film: None,
+                        made_by: Default::default(),
+                    },
+                )
             })
             .collect()
     }
@@ -109,7 +111,7 @@ impl ImageChecker for FakeImage {
     /// A variant passes (the fake reads no pixel).
     fn check_variant(
         &self,
-        _: &super::inputs::RenderedImage,
+        _: &crate::grade::checkers::RenderedImage,
         _: &crate::scene::SceneDescription,
     ) -> ImageOutcome {
         ImageOutcome {

@@ -45,7 +45,7 @@
 //!
 //! A rendered image group (`source = "render"`) is judged on the grader's render of its scene
 //! from the submission's code, at `spp` samples per pixel against the golden (see
-//! [`render`](super::render)); its uploaded `file` is still read and reported, and earns
+//! [`render`](super::checkers::rendered)); its uploaded `file` is still read and reported, and earns
 //! nothing. A submission's worst case is `code_time_budget_seconds` for the code checks plus
 //! each rendered group's `render_seconds` (the renders and the code checks run at the same time
 //! when there are cores for both).
@@ -59,6 +59,10 @@
 //! starts, with one line naming the rubric. Without a `golden`, the image checker renders the
 //! golden the first time it is needed and keeps it in the cache
 //! ([`crate::golden::golden_of`]).
+
+pub mod credit;
+pub mod score;
+pub mod weeks;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

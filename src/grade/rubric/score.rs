@@ -2,16 +2,16 @@
 
 use std::path::Path;
 
-use super::copies::CopyFinding;
-use super::credit::{ClassTally, Credit, credit};
-use super::inputs::{
+use crate::grade::checkers::copies::CopyFinding;
+use crate::grade::checkers::{
     CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageOutcome, ImageVerdict,
 };
-use super::result::{
+use crate::grade::result::{
     CheckResult, CheckStatus, FAILURES_SHOWN, ImageResult, round2, simplicity,
     smallest_case_sentence, smallest_failure,
 };
-use super::rubric::Group;
+use crate::grade::rubric::Group;
+use crate::grade::rubric::credit::{ClassTally, Credit, credit};
 use crate::oracle::vectors::ShapeKind;
 
 pub(crate) fn code_check(group: &Group, outcome: &CodeOutcome) -> Vec<CheckResult> {

@@ -16,8 +16,8 @@ use crate::candidate::process::render_request::{RenderJob, RenderOutcome, render
 use crate::candidate::{
     CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
 };
-use crate::grade::credit;
-use crate::grade::inputs::{CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts};
+use crate::grade::checkers::{CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts};
+use crate::grade::rubric::credit;
 use crate::grade::rubric::sha256_hex;
 use crate::oracle::default_suite;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
@@ -159,8 +159,8 @@ impl CodeChecker for CourseCodeChecker {
     fn render(
         &self,
         submission: &Path,
-        jobs: &[crate::grade::inputs::RenderJob],
-    ) -> Vec<crate::grade::inputs::RenderOutcome> {
+        jobs: &[crate::grade::checkers::RenderJob],
+    ) -> Vec<crate::grade::checkers::RenderOutcome> {
         course_render(self, submission, jobs)
     }
 
@@ -169,7 +169,7 @@ impl CodeChecker for CourseCodeChecker {
         submission: &Path,
         week: crate::functions::Week,
         options: crate::functions::FunctionOptions,
-    ) -> crate::grade::inputs::FunctionsOutcome {
+    ) -> crate::grade::checkers::FunctionsOutcome {
         course_functions(self, submission, week, options)
     }
 
@@ -548,8 +548,8 @@ fn course_functions(
     submission: &Path,
     week: crate::functions::Week,
     options: crate::functions::FunctionOptions,
-) -> crate::grade::inputs::FunctionsOutcome {
-    use crate::grade::inputs::FunctionsOutcome;
+) -> crate::grade::checkers::FunctionsOutcome {
+    use crate::grade::checkers::FunctionsOutcome;
     let fatal = |msg: String| FunctionsOutcome {
         fatal: Some(msg),
         ..FunctionsOutcome::default()

@@ -77,7 +77,7 @@ fn with_pixels_changed(image: &Rgb8Image, k: usize, salt: u64) -> Rgb8Image {
     out
 }
 
-/// The figures `docs/grading.md` states ("Copies"): `cargo test --lib grade::copies::tests --
+/// The figures `docs/grading.md` states ("Copies"): `cargo test --lib grade::checkers::copies::tests --
 /// --nocapture`. 21 independent renders of each course scene (seeds 1 to 21, 96 pixels wide,
 /// the scene's 20 samples per pixel) make 210 pairs each; none may share its noise, and every
 /// copy of each render (as it is, re-encoded, with 1, 3 or 10 pixels changed) must.

@@ -335,7 +335,7 @@ impl Rules<'_> {
 }
 
 /// Prints the table `docs/grading.md` quotes ("How a code group is scored"):
-/// `cargo test --lib grade::credit::tests::measure -- --nocapture`.
+/// `cargo test --lib grade::rubric::credit::tests::measure -- --nocapture`.
 #[test]
 fn measure_the_candidate_rules_on_the_catalogued_mistakes() {
     let suite = default_suite(0);

@@ -6,12 +6,21 @@
 //! ([`CompareImageChecker`](super::CompareImageChecker)) and the fakes of the tests implement
 //! them.
 
+pub mod code;
+pub mod copies;
+#[cfg(test)]
+pub(crate) mod fakes;
+pub(crate) mod functions;
+pub mod images;
+pub mod noise_floor;
+pub mod rendered;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::credit::ClassTally;
+use super::rubric::credit::ClassTally;
 use crate::oracle::vectors::ShapeKind;
 use crate::scene::SceneDescription;
 
@@ -32,7 +41,7 @@ pub trait CodeChecker: Sync {
     fn vectors_sha256(&self) -> String;
 
     /// Renders each job's scene with the submission's own code (the image groups rendered by
-    /// the grader, [`render`](super::render)), one outcome per job, in order. Never panics:
+    /// the grader, [`render`](super::checkers::rendered)), one outcome per job, in order. Never panics:
     /// whatever the code does is an outcome. The default declines every job (a checker that
     /// cannot run the submission's renderer).
     fn render(&self, submission: &Path, jobs: &[RenderJob]) -> Vec<RenderOutcome> {
@@ -189,7 +198,7 @@ pub struct GroupCounts {
     #[serde(default)]
     pub watertight_cracked: usize,
     /// The definite vectors by what they expect and how they were answered: what the scoring
-    /// rule ([`credit`](super::credit)) reads. `report.json` shows it in the check's `credit`.
+    /// rule ([`credit`](super::rubric::credit)) reads. `report.json` shows it in the check's `credit`.
     /// A checker that leaves it empty is scored as if every vector hit (in proportion to the
     /// vectors passed).
     #[serde(default, skip_serializing)]

@@ -1,12 +1,12 @@
 //! A batch's submissions compared with each other: the pairs whose images of one group share
-//! their Monte Carlo noise ([`copies::shared_noise`](super::copies::shared_noise)) are flagged for
+//! their Monte Carlo noise ([`copies::shared_noise`](crate::grade::checkers::copies::shared_noise)) are flagged for
 //! review in both reports and in the batch's summary.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use super::copies::{CopyFinding, Fingerprint, NoiseMatch, shared_noise};
-use super::result::GradeReport;
+use crate::grade::checkers::copies::{CopyFinding, Fingerprint, NoiseMatch, shared_noise};
+use crate::grade::result::GradeReport;
 
 /// Two submissions of a batch whose images of one group share their noise.
 #[derive(Clone, Debug, PartialEq)]

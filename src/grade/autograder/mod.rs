@@ -24,6 +24,8 @@
 //! `x86_64-unknown-linux-gnu` (or `-musl`) against a glibc no newer than the image's; the package
 //! refuses any other kind of executable.
 
+pub mod pack;
+
 use std::io::Write;
 use std::path::Path;
 
@@ -220,7 +222,7 @@ pub fn build_package(
 }
 
 /// [`build_package`] with `extra` files (path in the package, bytes) after the others: the
-/// rubric's scene files and goldens ([`super::pack::pack_rubric`]).
+/// rubric's scene files and goldens ([`super::autograder::pack::pack_rubric`]).
 pub fn build_package_with(
     binary: &Path,
     rubric_toml: &str,

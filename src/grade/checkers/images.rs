@@ -14,7 +14,7 @@
 //!
 //! The grader's own renders (a render group's scene and its variant) are judged as renders of
 //! exactly their spp: besides `compare`'s verdict, one too clean for its spp fails
-//! ([`crate::grade::noise_floor`], reported as `metrics.noise_floor`). A variant's reference is
+//! ([`crate::grade::checkers::noise_floor`], reported as `metrics.noise_floor`). A variant's reference is
 //! rendered on the spot at `max(`[`VARIANT_REFERENCE_SPP`]`, 100 N)` samples per pixel, with its
 //! variance, once per variant and checker (a batch asks every submission the same variant).
 
@@ -22,14 +22,14 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use super::inputs::{
-    ImageChecker, ImageOutcome, ImageVerdict, RenderedImage, SceneFile, SceneSource,
-};
 use crate::compare::{
     CandidateImage, CompareError, CompareOptions, Golden, check_size, compare_image, write_heatmap,
 };
 use crate::golden::{FoundGolden, GoldenScene, golden_of, golden_spp, sha256_hex};
-use crate::grade::noise_floor::too_clean;
+use crate::grade::checkers::noise_floor::too_clean;
+use crate::grade::checkers::{
+    ImageChecker, ImageOutcome, ImageVerdict, RenderedImage, SceneFile, SceneSource,
+};
 use crate::image_io::decode_exr;
 use crate::scene::SceneDescription;
 
@@ -175,7 +175,7 @@ impl CompareImageChecker {
 impl CompareImageChecker {
     /// Compares `candidate` (named `name` in messages), a render of `spp` samples per pixel, with
     /// the golden of `scene`: the verdict, the metrics, the diagnosis and the heatmap; with
-    /// `floor`, a candidate too clean for `spp` fails ([`crate::grade::noise_floor`]).
+    /// `floor`, a candidate too clean for `spp` fails ([`crate::grade::checkers::noise_floor`]).
     fn judge(
         &self,
         candidate: &CandidateImage,

@@ -23,7 +23,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
-use super::rubric::SceneSource;
+use crate::grade::rubric::SceneSource;
 use crate::image_io::Rgb8Image;
 
 /// How many codes (of 255) two pixel values may differ by and still count as the same value.
