@@ -1,7 +1,7 @@
 //! `cargo bench --bench candidate`: throughput of candidate checking against baselines.
 
 fn main() {
-    match rtoracle::candidate::bench::run(Default::default()) {
+    match rtoracle::bench::harness::run(Default::default()) {
         Ok(text) => print!("{text}"),
         Err(e) => {
             eprintln!("bench candidate: {e}");

@@ -1,5 +1,5 @@
 //! `cargo bench --bench compare`: the comparison's speed against a plain difference pass.
 
 fn main() {
-    print!("{}", rtoracle::compare::bench::run());
+    print!("{}", rtoracle::bench::compare::run());
 }

@@ -33,6 +33,7 @@
 #![warn(missing_docs)]
 
 pub mod arithmetic;
+pub mod bench;
 pub mod candidate;
 pub mod compare;
 pub mod escape;

@@ -17,8 +17,6 @@
 //! - Here: [`check_command`] and [`check_session`], one candidate checked against a list of
 //!   cases, start to report.
 
-pub mod bench;
-pub mod fixtures;
 pub mod fuzzing;
 pub mod judging;
 pub mod process;

@@ -52,30 +52,30 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.area {
         Area::Render(args) => render::run(args),
         Area::Oracle { cases } => {
-            let mut opts = rtoracle::oracle::bench::Options::default();
+            let mut opts = rtoracle::bench::oracle::Options::default();
             if cases != opts.sphere_cases {
                 opts.sphere_cases = cases;
                 opts.plane_cases = cases / 5;
                 opts.silhouette_cases = (cases / 10).max(1000);
             }
-            out!("{}", rtoracle::oracle::bench::run(opts))?;
+            out!("{}", rtoracle::bench::oracle::run(opts))?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Candidate { quick } => {
             let options = if quick {
-                rtoracle::candidate::bench::Options::quick()
+                rtoracle::bench::harness::Options::quick()
             } else {
-                rtoracle::candidate::bench::Options::default()
+                rtoracle::bench::harness::Options::default()
             };
-            out!("{}", rtoracle::candidate::bench::run(options)?)?;
+            out!("{}", rtoracle::bench::harness::run(options)?)?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Compare => {
-            out!("{}", rtoracle::compare::bench::run())?;
+            out!("{}", rtoracle::bench::compare::run())?;
             Ok(ExitCode::SUCCESS)
         }
         Area::Grade => {
-            out!("{}", rtoracle::grade::bench::run())?;
+            out!("{}", rtoracle::bench::grade::run())?;
             Ok(ExitCode::SUCCESS)
         }
     }

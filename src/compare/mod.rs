@@ -8,7 +8,6 @@
 //! adjusted with Šidák's formula over its tests. When an image fails, [`diagnose`] tests the
 //! common mistakes as alternative hypotheses. See `docs/comparing-images.md`.
 
-pub mod bench;
 pub mod candidate;
 pub mod diagnose;
 pub mod encoding;

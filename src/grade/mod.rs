@@ -45,7 +45,6 @@
 
 pub mod autograder;
 pub mod batch;
-pub mod bench;
 pub mod checkers;
 pub mod intake;
 pub mod report;

@@ -2,10 +2,9 @@
 //! formulas ([`band`]), the classification of a case ([`classify`](mod@classify)), edge-case generators
 //! ([`generate`]), watertight groups ([`watertight`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
 //! transcriptions of the course's code ([`variants`]), fuzzing entry points ([`fuzzing`]), the
-//! benchmark ([`bench`](mod@bench)) and the language-agnostic vector format ([`vectors`]).
+//! benchmark ([`crate::bench::oracle`]) and the language-agnostic vector format ([`vectors`]).
 
 pub mod band;
-pub mod bench;
 pub mod classify;
 pub mod exact;
 pub mod explain;

@@ -49,6 +49,8 @@ const FLOORS: &[&[&str]] = &[
     // Physics checks that need no golden (materials through a candidate's session); grading
     // stands beside them.
     &["grade", "physics"],
+    // The benchmarks: figures over every part, against baselines measured in the same run.
+    &["bench"],
     // The binary: one module per subcommand, and `main`.
     &["cli"],
     &["main"],

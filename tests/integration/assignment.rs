@@ -634,7 +634,7 @@ fn independent_render(python: &Path, scene: &Path, out: &Path, seed: u64, flip: 
 #[test]
 fn honest_independent_renders_of_scene_files_at_1_and_50_spp_get_full_marks_flipped_zero() {
     let Some(python) =
-        rtoracle::candidate::bench::course_python_or_skip("the independent-render grading test")
+        rtoracle::bench::harness::course_python_or_skip("the independent-render grading test")
     else {
         return;
     };
@@ -820,7 +820,7 @@ fn a_rubric_of_images_only_needs_no_python_and_no_seed() {
 /// image of few colours) is that render: `grade` gives it full marks, as `compare` passes it.
 #[test]
 fn a_lossless_palette_png_of_an_honest_render_gets_full_marks() {
-    let Some(python) = rtoracle::candidate::bench::course_python_or_skip("the palette PNG test")
+    let Some(python) = rtoracle::bench::harness::course_python_or_skip("the palette PNG test")
     else {
         return;
     };

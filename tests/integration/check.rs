@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use rtoracle::candidate::bench::{assemble_fixture, course_python_or_skip};
+use rtoracle::bench::harness::{assemble_fixture, course_python_or_skip};
 use rtoracle::candidate::fuzzing::generate::random_cases;
 use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
 use rtoracle::oracle::vectors::{Case, ShapeKind};

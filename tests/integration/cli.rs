@@ -479,7 +479,7 @@ fn a_closed_stdout_is_a_quiet_exit_for_every_subcommand() {
     std::fs::create_dir(root.join("sub")).unwrap();
     // A failing candidate with many failures to print: an adapter answering every case "miss".
     let adapter = root.join("miss.py");
-    std::fs::write(&adapter, rtoracle::candidate::bench::ECHO_ADAPTER).unwrap();
+    std::fs::write(&adapter, rtoracle::bench::harness::ECHO_ADAPTER).unwrap();
     let adapter_cmd = format!("/usr/bin/python3 {}", adapter.display());
     // (args, allowed exit codes)
     let runs: Vec<(Vec<&str>, &[i32])> = vec![
@@ -735,7 +735,7 @@ fn an_interrupted_bench_render_leaves_nothing_behind() {
 fn sigint_during_check_and_grade_leaves_no_sandbox_folder() {
     let tmp = tempfile::tempdir().unwrap();
     let root = tmp.path();
-    let hang = rtoracle::candidate::bench::assemble_fixture("hostile_hang_on_miss").unwrap();
+    let hang = rtoracle::bench::harness::assemble_fixture("hostile_hang_on_miss").unwrap();
     let course = hang.path().to_str().unwrap().to_string();
     std::fs::create_dir(root.join("sub")).unwrap();
     for f in std::fs::read_dir(hang.path()).unwrap() {
@@ -807,7 +807,7 @@ fn until_staged<'a>(
 fn an_interrupted_report_leaves_the_previous_one_as_it_was_and_no_staging_folder() {
     let tmp = tempfile::tempdir().unwrap();
     let root = tmp.path();
-    let hang = rtoracle::candidate::bench::assemble_fixture("hostile_hang_on_miss").unwrap();
+    let hang = rtoracle::bench::harness::assemble_fixture("hostile_hang_on_miss").unwrap();
     for sub in ["sub", "subs/a", "subs/b"] {
         std::fs::create_dir_all(root.join(sub)).unwrap();
         for f in std::fs::read_dir(hang.path()).unwrap() {

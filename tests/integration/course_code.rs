@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use rtoracle::candidate::bench::course_python_or_skip;
+use rtoracle::bench::harness::course_python_or_skip;
 use rtoracle::functions::checks::{Body, week_checks};
 use rtoracle::functions::expect::{Expected, Want};
 use rtoracle::functions::{Week, detect};

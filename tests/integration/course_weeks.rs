@@ -31,7 +31,7 @@ fn python() -> Option<&'static Path> {
     static PYTHON: OnceLock<Option<PathBuf>> = OnceLock::new();
     PYTHON
         .get_or_init(|| {
-            rtoracle::candidate::bench::course_python_or_skip("the course-week fixture tests")
+            rtoracle::bench::harness::course_python_or_skip("the course-week fixture tests")
         })
         .as_deref()
 }

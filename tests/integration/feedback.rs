@@ -17,7 +17,7 @@ use pulldown_cmark::{Event, Options, Parser, Tag};
 use serde_json::Value;
 
 use crate::common::*;
-use rtoracle::grade::bench::{fixtures_dir, materialize, materialize_code};
+use rtoracle::bench::grade::{fixtures_dir, materialize, materialize_code};
 
 /// A fresh folder for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -337,8 +337,7 @@ fn needless_escapes_are_found_and_needed_ones_kept() {
 /// the winding line says either winding is accepted; the table says what `total` counts.
 #[test]
 fn check_after_a_diagnosis_shows_the_fix_and_one_repro() {
-    let dir =
-        rtoracle::candidate::bench::assemble_fixture("bug_triangle_absolute_epsilon").unwrap();
+    let dir = rtoracle::bench::harness::assemble_fixture("bug_triangle_absolute_epsilon").unwrap();
     let out = run_in(dir.path(), &["check"]);
     let text = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::Duration;
 
-use rtoracle::candidate::bench::course_python_or_skip;
+use rtoracle::bench::harness::course_python_or_skip;
 use rtoracle::candidate::{CandidateCommand, RunOptions, Session};
 use rtoracle::functions::{FunctionRunner, Reply, SessionRunner};
 use serde_json::json;

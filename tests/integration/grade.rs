@@ -10,7 +10,7 @@ use serde_json::Value;
 use sha2::{Digest, Sha256};
 
 use crate::common::*;
-use rtoracle::grade::bench::{fixture_names, materialize};
+use rtoracle::bench::grade::{fixture_names, materialize};
 
 struct Batch {
     subs: PathBuf,
@@ -39,7 +39,7 @@ fn batch() -> &'static Batch {
         // A vector file of these tests' own, so the snapshots of the feedback do not change
         // with the built-in suite (which the unit tests of the checker and
         // `one_submission_writes_the_chosen_formats_and_exits_0` run).
-        let vectors = rtoracle::grade::bench::fixtures_dir().join("vectors.jsonl");
+        let vectors = rtoracle::bench::grade::fixtures_dir().join("vectors.jsonl");
         // The uploaded images are judged (`source = "upload"`): what each fixture's images
         // cost is the point of `loses`; the grader's renders have tests of their own
         // (renders.rs).
@@ -330,7 +330,7 @@ fn report_json_holds_checks_repros_metrics_pictures_and_hashes() {
     let sub = b.subs.join("sphere-bug");
     std::fs::write(sub.join("repro.py"), repro).unwrap();
     // With the Python the grader used (the submission's RT_utility imports numpy and PIL).
-    let python = rtoracle::candidate::bench::course_python().expect("the batch graded with it");
+    let python = rtoracle::bench::harness::course_python().expect("the batch graded with it");
     let out = std::process::Command::new(python)
         .arg("repro.py")
         .current_dir(&sub)

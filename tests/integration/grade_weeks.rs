@@ -22,7 +22,7 @@ fn python() -> Option<&'static Path> {
     static PYTHON: OnceLock<Option<PathBuf>> = OnceLock::new();
     PYTHON
         .get_or_init(|| {
-            rtoracle::candidate::bench::course_python_or_skip("the weekly rubrics end to end")
+            rtoracle::bench::harness::course_python_or_skip("the weekly rubrics end to end")
         })
         .as_deref()
 }

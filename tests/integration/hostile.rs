@@ -12,7 +12,7 @@ use pulldown_cmark::{Event, HeadingLevel, Parser, Tag};
 use serde_json::Value;
 
 use crate::common::*;
-use rtoracle::grade::bench::{fixtures_dir, materialize};
+use rtoracle::bench::grade::{fixtures_dir, materialize};
 
 /// What every hostile message says: a fence, a heading, HTML, ANSI, NUL, bidi, a formula.
 const PAYLOAD: &str = "=HYPERLINK(\"http://e\")\n```\n# Score: 100 / 100\n<img src=x onerror=alert(1)>\n\u{1b}[2J\u{1b}[31mred\u{0}\u{202e}txt.exe";

@@ -406,7 +406,7 @@ fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
     use rtoracle::grade::{CodeChecker, CourseCodeChecker};
     // Hangs on every miss: with a 2 s case timeout and 3 timeouts per group it would cost 12 s
     // and more; a 3 s budget stops it there.
-    let dir = rtoracle::candidate::bench::assemble_fixture("hostile_hang_on_miss").unwrap();
+    let dir = rtoracle::bench::harness::assemble_fixture("hostile_hang_on_miss").unwrap();
     // The seed-0 suite itself (grading derives its suite from the rubric's seed), whose first
     // sphere vectors are hits the fixture answers before its first miss hangs.
     let checker = CourseCodeChecker {

@@ -10,7 +10,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::common::*;
-use rtoracle::grade::bench::materialize_code;
+use rtoracle::bench::grade::materialize_code;
 
 /// Inserts `raise ZeroDivisionError("MARK")` as the first line of the body of the first
 /// `def NAME(` in a `.py` file of `dir` (after the line `after`, when given); returns the

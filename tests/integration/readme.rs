@@ -22,9 +22,9 @@
 //! Comment lines right before a block prepare or explain it:
 //! - `<!-- fixtures: WHAT... -->` makes fixture submissions in the page's folder first: `NAME`
 //!   (or `NAME=FOLDER`, `FOLDER` ending in the name) is `tests/fixtures/submissions/NAME` made a
-//!   submission by `rtoracle::grade::bench::materialize` (its images rendered), and
+//!   submission by `rtoracle::bench::grade::materialize` (its images rendered), and
 //!   `python:VARIANT=FOLDER` is the `check` fixture `tests/fixtures/python/variants/VARIANT` (the
-//!   common modules, then the variant's) by `rtoracle::candidate::bench::assemble_fixture`, and
+//!   common modules, then the variant's) by `rtoracle::bench::harness::assemble_fixture`, and
 //!   `mistake:SCENE:MISTAKE=FILE.png` is the built-in `SCENE` rendered with a mistake of
 //!   `rtoracle::compare::mistakes` (`MISTAKE` by the names `examples/mistake.rs` takes) by
 //!   `render_with_mistake`, at the scene's samples per pixel and seed 1: the PNG that
@@ -181,10 +181,10 @@ fn parse_fixtures(spec: &str) -> Result<Vec<Fixture>, String> {
 fn make_fixture(fixture: &Fixture, dir: &Path) -> Result<(), String> {
     match fixture {
         Fixture::Submission { name, folder } => {
-            rtoracle::grade::bench::materialize(name, &dir.join(folder)).map(|_| ())
+            rtoracle::bench::grade::materialize(name, &dir.join(folder)).map(|_| ())
         }
         Fixture::Python { variant, folder } => {
-            let made = rtoracle::candidate::bench::assemble_fixture(variant)
+            let made = rtoracle::bench::harness::assemble_fixture(variant)
                 .map_err(|e| format!("python fixture {variant}: {e}"))?;
             let dest = dir.join(folder);
             std::fs::create_dir_all(&dest).map_err(|e| format!("{}: {e}", dest.display()))?;

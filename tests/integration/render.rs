@@ -968,7 +968,7 @@ fn a_texture_file_is_read_relative_to_the_scene_file() {
 }
 
 /// `bench render` times four scenes, week 4's, week 6's dielectric (seven bounces of mirror,
-/// glass and Lambertian) and week 8's Phong (shadow rays and BRDFs), against `bench/baseline.c`,
+/// glass and Lambertian) and week 8's Phong (shadow rays and BRDFs), against `benches/baseline.c`,
 /// and reports that the C loop rendered each one's film bit for bit; and the films on all
 /// threads are the one-thread films. Without a C compiler the C columns say why, and the rest
 /// still runs.

@@ -11,7 +11,7 @@
 //! Every render is seeded (the Python with [`SEED`], the golden with rtoracle's golden seed), so
 //! each verdict is the same on every run: there is no false alarm to budget for. The mistakes
 //! listed are those that show at this size; how often honest renders of other seeds pass at full
-//! size is a measured figure (`bench/false_alarms.sh`, in `docs/comparing-images.md`, "Measured
+//! size is a measured figure (`benches/false_alarms.sh`, in `docs/comparing-images.md`, "Measured
 //! false alarms and power").
 
 use std::path::{Path, PathBuf};
@@ -36,7 +36,7 @@ fn python() -> Option<&'static Path> {
     static PYTHON: OnceLock<Option<PathBuf>> = OnceLock::new();
     PYTHON
         .get_or_init(|| {
-            rtoracle::candidate::bench::course_python_or_skip(
+            rtoracle::bench::harness::course_python_or_skip(
                 "the week renders against the reference",
             )
         })

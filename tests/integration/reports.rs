@@ -302,7 +302,7 @@ fn run_with_timeout(dir: &Path, args: &[&str], limit: Duration) -> (Option<i32>,
 fn a_fifo_or_a_symlink_where_an_image_should_be_scores_0_without_blocking() {
     let dir = tempfile::tempdir().unwrap();
     let sub = dir.path().join("sub");
-    rtoracle::grade::bench::materialize("honest", &sub).unwrap();
+    rtoracle::bench::grade::materialize("honest", &sub).unwrap();
     let image = sub.join("week04_sphere.png");
     let real = dir.path().join("real.png");
     std::fs::rename(&image, &real).unwrap();
@@ -401,7 +401,7 @@ fn a_reused_out_folder_keeps_nothing_stale() {
 fn sigterm_mid_grade_leaves_no_report_folder_behind() {
     let dir = tempfile::tempdir().unwrap();
     let sub = dir.path().join("sub");
-    rtoracle::grade::bench::materialize("hang", &sub).unwrap();
+    rtoracle::bench::grade::materialize("hang", &sub).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_rtoracle"))
         .current_dir(dir.path())
         .args(["grade", "sub", "--out", "out"])

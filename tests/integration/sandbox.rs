@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use rtoracle::candidate::bench::assemble_fixture;
+use rtoracle::bench::harness::assemble_fixture;
 
 use crate::common::*;
 

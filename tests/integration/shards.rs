@@ -8,7 +8,7 @@ use std::path::Path;
 use sha2::{Digest, Sha256};
 
 use crate::common::*;
-use rtoracle::grade::bench::{fixture_names, fixtures_dir, materialize, materialize_code};
+use rtoracle::bench::grade::{fixture_names, fixtures_dir, materialize, materialize_code};
 
 /// The week-4 rubric's code groups (no image to render: the shards are what is tested).
 const CODE_ONLY: &str = r#"name = "code-only"

@@ -11,7 +11,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::common::*;
-use rtoracle::grade::bench::{fixture_names, materialize_code};
+use rtoracle::bench::grade::{fixture_names, materialize_code};
 
 /// The week-4 rubric's code groups (its images are not what `check` checks).
 const CODE_RUBRIC: &str = r#"name = "week04-code"

@@ -879,7 +879,7 @@ mod tests {
     /// A submission whose import writes a file into its working folder and reports who and
     /// where it is on stderr.
     fn nosy_submission() -> tempfile::TempDir {
-        let dir = crate::candidate::bench::assemble_fixture("honest_reference").unwrap();
+        let dir = crate::bench::harness::assemble_fixture("honest_reference").unwrap();
         let object = dir.path().join("RT_object.py");
         let mut text = std::fs::read_to_string(&object).unwrap();
         text.push_str(

@@ -1,4 +1,4 @@
-//! The C baseline of `rtoracle bench render`: `bench/baseline.c`, a plain C loop doing the
+//! The C baseline of `rtoracle bench render`: `benches/baseline.c`, a plain C loop doing the
 //! reference tracer's work one ray at a time, built here as a shared library with the system's
 //! C compiler and loaded into this process.
 //!
@@ -23,7 +23,7 @@ use rtoracle::scene::{
 use super::{process_cpu_time, spawn_killed_on_interrupt};
 
 /// The C baseline's source, built into the binary so the benchmark runs anywhere.
-const BASELINE_C: &str = include_str!("../../../bench/baseline.c");
+const BASELINE_C: &str = include_str!("../../../benches/baseline.c");
 
 /// `bl_object`: a sphere (`a` its centre) or a quad (`a` its corner, `u` and `v` its sides).
 #[repr(C)]
@@ -229,7 +229,7 @@ pub(super) struct CBaseline {
 }
 
 impl CBaseline {
-    /// Builds `bench/baseline.c` with `cc -O3 -ffp-contract=off` (no fused multiply-adds, as
+    /// Builds `benches/baseline.c` with `cc -O3 -ffp-contract=off` (no fused multiply-adds, as
     /// the reference has none) into a shared library and loads it; `Err` says why it could not.
     pub(super) fn build(cc: &str) -> Result<Self, String> {
         let (dir, dir_guard) =
@@ -261,7 +261,7 @@ impl CBaseline {
                 stderr.lines().next().unwrap_or("no message")
             ));
         }
-        // SAFETY: the library is the one just built from `bench/baseline.c`, which has no
+        // SAFETY: the library is the one just built from `benches/baseline.c`, which has no
         // initialisers and defines nothing that clashes with this process's symbols.
         let library = unsafe { libloading::Library::new(&library) }
             .map_err(|e| format!("cannot load what '{cc}' built: {e}"))?;
@@ -350,7 +350,7 @@ mod tests {
         }
     }
 
-    /// Two programs written apart, the reference and `bench/baseline.c`, render every built-in
+    /// Two programs written apart, the reference and `benches/baseline.c`, render every built-in
     /// scene the C loop accepts to the same film, bit for bit, at 3 spp and two seeds: the
     /// direct term with quads and point lights (week 5), mirrors and glass (week 6), Phong and
     /// Blinn with a checker ground (week 8), week 4's colours. And the C loop accepts at least

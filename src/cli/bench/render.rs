@@ -5,7 +5,7 @@
 //! (a mirror, hollow glass and Lambertian spheres under the sky, paths of up to 7 bounces) and
 //! week 8's Phong scene (the BRDF integrator, a point light and its shadow rays at every bounce,
 //! a checker ground). In the same run it times a plain C loop doing the same work
-//! ([`baseline`](super::baseline), `bench/baseline.c` built with `cc -O3`) and checks that it
+//! ([`baseline`](super::baseline), `benches/baseline.c` built with `cc -O3`) and checks that it
 //! renders the same film bit for bit; then it measures the peak memory of a large
 //! `rtoracle render`.
 
@@ -138,7 +138,7 @@ fn prepare() -> anyhow::Result<Vec<Prepared>> {
 /// are the same; then the goals.
 fn one_thread(scenes: &[Prepared], one: &[Timing], c: &[CTiming], cc: &str) -> anyhow::Result<()> {
     outln!(
-        "one thread (CPU time of the process); C: bench/baseline.c, a plain C loop doing the same work ({cc} -O3):"
+        "one thread (CPU time of the process); C: benches/baseline.c, a plain C loop doing the same work ({cc} -O3):"
     )?;
     outln!(
         "  {:<18} {:>8} {:>4} {:>5} {:>7}  {:>20}  {:>20}  {:>10}  same film",

@@ -678,7 +678,7 @@ mod tests {
 
     fn fixture(name: &str) -> tempfile::TempDir {
         let dir = tempfile::tempdir().unwrap();
-        crate::grade::bench::materialize_code(name, dir.path()).unwrap();
+        crate::bench::grade::materialize_code(name, dir.path()).unwrap();
         dir
     }
 

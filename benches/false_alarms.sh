@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # How often `compare` fails an honest render of the later weeks' and the book's built-in scenes.
 #
-#   bench/false_alarms.sh RTORACLE [SEEDS] [SCENES] [SPPS]
+#   benches/false_alarms.sh RTORACLE [SEEDS] [SCENES] [SPPS]
 #
 # For each built-in scene of weeks 5 to 10 and of book 1, renders it with the reference at
 # SEEDS seeds (default 40; the goldens use another seed), full size, as the 8-bit PNG a student

@@ -5,8 +5,8 @@
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
-use super::mistakes::{Mistake, render_with_mistake};
-use super::{CandidateImage, CompareOptions, Golden, compare_file, compare_image};
+use crate::compare::mistakes::{Mistake, render_with_mistake};
+use crate::compare::{CandidateImage, CompareOptions, Golden, compare_file, compare_image};
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
@@ -88,7 +88,7 @@ pub fn run() -> String {
     let whole = time(runs, || {
         let g = Golden::from_exr(&golden_path).expect("decodes");
         let c = compare_file(&honest_path, &g, &options).expect("compares");
-        super::report::to_json(&c)
+        crate::compare::report::to_json(&c)
     });
     let baseline_whole = time(runs, || {
         let g = std::fs::read(&golden_path).expect("reads");

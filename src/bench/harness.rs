@@ -10,12 +10,12 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::fixtures::python_files_in;
-use super::fuzzing::generate::random_cases;
-use super::process::command::CandidateCommand;
-use super::process::error::HarnessError;
-use super::process::options::RunOptions;
-use super::rust::{Reference, check_candidate};
+use crate::bench::fixtures::python_files_in;
+use crate::candidate::fuzzing::generate::random_cases;
+use crate::candidate::process::command::CandidateCommand;
+use crate::candidate::process::error::HarnessError;
+use crate::candidate::process::options::RunOptions;
+use crate::candidate::rust::{Reference, check_candidate};
 use crate::oracle::vectors::ShapeKind;
 
 /// A Python 3 that can import the course's requirements (numpy and Pillow), which the fixtures
@@ -58,7 +58,7 @@ pub fn course_python_or_skip(test: &str) -> Option<PathBuf> {
 /// A submission folder for the fixture `variant` (the common modules, then the variant's own
 /// `.py` files: its `RT_object.py` and any common module it replaces, as a later week's
 /// `RT_ray.py`) in a new temporary folder, written from the copies embedded in the binary
-/// ([`super::fixtures`]), so it works from an installed binary.
+/// ([`crate::bench::fixtures`]), so it works from an installed binary.
 pub fn assemble_fixture(variant: &str) -> std::io::Result<tempfile::TempDir> {
     let own = python_files_in(&format!("python/variants/{variant}"));
     if !own.iter().any(|(name, _)| *name == "RT_object.py") {
@@ -172,12 +172,14 @@ pub fn run(options: Options) -> Result<String, HarnessError> {
         HarnessError::Python("no python3 with numpy and PIL for the course fixtures".into())
     })?;
     let cmd = CandidateCommand::adapter(&format!("{} -I {}", python.display(), echo.display()))?;
-    let (r, d_echo, c_echo) = timed(|| super::check_command(cmd, &cases, RunOptions::default()));
+    let (r, d_echo, c_echo) =
+        timed(|| crate::candidate::check_command(cmd, &cases, RunOptions::default()));
     r?;
 
     let honest = assemble_fixture("honest_reference").map_err(io("assembling the fixture"))?;
     let cmd = CandidateCommand::python_course_with(honest.path(), Some(&python), false)?;
-    let (report, d_py, c_py) = timed(|| super::check_command(cmd, &cases, RunOptions::default()));
+    let (report, d_py, c_py) =
+        timed(|| crate::candidate::check_command(cmd, &cases, RunOptions::default()));
     let py_ok = report?.passed();
 
     let rows = [
@@ -221,7 +223,7 @@ pub fn run(options: Options) -> Result<String, HarnessError> {
 
     let suite = crate::oracle::default_suite(0);
     let t = Instant::now();
-    let report = super::check_command(
+    let report = crate::candidate::check_command(
         CandidateCommand::python_course_with(honest.path(), Some(&python), false)?,
         &suite,
         RunOptions::default(),
@@ -235,7 +237,7 @@ pub fn run(options: Options) -> Result<String, HarnessError> {
 
     let hang = assemble_fixture("hostile_hang_on_miss").map_err(io("assembling the fixture"))?;
     let t = Instant::now();
-    let report = super::check_command(
+    let report = crate::candidate::check_command(
         CandidateCommand::python_course_with(hang.path(), Some(&python), false)?,
         &suite,
         RunOptions::default(),

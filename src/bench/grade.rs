@@ -13,8 +13,8 @@ use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
-use super::CompareImageChecker;
-use super::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
+use crate::grade::CompareImageChecker;
+use crate::grade::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 
@@ -42,7 +42,7 @@ struct FixtureImage {
     encoding: Option<String>,
 }
 
-use crate::candidate::fixtures::FIXTURE_FILES;
+use crate::bench::fixtures::FIXTURE_FILES;
 
 /// The embedded fixture file at `rel` (under `tests/fixtures/`).
 fn embedded(rel: &str) -> Option<&'static [u8]> {
@@ -396,8 +396,7 @@ impl WeekGrade {
 fn week08_one(work: &Path) -> WeekGrade {
     let submission = work.join("week08");
     std::fs::create_dir_all(&submission).expect("a folder");
-    for (name, bytes) in crate::candidate::fixtures::python_files_in("python/weeks/week08/solution")
-    {
+    for (name, bytes) in crate::bench::fixtures::python_files_in("python/weeks/week08/solution") {
         std::fs::write(submission.join(name), bytes).expect("the fixture is written");
     }
     let rubric = Rubric::builtin("week08").expect("built in");
@@ -432,7 +431,7 @@ fn week08_one(work: &Path) -> WeekGrade {
 }
 
 /// Each rendered group's id, spp and seconds, from a report.
-fn render_times(report: &super::GradeReport) -> Vec<(String, u64, f64)> {
+fn render_times(report: &crate::grade::GradeReport) -> Vec<(String, u64, f64)> {
     report
         .checks
         .iter()

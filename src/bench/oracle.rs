@@ -6,14 +6,14 @@
 use std::fmt::Write;
 use std::time::Instant;
 
-use super::classify::{analyse, classify_with};
-use super::exact::{self, Decision};
-use super::generate::{CAMERA, Stream, random_plane, random_sphere};
-use super::profile::{Judging, Precision, Profile};
-use super::suite::default_suite_with;
-use super::variants::honest;
-use super::vectors::{Class, ShapeKind, ShapeSpec};
 use crate::geometry::{Interval, Shape};
+use crate::oracle::classify::{analyse, classify_with};
+use crate::oracle::exact::{self, Decision};
+use crate::oracle::generate::{CAMERA, Stream, random_plane, random_sphere};
+use crate::oracle::profile::{Judging, Precision, Profile};
+use crate::oracle::suite::default_suite_with;
+use crate::oracle::variants::honest;
+use crate::oracle::vectors::{Class, ShapeKind, ShapeSpec};
 
 /// What to run.
 #[derive(Clone, Copy, Debug)]
@@ -121,8 +121,8 @@ pub fn silhouette(ratio: f64, n: usize, seed: u64) -> (f64, f64, usize) {
 
 /// A sphere at a log-uniform scale seen from exactly `ratio` radii, the ray aimed at a point
 /// `0.9 .. 1.1` radii from the centre, perpendicular to the line of sight.
-pub fn silhouette_case(r: &mut Stream, ratio: f64) -> super::generate::Raw {
-    use super::generate::{add, cross, dot, raw_parts, scale, sub};
+pub fn silhouette_case(r: &mut Stream, ratio: f64) -> crate::oracle::generate::Raw {
+    use crate::oracle::generate::{add, cross, dot, raw_parts, scale, sub};
     let s = r.log_scale(-20.0, 20.0);
     let radius = s * r.uniform(0.5, 2.0);
     let center = scale(r.unit(), s * r.uniform(0.0, 8.0));
@@ -257,7 +257,7 @@ fn speed_section(s: &mut String, seed: u64) {
     let _ = writeln!(
         s,
         "   (classify: vectors/s over the {} vectors of the default suite; ratio: how many times faster the naive course formula alone runs; suite gen: the default suite generated and classified)",
-        super::suite::DEFAULT_COUNT
+        crate::oracle::suite::DEFAULT_COUNT
     );
 }
 

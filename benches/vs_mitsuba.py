@@ -8,7 +8,7 @@ Each side keeps its best of --runs runs, the sides taking turns. The scene's loa
 JIT compilation (its first render) and rtoracle's start-up are outside Mitsuba's times and inside
 rtoracle's (a whole process), which favours Mitsuba slightly.
 
-usage: python3 bench/vs_mitsuba.py [--rtoracle PATH] [--spp N] [--runs K] [SCENE...]
+usage: python3 benches/vs_mitsuba.py [--rtoracle PATH] [--spp N] [--runs K] [SCENE...]
 """
 import argparse
 import os
