@@ -3,6 +3,8 @@
 //! 130 / 143 interrupted by SIGINT / SIGTERM (after removing what was half-written). A closed
 //! stdout or stderr never makes it panic (see `cli::out`).
 
+#![deny(clippy::undocumented_unsafe_blocks)]
+
 #[macro_use]
 mod cli;
 

@@ -101,6 +101,7 @@ fn cpu_seconds() -> [f64; 2] {
     {
         // SAFETY: getrusage fills the struct it is given.
         let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: `u` is a live rusage for getrusage to fill.
         if unsafe { libc::getrusage(who, &mut u) } == 0 {
             for t in [u.ru_utime, u.ru_stime] {
                 total[k] += t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;

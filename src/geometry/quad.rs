@@ -58,8 +58,8 @@ impl Quad {
     /// The course's decision given `offset = self.plane_offset(ray.origin)`. [`Shape::hit_t`] and
     /// the fast path both call it, so they agree bit for bit. The fast path's ray packets repeat
     /// these operations lane by lane, without branches (`quad_hit_lanes` in
-    /// `render::fixed_origin`), and so do the four-ray queries of the later weeks' lanes of paths
-    /// (`quad_lanes` in `scene::shape_lanes`): a change here must be made in both, which the
+    /// `render::fast::fixed_origin`), and so do the four-ray queries of the later weeks' lanes of paths
+    /// (`quad_lanes` in `scene::accel::shape_lanes`): a change here must be made in both, which the
     /// renderer's and the lanes' bit-for-bit tests check.
     #[inline(always)]
     // `!(x >= y)` is meant: it is true for NaN too.

@@ -105,9 +105,9 @@ impl Sphere {
 /// underflowed (then [`Sphere::roots`] rescales). [`Sphere::roots`] and the renderer's
 /// fixed-origin fast path (which computes `f`, `r2` and `c` once per render) both call it, so
 /// they agree bit for bit. The fast path's ray packets repeat these operations lane by lane,
-/// without branches (`PreparedSphere::hit_lanes` in `render::fixed_origin`), and so do the
+/// without branches (`PreparedSphere::hit_lanes` in `render::fast::fixed_origin`), and so do the
 /// four-ray queries of the later weeks' lanes of paths (`ball_lanes` and `roots_lanes` in
-/// `scene::shape_lanes`): a change here must be made in both, which the renderer's and the
+/// `scene::accel::shape_lanes`): a change here must be made in both, which the renderer's and the
 /// lanes' bit-for-bit tests check.
 #[inline(always)]
 #[allow(clippy::result_unit_err)]
@@ -174,7 +174,7 @@ impl MovingSphere {
     }
 
     /// Where the sphere is at `time`: centre `center + (end - center) * time`. The lanes of
-    /// paths (`scene::shape_lanes`, and `scene::shape_set`'s scalar loop) compute the same
+    /// paths (`scene::accel::shape_lanes`, and `scene::accel::shape_set`'s scalar loop) compute the same
     /// centre from a precomputed `end - center`: a change here must be made there too.
     #[inline]
     pub fn at(&self, time: f64) -> Sphere {

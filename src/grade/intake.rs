@@ -354,6 +354,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let d = dir.path();
         let fifo = std::ffi::CString::new(d.join("week04_sphere.png").to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path that lives across the call.
         assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o644) }, 0);
         std::fs::write(d.join("real.png"), b"x").unwrap();
         std::os::unix::fs::symlink(d.join("real.png"), d.join("link.png")).unwrap();
@@ -374,6 +375,7 @@ mod tests {
         assert_eq!(err("none.png"), "none.png is missing from the submission");
         // A device, where root can make one (a copy of /dev/null's numbers).
         let dev = std::ffi::CString::new(d.join("dev.png").to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path that lives across the call.
         if unsafe { libc::mknod(dev.as_ptr(), libc::S_IFCHR | 0o644, libc::makedev(1, 3)) } == 0 {
             assert_eq!(
                 err("dev.png"),

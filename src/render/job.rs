@@ -37,8 +37,8 @@ fn strata(n: u32) -> (u32, u32) {
 }
 
 /// How a renderer draws the rows of a [`Job`]: the general path (one ray at a time through the
-/// scene, or four paths at a time in a small scene of spheres and quads, `render::lanes`), or the
-/// pinhole fast path (`render::pinhole`), each giving the same film bit for bit.
+/// scene, or four paths at a time in a small scene of spheres and quads, `render::fast::lanes`), or the
+/// pinhole fast path (`render::fast::pinhole`), each giving the same film bit for bit.
 pub(super) trait Trace: Sync + Sized {
     /// Renders row `j` of `job` into `means` (and `variances` when `VARIANCE`) with the jitter
     /// `JITTER` (0 uniform, 1 stratified, 2 centre, 3 the course's jittered sampling).

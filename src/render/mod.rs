@@ -1,17 +1,22 @@
 //! The renderer: a seeded random stream per pixel, the integrators of the course's weeks 4 to 10
 //! and of *Ray Tracing in One Weekend*, and rows rendered in parallel into a film whose bytes do
 //! not depend on the number of threads.
+//!
+//! The reference is the files here, readable on their own: [`trace`] and [`radiance`] follow a
+//! ray through the scene's objects one by one (`integrator.rs`), the materials scatter
+//! (`scatter.rs`, `optics.rs`, `brdf.rs`), a pixel's samples come from its own seeded stream
+//! (`sampler.rs`, `job.rs`) and [`render`] fills a film row by row (`renderer.rs`, `film.rs`).
+//! The fast paths are in `fast/`, each giving the same bytes as the reference (the tests compare
+//! them bit for bit): primary rays of a pinhole camera in packets, rays from one origin against
+//! prepared shapes (`fast/fixed_origin/`), and, on x86_64, four rays at once in AVX2
+//! (`fast/lanes.rs`, the one place the processor is chosen).
 
 mod brdf;
+mod fast;
 mod film;
-mod fixed_origin;
 mod integrator;
 mod job;
-#[cfg(target_arch = "x86_64")]
-mod lanes;
 mod optics;
-mod packet;
-mod pinhole;
 mod renderer;
 mod sampler;
 mod scatter;

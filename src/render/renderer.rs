@@ -3,10 +3,10 @@ use std::io::IsTerminal;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::job::{Job, Moments, PixelJitter, Spread, Trace};
 #[cfg(target_arch = "x86_64")]
-use super::lanes;
-use super::pinhole::Pinhole;
+use super::fast::lanes;
+use super::fast::pinhole::Pinhole;
+use super::job::{Job, Moments, PixelJitter, Spread, Trace};
 use super::{Film, PixelSampler, trace};
 use crate::scene::{Background, Camera, Integrator, Material, PixelSampling, Profile, World};
 
@@ -56,7 +56,7 @@ pub enum RenderError {
 impl Trace for World {
     /// Each sample's ray ([`Job::sample_ray`]) through the world's integrator ([`trace`]), times
     /// the job's scale; in a small scene of spheres, moving spheres and quads, four paths at a
-    /// time ([`lanes::row`](super::lanes::row)), to the same film.
+    /// time ([`lanes::row`](super::fast::lanes::row)), to the same film.
     #[inline(always)]
     fn row<const VARIANCE: bool, const JITTER: u8>(
         job: &Job<'_, Self>,
@@ -240,8 +240,8 @@ pub fn render(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::fast::packet::WIDTH;
     use crate::render::job::film_bits_with;
-    use crate::render::packet::WIDTH;
 
     /// The book's final scene (about 490 spheres) renders through the hierarchy to the very film
     /// the linear scan gives, variance included.
@@ -329,6 +329,7 @@ mod tests {
                     #[cfg(target_arch = "x86_64")]
                     if std::arch::is_x86_feature_detected!("avx2") {
                         assert_eq!(
+                            // SAFETY: AVX2 was detected just above.
                             film_bits_with(&fast, |job, j, m, v| unsafe {
                                 job.row_avx2::<true>(j, m, v)
                             }),

@@ -6,8 +6,8 @@
 //! materials and objects; [`SceneDescription::scene`] turns it into a [`World`].
 //! [`to_mitsuba_xml`] writes one for Mitsuba 3 where the two renderers share the physics.
 
+mod accel;
 mod builtin;
-mod bvh;
 mod camera;
 mod description;
 mod error;
@@ -17,17 +17,21 @@ mod mitsuba;
 mod object;
 mod profile;
 mod settings;
-mod shape_lanes;
-mod shape_set;
 mod texture;
 mod validate;
 mod world;
 
+pub use accel::bvh::BVH_MIN_OBJECTS;
+#[cfg(test)]
+pub(crate) use accel::shape_lanes::skipped_without_lanes;
+pub(crate) use accel::shape_lanes::{LANES, RayLanes, has_lanes};
+#[cfg(target_arch = "x86_64")]
+pub(crate) use accel::shape_lanes::{between as lanes_between, splat as lanes_splat};
+pub(crate) use accel::shape_set::ShapeSet;
 pub use builtin::{
     BUILTIN_SCENES, BuiltinScene, TextureSource, builtin, builtin_names, builtin_with_textures,
     rtiow_final_scene,
 };
-pub use bvh::BVH_MIN_OBJECTS;
 pub use camera::{Camera, CameraSettings};
 pub use description::{
     ImageSettings, MaterialEntry, MaterialKind, ObjectEntry, SceneDescription, TextureEntry,
@@ -42,12 +46,6 @@ pub use settings::{
     Background, COURSE_BACKGROUND, DEFAULT_MAX_DEPTH, DiffuseSampling, DirectTerm, Integrator,
     PixelSampling, RenderSettings,
 };
-#[cfg(test)]
-pub(crate) use shape_lanes::skipped_without_lanes;
-pub(crate) use shape_lanes::{LANES, RayLanes, has_lanes};
-#[cfg(target_arch = "x86_64")]
-pub(crate) use shape_lanes::{between as lanes_between, splat as lanes_splat};
-pub(crate) use shape_set::ShapeSet;
 pub use texture::{
     GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,
 };

@@ -5,8 +5,8 @@
 
 use glam::DVec3;
 
-use super::bvh::{BVH_MIN_OBJECTS, Bvh};
-use super::shape_set::ShapeSet;
+use super::accel::bvh::{BVH_MIN_OBJECTS, Bvh};
+use super::accel::shape_set::ShapeSet;
 use super::{Material, Object, Profile, RenderSettings, Scene, TextureImage};
 use crate::geometry::{Interval, Ray};
 

@@ -169,6 +169,108 @@ fn the_exceptions_are_still_needed() {
     assert!(stale.is_empty(), "{}", stale.join("\n"));
 }
 
+/// The most `.rs` files a folder of `src/` holds directly (its sub-folders count as one each):
+/// past about a dozen, a folder is split into rooms along the groups its `mod.rs` names.
+const MAX_FOLDER_ENTRIES: usize = 13;
+
+/// Folders not yet split into rooms, with what they hold now: each goes when its split lands
+/// (the test fails when an entry is no longer needed, so the list only shrinks).
+const FOLDERS_BEING_SPLIT: &[(&str, &str)] = &[
+    (
+        "src/sandbox",
+        "the sandbox: start, view, limits, watchdogs, identity, reaper",
+    ),
+    ("src/cli", "the binary: one file per subcommand"),
+    (
+        "src/functions",
+        "the weekly checks: run, runner, report, stats, samplers, week",
+    ),
+    (
+        "src/compare",
+        "the comparison: verdict, stats, diagnosis, reports, FLIP, two-sample",
+    ),
+    (
+        "src/scene",
+        "scenes: materials, textures, objects, camera, files, world",
+    ),
+];
+
+#[test]
+fn no_folder_holds_more_than_about_a_dozen_files() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut crowded = BTreeMap::new();
+    let mut dirs = vec![root.join("src")];
+    while let Some(dir) = dirs.pop() {
+        let mut entries = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+                entries += 1;
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                entries += 1;
+            }
+        }
+        let name = dir
+            .strip_prefix(&root)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        crowded.insert(name, entries);
+    }
+    // `src` itself holds the top-level modules, which FLOORS orders.
+    crowded.remove("src");
+    let mut too_many = Vec::new();
+    for (name, entries) in &crowded {
+        let excused = FOLDERS_BEING_SPLIT.iter().any(|(f, _)| f == name);
+        if excused {
+            assert!(
+                *entries > MAX_FOLDER_ENTRIES,
+                "{name} holds {entries} entries now: remove it from FOLDERS_BEING_SPLIT"
+            );
+        } else if *entries > MAX_FOLDER_ENTRIES {
+            too_many.push(format!("{name} ({entries})"));
+        }
+    }
+    assert!(
+        too_many.is_empty(),
+        "these folders hold more than {MAX_FOLDER_ENTRIES} files and folders: {}; split each \
+         into rooms along the groups its mod.rs names",
+        too_many.join(", ")
+    );
+}
+
+/// docs/ARCHITECTURE.md's "Where to find things" names files and folders a newcomer opens
+/// first: each must exist.
+#[test]
+fn the_files_the_architecture_page_points_to_exist() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let page = std::fs::read_to_string(root.join("docs/ARCHITECTURE.md")).unwrap();
+    let start = page.find("## Where to find things").expect("the section");
+    let end = page[start + 3..]
+        .find("\n## ")
+        .map_or(page.len(), |e| start + 3 + e);
+    let section = &page[start..end];
+    let mut named = 0;
+    for word in section.split(|c: char| c.is_whitespace() || c == '`' || c == '(' || c == ',') {
+        if let Some(path) = word.strip_prefix("src/") {
+            let path = root
+                .join("src")
+                .join(path.trim_end_matches(['.', ')', ';', ':']));
+            assert!(
+                path.exists(),
+                "docs/ARCHITECTURE.md names {} which is not there",
+                path.display()
+            );
+            named += 1;
+        }
+    }
+    assert!(
+        named >= 20,
+        "only {named} paths found in the section: the parser lost them"
+    );
+}
+
 #[test]
 fn the_floors_name_every_module_once() {
     let mut seen = BTreeSet::new();

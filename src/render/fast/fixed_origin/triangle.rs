@@ -5,7 +5,7 @@ use glam::DVec3;
 
 use super::cone::Cone;
 use crate::geometry::{Interval, Ray, Shape, Triangle};
-use crate::render::packet::{Directions, Lanes, WIDTH};
+use crate::render::fast::packet::{Directions, Lanes, WIDTH};
 
 /// The triangle pre-classification's bound on an edge function's rounding error, relative to
 /// `M . |d|` (see `PreparedTriangle`): `2^-45 = 256 eps`, against a worst case of about

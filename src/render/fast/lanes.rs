@@ -1,7 +1,7 @@
 //! Lanes of paths: in a small scene of spheres, moving spheres and quads, the renderer traces
 //! four pixels' paths at a time, so that each closest-hit and shadow query tests one object
 //! against four rays in one vector (AVX2 where the processor has it: the caller,
-//! [`Job::row`](super::job), is compiled for it).
+//! [`Job::row`](crate::render::job), is compiled for it).
 //!
 //! It promises the film of the one-ray-at-a-time row, bit for bit. Each lane renders whole
 //! pixels, one after the other along the row, each from its own random stream, sample after
@@ -16,9 +16,9 @@
 
 use glam::DVec3;
 
-use super::PixelSampler;
-use super::integrator::{Path, Shadows, hit_interval, occluded, step};
-use super::job::{Job, Moments, Spread};
+use crate::render::PixelSampler;
+use crate::render::integrator::{Path, Shadows, hit_interval, occluded, step};
+use crate::render::job::{Job, Moments, Spread};
 use crate::scene::{Background, Integrator, LANES, Profile, RayLanes, ShapeSet, World, has_lanes};
 
 /// One lane's work: the pixel it renders, its random stream, the sample in flight and the
@@ -35,7 +35,7 @@ struct Lane {
 /// moving spheres and quads (no hierarchy) whose paths have at least one bounce, on a
 /// processor with the lanes' vector instructions ([`has_lanes`]).
 #[inline(always)]
-pub(super) fn takes_lanes(world: &World) -> Option<&ShapeSet> {
+pub(in crate::render) fn takes_lanes(world: &World) -> Option<&ShapeSet> {
     let albedo =
         world.profile == Profile::Course && world.settings.integrator == Integrator::Albedo;
     if (albedo || world.settings.max_depth > 0) && has_lanes() {
@@ -100,7 +100,7 @@ fn start<const JITTER: u8>(job: &Job<'_, World>, pixel: usize, j: usize) -> Lane
 ///
 /// The processor must have AVX2: `set` comes from [`takes_lanes`], which checked it.
 #[inline(always)]
-pub(super) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
+pub(in crate::render) unsafe fn row<const VARIANCE: bool, const JITTER: u8>(
     job: &Job<'_, World>,
     set: &ShapeSet,
     j: usize,

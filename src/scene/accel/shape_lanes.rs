@@ -13,7 +13,7 @@
 //!
 //! Work is skipped only where its answer is known without it, as the scalar set skips it (a
 //! sphere behind the ray, beside it, or left by a ray starting on its surface: `sure_miss` in
-//! `scene::shape_set`), and, for shadow rays, the light's own sphere, which a ray aimed at its
+//! `scene::accel::shape_set`), and, for shadow rays, the light's own sphere, which a ray aimed at its
 //! centre from far enough surely hits (`aimed_ball_lanes`, with the exact arithmetic that
 //! proves it); the occlusion test tests that sphere first and stops once every lane has met two
 //! objects, as the scalar count stops at its limit.
@@ -26,8 +26,8 @@
 //! into, and ones the compiler left out of line called each intrinsic as a function (week 5's
 //! goldens rendered five times slower).
 //!
-//! [`Scene::closest`]: super::Scene::closest
-//! [`Scene::count_hits`]: super::Scene::count_hits
+//! [`Scene::closest`]: crate::scene::Scene::closest
+//! [`Scene::count_hits`]: crate::scene::Scene::count_hits
 
 use glam::DVec3;
 
@@ -35,10 +35,12 @@ use glam::DVec3;
 use std::arch::x86_64::*;
 
 #[cfg(target_arch = "x86_64")]
-use super::shape_set::{Ball, Member, ShapeSet};
-use super::shape_set::{LEAVING_MIN, LEAVING_SLOPE, PREFILTER_MARGIN, PREFILTER_RANGE};
-#[cfg(target_arch = "x86_64")]
 use crate::geometry::{Interval, PARALLEL_EPSILON, Quad};
+#[cfg(target_arch = "x86_64")]
+use crate::scene::accel::shape_set::{Ball, Member, ShapeSet};
+use crate::scene::accel::shape_set::{
+    LEAVING_MIN, LEAVING_SLOPE, PREFILTER_MARGIN, PREFILTER_RANGE,
+};
 
 /// How many rays [`ShapeSet::closest_lanes`] and [`ShapeSet::shadowed_lanes`] take at once:
 /// four `f64` lanes, one AVX2 vector.
@@ -333,7 +335,7 @@ unsafe fn ball_lanes(
     max: &[f64; LANES],
     t: &mut [f64; LANES],
 ) -> (u32, u32) {
-    // SAFETY (every intrinsic below): AVX2 is there (this function's contract).
+    // SAFETY: for every intrinsic below, AVX2 is there (this function's contract).
     unsafe {
         let [o, d] = [loaded.origin, loaded.direction];
         let f = [
@@ -424,7 +426,7 @@ unsafe fn aimed_ball_lanes(
     max: &[f64; LANES],
     t: &mut [f64; LANES],
 ) -> (u32, u32) {
-    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the load
+    // SAFETY: for every intrinsic below, AVX2 is there (this function's contract); the load
     // reads a whole `[f64; 4]`.
     unsafe {
         let sure = if min < 0.25 {
@@ -479,7 +481,7 @@ unsafe fn roots_lanes(
     max: &[f64; LANES],
     t: &mut [f64; LANES],
 ) -> (u32, u32) {
-    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the load and
+    // SAFETY: for every intrinsic below, AVX2 is there (this function's contract); the load and
     // the store read and write whole `[f64; 4]` arrays.
     unsafe {
         let &Parts {
@@ -555,7 +557,7 @@ unsafe fn quad_lanes(
     max: &[f64; LANES],
     t: &mut [f64; LANES],
 ) -> u32 {
-    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); the load and
+    // SAFETY: for every intrinsic below, AVX2 is there (this function's contract); the load and
     // the store read and write whole `[f64; 4]` arrays.
     unsafe {
         let [o, d] = [loaded.origin, loaded.direction];
@@ -816,7 +818,7 @@ mod tests {
     use super::*;
     use crate::geometry::Ray;
     use crate::render::PixelSampler;
-    use crate::scene::shape_set::tests::{intervals, random_ray, random_scene};
+    use crate::scene::accel::shape_set::tests::{intervals, random_ray, random_scene};
     use crate::scene::{Object, Scene};
 
     /// On 300 random scenes of spheres, then 300 of spheres, moving spheres and quads, 250

@@ -1,7 +1,7 @@
 //! The objects of a small scene of spheres, moving spheres and quads ([`ShapeSet`]), side by
 //! side: each sphere's centre and squared radius, each moving sphere's travel, each quad's
 //! plane, tested in one tight loop (spheres with two exact early outs) for the closest hit and
-//! the course's occlusion count. On x86-64 with AVX2, `scene::shape_lanes` answers the same two
+//! the course's occlusion count. On x86-64 with AVX2, `scene::accel::shape_lanes` answers the same two
 //! queries for four rays at once, which the renderer's lanes of paths use.
 //!
 //! It promises the answers of [`Scene::closest`] and [`Scene::count_hits`], bit for bit. Each
@@ -22,8 +22,8 @@
 
 use glam::DVec3;
 
-use super::{Object, Scene};
 use crate::geometry::{Interval, Quad, Ray, Shape, pick_root, roots_of};
+use crate::scene::{Object, Scene};
 
 /// The pre-filter's margin, relative to `a (f . f + r2)`.
 ///
@@ -37,17 +37,17 @@ use crate::geometry::{Interval, Quad, Ray, Shape, pick_root, roots_of};
 /// way. Any NaN or infinity makes the comparison false; so does `a` or `|f|^2 + r^2` outside
 /// `[1e-100, 1e100)`, where underflow could make the relative bounds wrong. (The renderer's
 /// fixed-origin fast path uses the same margin and the same argument.)
-pub(super) const PREFILTER_MARGIN: f64 = 1e-12;
+pub(in crate::scene) const PREFILTER_MARGIN: f64 = 1e-12;
 
 /// Where the pre-filter trusts `a` and `|f|^2 + r^2`.
-pub(super) const PREFILTER_RANGE: std::ops::Range<f64> = 1e-100..1e100;
+pub(in crate::scene) const PREFILTER_RANGE: std::ops::Range<f64> = 1e-100..1e100;
 
 /// The *leaving* early out's bound on `-c / b'` (see [`sure_miss`]).
-pub(super) const LEAVING_SLOPE: f64 = 1e-7;
+pub(in crate::scene) const LEAVING_SLOPE: f64 = 1e-7;
 
 /// The least `interval.min` for which the *leaving* early out holds: ten times
 /// [`LEAVING_SLOPE`], well above the root it rules out.
-pub(super) const LEAVING_MIN: f64 = 1e-6;
+pub(in crate::scene) const LEAVING_MIN: f64 = 1e-6;
 
 /// Whether a sphere whose roots [`roots_of`] would find from these parts (it checked them:
 /// no over- or underflow) certainly has none inside `interval`.
@@ -81,14 +81,14 @@ fn sure_miss(a: f64, half_b: f64, ff: f64, r2: f64, c: f64, interval: Interval) 
 
 /// One sphere: its centre and squared radius.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Ball {
-    pub(super) center: DVec3,
-    pub(super) r2: f64,
+pub(in crate::scene) struct Ball {
+    pub(in crate::scene) center: DVec3,
+    pub(in crate::scene) r2: f64,
 }
 
 /// One object of the set, as the queries test it.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Member {
+pub(in crate::scene) enum Member {
     /// A static sphere.
     Ball(Ball),
     /// A moving sphere: the ball at time 0 and its `travel = end - center`, so that at time
@@ -105,7 +105,7 @@ pub(super) enum Member {
 /// decides ties).
 #[derive(Clone, Debug)]
 pub(crate) struct ShapeSet {
-    pub(super) members: Vec<Member>,
+    pub(in crate::scene) members: Vec<Member>,
 }
 
 /// What one object does to a ray: no root in the interval, a root `t`, or over- or underflow.
@@ -118,7 +118,7 @@ enum Roots {
 impl ShapeSet {
     /// The set of `scene`'s objects, or `None` when one of them is not a sphere, a moving
     /// sphere or a quad, or there is none.
-    pub(super) fn new(scene: &Scene) -> Option<Self> {
+    pub(in crate::scene) fn new(scene: &Scene) -> Option<Self> {
         let ball = |s: crate::geometry::Sphere| Ball {
             center: s.center,
             r2: s.radius * s.radius,
@@ -154,7 +154,7 @@ impl ShapeSet {
 
     /// Whether an object moves (its rays' times matter).
     #[cfg(test)]
-    pub(super) fn moves(&self) -> bool {
+    pub(in crate::scene) fn moves(&self) -> bool {
         self.members
             .iter()
             .any(|m| matches!(m, Member::Moving { .. }))
@@ -205,7 +205,11 @@ impl ShapeSet {
 
     /// [`Scene::closest`]'s answer, inside `Some`; `None` when the scalar path must decide.
     #[inline(always)]
-    pub(super) fn closest(&self, ray: &Ray, interval: Interval) -> Option<Option<(f64, usize)>> {
+    pub(in crate::scene) fn closest(
+        &self,
+        ray: &Ray,
+        interval: Interval,
+    ) -> Option<Option<(f64, usize)>> {
         let a = ray.direction.dot(ray.direction);
         let mut best = None;
         let mut closest = interval.max;
@@ -224,7 +228,12 @@ impl ShapeSet {
 
     /// [`Scene::count_hits`]'s answer; `None` when the scalar path must decide.
     #[inline(always)]
-    pub(super) fn count_hits(&self, ray: &Ray, interval: Interval, limit: usize) -> Option<usize> {
+    pub(in crate::scene) fn count_hits(
+        &self,
+        ray: &Ray,
+        interval: Interval,
+        limit: usize,
+    ) -> Option<usize> {
         let a = ray.direction.dot(ray.direction);
         let mut count = 0;
         for member in &self.members {

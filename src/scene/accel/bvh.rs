@@ -19,8 +19,8 @@
 
 use glam::DVec3;
 
-use super::{Object, Scene};
 use crate::geometry::{Interval, Ray, Shape};
+use crate::scene::{Object, Scene};
 
 /// Objects per leaf at most.
 const LEAF_SIZE: usize = 4;

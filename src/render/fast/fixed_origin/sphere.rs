@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use super::cone::{Cone, SANE_MAX, SANE_MIN};
 use crate::geometry::{Interval, Ray, Shape, Sphere, pick_root, roots_of};
-use crate::render::packet::{Directions, Lanes, WIDTH};
+use crate::render::fast::packet::{Directions, Lanes, WIDTH};
 
 /// The sphere pre-filter's margin, relative to `a (f . f + r2)`.
 ///

@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use crate::geometry::{PARALLEL_EPSILON, Quad};
-use crate::render::packet::{Directions, Lanes, WIDTH};
+use crate::render::fast::packet::{Directions, Lanes, WIDTH};
 
 #[cfg(target_arch = "x86_64")]
 use crate::scene::{lanes_between, lanes_splat};
@@ -75,7 +75,7 @@ pub(super) fn quad_hit_lanes(
 /// vectors and scalar compares; written with the intrinsics, the packet is one vector.
 ///
 /// The directions are read in halves of two lanes: they were just written, and a 32-byte load
-/// is not served from the smaller stores that wrote them (see `scene::shape_lanes`).
+/// is not served from the smaller stores that wrote them (see `scene::accel::shape_lanes`).
 ///
 /// # Safety
 ///
@@ -91,7 +91,7 @@ pub(super) unsafe fn quads_hit_avx2(
     closest: &mut Lanes,
     index: &mut [u64; WIDTH],
 ) {
-    // SAFETY (every intrinsic below): AVX2 is there (this function's contract); each load and
+    // SAFETY: for every intrinsic below, AVX2 is there (this function's contract); each load and
     // store reads or writes two or four elements of an array of four.
     unsafe {
         let (dx, dy, dz) = (halves(&d.x), halves(&d.y), halves(&d.z));

@@ -10,11 +10,11 @@
 
 use glam::DVec3;
 
-use super::PixelSampler;
-use super::fixed_origin::{ALL_CANDIDATES, Candidates, Cone, FixedOrigin};
-use super::job::{Job, Moments, Spread, Trace};
-use super::packet::{Directions, NO_HIT, WIDTH};
 use crate::geometry::Interval;
+use crate::render::PixelSampler;
+use crate::render::fast::fixed_origin::{ALL_CANDIDATES, Candidates, Cone, FixedOrigin};
+use crate::render::fast::packet::{Directions, NO_HIT, WIDTH};
+use crate::render::job::{Job, Moments, Spread, Trace};
 use crate::scene::{Camera, Scene};
 
 /// The cone from the camera's centre that holds every direction the samples of pixel `(i, j)`
@@ -70,7 +70,7 @@ fn footprint(camera: &Camera, i: usize, j: usize) -> Option<Cone> {
 }
 
 /// A scene prepared for rays from one origin, with each object's albedo.
-pub(super) struct Pinhole {
+pub(in crate::render) struct Pinhole {
     prepared: FixedOrigin,
     /// Each object's albedo, with a fourth lane of zero.
     albedos: Vec<[f64; 4]>,
@@ -78,7 +78,7 @@ pub(super) struct Pinhole {
 
 impl Pinhole {
     /// `scene` prepared for rays leaving `origin`.
-    pub(super) fn new(scene: &Scene, origin: DVec3) -> Self {
+    pub(in crate::render) fn new(scene: &Scene, origin: DVec3) -> Self {
         Self {
             prepared: FixedOrigin::new(scene, origin),
             albedos: (0..scene.objects.len())
