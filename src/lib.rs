@@ -23,7 +23,7 @@
 //! - [`image_io`]: PNG and OpenEXR, written atomically.
 //! - [`candidate`]: checking other implementations (a candidate as a process, judging its
 //!   answers, fuzzing; the course's Python API; a trait for Rust tracers).
-//! - [`functions`]: the weekly checks of the course's weeks 5 to 10, the protocol's function
+//! - [`weekly`]: the weekly checks of the course's weeks 5 to 10, the protocol's function
 //!   requests judged against the reference's own answers.
 //! - [`golden`]: the golden EXRs of the built-in scenes (mean and per-sample variance at 4096 spp),
 //!   embedded in the library, the golden of any scene file, and their comparison.
@@ -43,7 +43,6 @@ pub mod bench;
 pub mod candidate;
 pub mod compare;
 pub mod escape;
-pub mod functions;
 pub mod geometry;
 pub mod golden;
 pub mod grade;
@@ -56,3 +55,4 @@ pub mod render;
 pub mod sandbox;
 pub mod scene;
 pub mod secret;
+pub mod weekly;

@@ -410,7 +410,7 @@ fn week08_one(work: &Path) -> WeekGrade {
             &submission,
             &rubric,
             &CourseCodeChecker {
-                week: rubric.week.and_then(crate::functions::Week::new),
+                week: rubric.week.and_then(crate::weekly::Week::new),
                 time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
                 ..CourseCodeChecker::default()
             },

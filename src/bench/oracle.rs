@@ -10,9 +10,9 @@ use crate::geometry::{Interval, Shape};
 use crate::oracle::classify::{analyse, classify_with};
 use crate::oracle::exact::{self, Decision};
 use crate::oracle::generate::{CAMERA, Stream, random_plane, random_sphere};
+use crate::oracle::mistakes::honest;
 use crate::oracle::profile::{Judging, Precision, Profile};
 use crate::oracle::suite::default_suite_with;
-use crate::oracle::variants::honest;
 use crate::oracle::vectors::{Class, ShapeKind, ShapeSpec};
 
 /// What to run.

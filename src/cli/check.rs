@@ -10,12 +10,12 @@ use anyhow::Context;
 use rtoracle::candidate::{
     CandidateCommand, RunOptions, SandboxPolicy, check_command, process::python,
 };
-use rtoracle::functions::{FunctionOptions, Week, check_week, detect};
 use rtoracle::oracle::vectors::{Case, read_vectors};
 use rtoracle::oracle::{
     Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
 };
 use rtoracle::sandbox::SandboxError;
+use rtoracle::weekly::{FunctionOptions, Week, check_week, detect};
 
 /// Which candidate to run (shared by `check` and `fuzz`; `check` without either checks the
 /// course submission in the current folder).
@@ -273,7 +273,7 @@ pub struct Args {
     #[arg(long, value_name = "N", value_parser = super::num::week)]
     week: Option<u8>,
     /// False-alarm rate of each statistical test of the week's samplers.
-    #[arg(long, value_name = "P", default_value_t = rtoracle::functions::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
+    #[arg(long, value_name = "P", default_value_t = rtoracle::weekly::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
     alpha: f64,
     /// Score the ambiguous vectors too, each by its exact answer (as a grading rubric's
     /// `score_ambiguous` does): edges, corners and tangents answered otherwise then fail.
@@ -321,7 +321,7 @@ fn current_submission() -> anyhow::Result<PathBuf> {
 }
 
 pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
-    use rtoracle::functions::report::CheckDocument;
+    use rtoracle::weekly::report::CheckDocument;
     if let Some(folder) = args.folder.take() {
         check_submission_folder(&folder, "")?;
         args.target.python_course = Some(folder);

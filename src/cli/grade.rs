@@ -227,7 +227,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         policy,
         python,
         python_requires: rubric.python_requires.clone(),
-        week: rubric.week.and_then(rtoracle::functions::Week::new),
+        week: rubric.week.and_then(rtoracle::weekly::Week::new),
         ..Default::default()
     })
 }

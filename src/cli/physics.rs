@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
     seed: u64,
     /// The false-alarm rate of the whole run (shared by its statistical tests).
-    #[arg(long, value_name = "P", default_value_t = rtoracle::functions::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
+    #[arg(long, value_name = "P", default_value_t = rtoracle::weekly::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
     alpha: f64,
     /// Time allowed per request, in milliseconds.
     #[arg(long, value_name = "N", default_value_t = 20_000, value_parser = super::num::millis)]
@@ -115,9 +115,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // submission (week 9's sampling from week 9 on), the book's for any other renderer.
     let family = match &args.target.python_course {
         Some(dir) => {
-            let week = rtoracle::functions::detect(dir)
-                .week
-                .map_or(9, |w| w.number());
+            let week = rtoracle::weekly::detect(dir).week.map_or(9, |w| w.number());
             Family::Course { cosine: week >= 9 }
         }
         None => Family::Book,

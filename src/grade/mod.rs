@@ -18,7 +18,7 @@
 //!   credit ([`rubric::credit`]) and the points of each group ([`rubric::score`]).
 //! - [`checkers`]: the two interfaces and their real implementations: the course's code through
 //!   the `check` harness ([`checkers::code`]), the weekly function checks
-//!   ([`checkers::functions`]), images against their reference ([`checkers::images`]), renders
+//!   ([`checkers::weekly`]), images against their reference ([`checkers::images`]), renders
 //!   asked of the submission's own code ([`checkers::rendered`], [`checkers::noise_floor`]) and
 //!   copied images ([`checkers::copies`]).
 //! - [`batch`]: a folder of submissions in parallel, the gradebook, one shard's entry
@@ -54,8 +54,8 @@ mod run;
 mod write;
 
 pub use checkers::code::CourseCodeChecker;
-pub use checkers::functions::{UNSCORED_ID, function_checks};
 pub use checkers::images::CompareImageChecker;
+pub use checkers::weekly::{UNSCORED_ID, function_checks};
 pub use checkers::{
     CodeChecker, CodeOutcome, FailureKind, FailureSummary, FunctionsOutcome, GroupCounts,
     ImageChecker, ImageOutcome, ImageVerdict, SceneFile, SceneSource,

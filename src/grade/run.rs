@@ -146,12 +146,10 @@ fn run_code(
     code: &dyn CodeChecker,
 ) -> (CodeOutcome, Option<super::checkers::FunctionsOutcome>) {
     let shapes = rubric.code_shapes();
-    let week = rubric.week.and_then(crate::functions::Week::new);
-    let function_options = crate::functions::FunctionOptions {
+    let week = rubric.week.and_then(crate::weekly::Week::new);
+    let function_options = crate::weekly::FunctionOptions {
         seed: rubric.seed,
-        alpha: rubric
-            .alpha
-            .unwrap_or(crate::functions::stats::DEFAULT_ALPHA),
+        alpha: rubric.alpha.unwrap_or(crate::weekly::stats::DEFAULT_ALPHA),
     };
     rayon::join(
         || {
@@ -215,7 +213,7 @@ pub fn grade(
     let mut fingerprints = Vec::new();
     let mut function_checks = functions
         .as_ref()
-        .map(|f| super::checkers::functions::function_checks(rubric, f))
+        .map(|f| super::checkers::weekly::function_checks(rubric, f))
         .unwrap_or_default();
     for g in &rubric.groups {
         match g.kind {

@@ -1,7 +1,7 @@
 //! The intersection oracle: exact decisions ([`exact`]), the error bands of the course's naive
 //! formulas ([`band`]), the classification of a case ([`classify`](mod@classify)), edge-case generators
 //! ([`generate`]), watertight groups ([`watertight`]), the default suite ([`suite`]), explanations ([`explain`]), honest and buggy
-//! transcriptions of the course's code ([`variants`]), fuzzing entry points ([`fuzzing`]), the
+//! transcriptions of the course's code ([`mistakes`]), fuzzing entry points ([`fuzzing`]), the
 //! benchmark ([`crate::bench::oracle`]) and the language-agnostic vector format ([`vectors`]).
 
 pub mod band;
@@ -10,10 +10,10 @@ pub mod exact;
 pub mod explain;
 pub mod fuzzing;
 pub mod generate;
+pub mod mistakes;
 pub mod profile;
 pub mod suite;
 pub mod tags;
-pub mod variants;
 pub mod vectors;
 pub mod watertight;
 

@@ -287,8 +287,8 @@ pub fn watertight_cases(seed: u64, judging: Judging) -> Vec<Case> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::oracle::mistakes::{self, VHit, Variant};
     use crate::oracle::profile::{Precision, Profile};
-    use crate::oracle::variants::{self, VHit, Variant};
     use crate::oracle::vectors::ShapeKind;
     use std::collections::BTreeMap;
 
@@ -369,10 +369,10 @@ mod tests {
     /// open-edge code (`0 < alpha < 1`) hits none in any group.
     #[test]
     fn closed_edges_hold_every_group_and_open_edges_crack_every_one() {
-        let honest = variants::honest();
-        let rtiow: Vec<Variant> = variants::rtiow()
+        let honest = mistakes::honest();
+        let rtiow: Vec<Variant> = mistakes::rtiow()
             .into_iter()
-            .chain(variants::rtiow_f32())
+            .chain(mistakes::rtiow_f32())
             .collect();
         let closed = [
             (

@@ -158,7 +158,7 @@ impl Default for FurnaceOptions {
             spp: DEFAULT_SPP,
             renders: DEFAULT_RENDERS,
             seed: 0,
-            alpha: crate::functions::stats::DEFAULT_ALPHA,
+            alpha: crate::weekly::stats::DEFAULT_ALPHA,
         }
     }
 }

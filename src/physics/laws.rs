@@ -17,8 +17,8 @@ use serde::Serialize;
 
 use super::source::MaterialSample;
 use super::sphere::{CellIntegrals, Frame, cell_of};
-use crate::functions::stats::{binomial, chi_square_sf};
 use crate::render::reflect;
+use crate::weekly::stats::{binomial, chi_square_sf};
 
 /// A law of the checks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
@@ -379,7 +379,7 @@ fn chi_square_law(
     let mut acc = (0.0, 0.0, 0.0);
     for (obs, exp, e) in terms {
         acc = (acc.0 + obs, acc.1 + exp, acc.2 + e);
-        if acc.1 >= crate::functions::stats::MIN_EXPECTED {
+        if acc.1 >= crate::weekly::stats::MIN_EXPECTED {
             pooled.push(acc);
             acc = (0.0, 0.0, 0.0);
         }

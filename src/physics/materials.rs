@@ -129,7 +129,7 @@ impl Default for MaterialOptions {
         MaterialOptions {
             seed: 0,
             samples: DEFAULT_SAMPLES,
-            alpha: crate::functions::stats::DEFAULT_ALPHA,
+            alpha: crate::weekly::stats::DEFAULT_ALPHA,
         }
     }
 }
@@ -662,7 +662,7 @@ pub fn check_candidate_materials(
     let label = command.label.clone();
     let timeout = run.timeout;
     let mut session = crate::candidate::Session::start(command, run)?;
-    let mut runner = crate::functions::SessionRunner::new(&mut session);
+    let mut runner = crate::weekly::SessionRunner::new(&mut session);
     let mut source = super::source::ProtocolSource::new(&mut runner, label, timeout);
     let mut model = reference.map(super::models::ModelSource::new);
     Ok(check_materials(

@@ -43,7 +43,7 @@ const FLOORS: &[&[&str]] = &[
     &["image_io"],
     &["candidate"],
     // The function checks of the course's weeks 5 to 10 (run through a candidate's session).
-    &["functions"],
+    &["weekly"],
     &["golden"],
     &["compare"],
     // Physics checks that need no golden (materials through a candidate's session); grading
@@ -182,7 +182,7 @@ const FOLDERS_BEING_SPLIT: &[(&str, &str)] = &[
     ),
     ("src/cli", "the binary: one file per subcommand"),
     (
-        "src/functions",
+        "src/weekly",
         "the weekly checks: run, runner, report, stats, samplers, week",
     ),
     (

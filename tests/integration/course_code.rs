@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use rtoracle::bench::harness::course_python_or_skip;
-use rtoracle::functions::checks::{Body, week_checks};
-use rtoracle::functions::expect::{Expected, Want};
-use rtoracle::functions::{Week, detect};
+use rtoracle::weekly::checks::{Body, week_checks};
+use rtoracle::weekly::expect::{Expected, Want};
+use rtoracle::weekly::{Week, detect};
 use serde_json::{Value, json};
 
 use crate::common::{CourseTree, course_code, course_week_copy};
@@ -303,7 +303,7 @@ fn repros(week: u8) -> Vec<Repro> {
                         scored: c.class.is_scored(),
                         course_raises: matches!(
                             c.class,
-                            rtoracle::functions::expect::Class::CourseFails(_)
+                            rtoracle::weekly::expect::Class::CourseFails(_)
                         ),
                     });
                 }

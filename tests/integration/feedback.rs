@@ -374,9 +374,9 @@ fn check_after_a_diagnosis_shows_the_fix_and_one_repro() {
 /// Every mistake of the catalogue comes with its fix.
 #[test]
 fn every_catalogued_mistake_has_a_fix() {
-    let missing: Vec<&str> = rtoracle::oracle::variants::buggy()
+    let missing: Vec<&str> = rtoracle::oracle::mistakes::buggy()
         .into_iter()
-        .chain(rtoracle::oracle::variants::buggy_extra())
+        .chain(rtoracle::oracle::mistakes::buggy_extra())
         .filter(|v| !v.honest)
         .map(|v| v.name)
         .filter(|name| rtoracle::candidate::judging::diagnose::fix(name).is_none())

@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use rtoracle::bench::harness::course_python_or_skip;
 use rtoracle::candidate::{CandidateCommand, RunOptions, Session};
-use rtoracle::functions::{FunctionRunner, Reply, SessionRunner};
+use rtoracle::weekly::{FunctionRunner, Reply, SessionRunner};
 use serde_json::json;
 
 fn python() -> Option<&'static Path> {

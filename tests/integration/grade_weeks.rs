@@ -9,7 +9,7 @@
 //! same on every run. With the course's real code at hand (`RTORACLE_COURSE_CODE`), only
 //! week 8's replay runs: `course_grades` grades every week's real solution and skeleton. The
 //! function mistakes are graded by the same rubric in
-//! `functions::week_is_judged_fairly`, from the same sessions that check them.
+//! `weekly::week_is_judged_fairly`, from the same sessions that check them.
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;

@@ -406,12 +406,12 @@ mod tests {
         );
     }
 
-    fn fuzz_failures(v: &crate::oracle::variants::Variant, cases: &[Case]) -> Vec<String> {
+    fn fuzz_failures(v: &crate::oracle::mistakes::Variant, cases: &[Case]) -> Vec<String> {
         cases
             .iter()
             .filter(|c| c.shape.kind() == v.shape)
             .filter_map(|c| {
-                crate::oracle::variants::judge(&c.expect, &(v.run)(&c.shape, &c.ray, c.interval))
+                crate::oracle::mistakes::judge(&c.expect, &(v.run)(&c.shape, &c.ray, c.interval))
                     .err()
                     .map(|e| format!("{}: {e}", c.id))
             })
@@ -420,7 +420,7 @@ mod tests {
 
     #[test]
     fn fuzzing_under_robust_finds_rtiow_out_and_the_reference_passes_it() {
-        use crate::oracle::variants::{honest, rtiow};
+        use crate::oracle::mistakes::{honest, rtiow};
         // Seeded: the same 2000 sphere cases every run.
         let robust = random_cases_with(3, 0, 2000, &[ShapeKind::Sphere], Judging::ROBUST);
         assert_eq!(robust.len(), 2000);

@@ -3,7 +3,7 @@
 //! When definite vectors of a shape group fail (wrong answers or raised errors; time-outs,
 //! deaths, protocol errors and vectors not run are not evidence), every mistake of the
 //! catalogue for that shape (the oracle's buggy transcriptions of the course's code,
-//! [`variants::buggy`] and [`variants::buggy_extra`]) is replayed on the failing vectors and on
+//! [`mistakes::buggy`] and [`mistakes::buggy_extra`]) is replayed on the failing vectors and on
 //! a deterministic sample of the passing ones (up to [`SAMPLE`], evenly spaced in suite order).
 //!
 //! A mistake *explains* a failing vector when the variant fails it the same way: the same
@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use crate::candidate::judging::check::{NORMAL_TOL, Winding};
 use crate::candidate::process::outcome::Outcome;
 use crate::candidate::process::protocol::Answer;
-use crate::oracle::variants::{self, VHit, Variant};
+use crate::oracle::mistakes::{self, VHit, Variant};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
 
 /// How many passing vectors of a group are replayed at most.
@@ -174,8 +174,8 @@ pub fn describe(mistake_id: &str) -> String {
 
 /// The catalogue of known mistakes.
 pub fn catalogue() -> Vec<Variant> {
-    let mut list = variants::buggy();
-    list.extend(variants::buggy_extra());
+    let mut list = mistakes::buggy();
+    list.extend(mistakes::buggy_extra());
     list
 }
 
@@ -367,7 +367,7 @@ mod tests {
 
     /// `v`'s answers on its shape, the reference's on the others.
     fn run(v: &Variant, cases: &[Case]) -> Vec<Outcome> {
-        let honest = variants::honest();
+        let honest = mistakes::honest();
         cases
             .iter()
             .map(|c| {
@@ -404,7 +404,7 @@ mod tests {
                 assert!(same, "{} named {}", v.name, d.mistake_id);
             }
         }
-        for v in variants::honest() {
+        for v in mistakes::honest() {
             let found = diagnose(&cases, &run(&v, &cases), None);
             assert!(found.is_empty(), "{}: {found:?}", v.name);
         }
@@ -445,7 +445,7 @@ mod tests {
     #[test]
     fn an_unexplained_failure_names_nothing_and_the_sentence_says_what_it_names() {
         let cases = default_suite(0);
-        let reference = variants::honest()
+        let reference = mistakes::honest()
             .into_iter()
             .find(|v| v.name == "sphere-reference")
             .unwrap();

@@ -42,7 +42,7 @@ pub const PYTHON_COURSE_ADAPTER: &str = include_str!("python_course.py");
 /// material requests' driver (`rtoracle physics`) is appended to it: it extends the driver's
 /// `OPS` and `answer`.
 pub const COURSE_FUNCTIONS_DRIVER: &str = concat!(
-    include_str!("../../functions/course_functions.py"),
+    include_str!("../../weekly/course_functions.py"),
     include_str!("../../physics/course_materials.py")
 );
 

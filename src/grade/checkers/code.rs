@@ -55,8 +55,8 @@ pub struct CourseCodeChecker {
     pub python_requires: Vec<String>,
     /// The course week of the submissions (the rubric's `week`): from week 7 on, a sphere
     /// vector on which the course's own `get_uv` raises at a pole is not scored
-    /// ([`crate::functions::submission::excuse_pole_crashes`]).
-    pub week: Option<crate::functions::Week>,
+    /// ([`crate::weekly::submission::excuse_pole_crashes`]).
+    pub week: Option<crate::weekly::Week>,
 }
 
 impl Default for CourseCodeChecker {
@@ -167,8 +167,8 @@ impl CodeChecker for CourseCodeChecker {
     fn check_functions(
         &self,
         submission: &Path,
-        week: crate::functions::Week,
-        options: crate::functions::FunctionOptions,
+        week: crate::weekly::Week,
+        options: crate::weekly::FunctionOptions,
     ) -> crate::grade::checkers::FunctionsOutcome {
         course_functions(self, submission, week, options)
     }
@@ -228,7 +228,7 @@ impl CodeChecker for CourseCodeChecker {
                     // From week 7 on, the course's own get_uv raises at a sphere's pole.
                     let cases = match self.week {
                         Some(week) => {
-                            let (excused, _) = crate::functions::submission::excuse_pole_crashes(
+                            let (excused, _) = crate::weekly::submission::excuse_pole_crashes(
                                 week, &cases, &outcomes,
                             );
                             for (before, after) in cases.iter().zip(&excused) {
@@ -513,25 +513,25 @@ impl CourseCodeChecker {
     }
 }
 
-/// A [`FunctionRunner`](crate::functions::FunctionRunner) that stops sending requests once a
+/// A [`FunctionRunner`](crate::weekly::FunctionRunner) that stops sending requests once a
 /// wall-clock deadline has passed (the rubric's code time budget): the rest are not run.
 struct BudgetRunner<'a> {
-    inner: crate::functions::SessionRunner<'a>,
+    inner: crate::weekly::SessionRunner<'a>,
     deadline: Option<std::time::Instant>,
     refused: usize,
 }
 
-impl crate::functions::FunctionRunner for BudgetRunner<'_> {
+impl crate::weekly::FunctionRunner for BudgetRunner<'_> {
     fn supports(&self, op: &str) -> bool {
         self.inner.supports(op)
     }
 
-    fn call(&mut self, request: &Value, timeout: Duration) -> crate::functions::Reply {
+    fn call(&mut self, request: &Value, timeout: Duration) -> crate::weekly::Reply {
         let now = std::time::Instant::now();
         match self.deadline {
             Some(d) if now >= d => {
                 self.refused += 1;
-                crate::functions::Reply::NotRun("the code time budget ran out".into())
+                crate::weekly::Reply::NotRun("the code time budget ran out".into())
             }
             Some(d) => self.inner.call(request, timeout.min(d - now)),
             None => self.inner.call(request, timeout),
@@ -546,8 +546,8 @@ impl crate::functions::FunctionRunner for BudgetRunner<'_> {
 fn course_functions(
     checker: &CourseCodeChecker,
     submission: &Path,
-    week: crate::functions::Week,
-    options: crate::functions::FunctionOptions,
+    week: crate::weekly::Week,
+    options: crate::weekly::FunctionOptions,
 ) -> crate::grade::checkers::FunctionsOutcome {
     use crate::grade::checkers::FunctionsOutcome;
     let fatal = |msg: String| FunctionsOutcome {
@@ -583,11 +583,11 @@ fn course_functions(
     }
     let deadline = budget.map(|b| std::time::Instant::now() + b);
     let mut runner = BudgetRunner {
-        inner: crate::functions::SessionRunner::new(&mut session),
+        inner: crate::weekly::SessionRunner::new(&mut session),
         deadline,
         refused: 0,
     };
-    let mut report = crate::functions::run_week(&mut runner, week, options);
+    let mut report = crate::weekly::run_week(&mut runner, week, options);
     let out_of_time = runner.refused;
     for f in &mut report.functions {
         if let Some(failure) = &mut f.failure {

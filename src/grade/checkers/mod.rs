@@ -10,10 +10,10 @@ pub mod code;
 pub mod copies;
 #[cfg(test)]
 pub(crate) mod fakes;
-pub(crate) mod functions;
 pub mod images;
 pub mod noise_floor;
 pub mod rendered;
+pub(crate) mod weekly;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -51,14 +51,14 @@ pub trait CodeChecker: Sync {
             .collect()
     }
 
-    /// Runs week `week`'s function checks ([`crate::functions`]) on the submission. Never
+    /// Runs week `week`'s function checks ([`crate::weekly`]) on the submission. Never
     /// panics: whatever the code does is in the outcome. The default runs none (a checker that
     /// cannot send function requests), and says so in `fatal`.
     fn check_functions(
         &self,
         submission: &Path,
-        week: crate::functions::Week,
-        options: crate::functions::FunctionOptions,
+        week: crate::weekly::Week,
+        options: crate::weekly::FunctionOptions,
     ) -> FunctionsOutcome {
         let _ = (submission, week, options);
         FunctionsOutcome {
@@ -74,7 +74,7 @@ pub use crate::candidate::process::render_request::{RenderJob, RenderOutcome, Re
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct FunctionsOutcome {
     /// The function checks, judged (`None` when nothing could be run: see `fatal`).
-    pub report: Option<crate::functions::WeekReport>,
+    pub report: Option<crate::weekly::WeekReport>,
     /// Set when nothing could be run: the import failed (the message shows the exception), the
     /// interpreter is missing, the checker does not run function checks.
     pub fatal: Option<String>,

@@ -298,7 +298,7 @@ fn ambiguous_counts(c: &CheckResult, checks: &[CheckResult]) -> Option<(usize, u
 /// block `quote` writes: it is the submission's text), the reproduction, and the notes.
 fn function_body(
     c: &CheckResult,
-    f: &crate::functions::FunctionResult,
+    f: &crate::weekly::FunctionResult,
     quote: fn(&Untrusted) -> String,
 ) -> String {
     let mut md = c.message.markdown_inline();

@@ -8,7 +8,7 @@ use crate::candidate::Answer;
 use crate::candidate::judging::check::{decide_winding, judge_wound};
 use crate::oracle::default_suite;
 use crate::oracle::generate::{add, scale};
-use crate::oracle::variants::{self, Variant};
+use crate::oracle::mistakes::{self, Variant};
 use crate::oracle::vectors::ShapeKind;
 
 /// Deterministic pseudo-random numbers (splitmix64) for the coin-toss strategies.
@@ -115,7 +115,7 @@ fn strategies(cases: &[Case]) -> Vec<(String, Strategy)> {
 }
 
 /// A transcription's answer as the course adapter would send it.
-fn answer_of(v: &variants::Answer, c: &Case) -> Answer {
+fn answer_of(v: &mistakes::Answer, c: &Case) -> Answer {
     match v {
         Err(e) => Answer::error(*e, "raised"),
         Ok(None) => Answer::miss(),
@@ -186,8 +186,8 @@ fn fraction((t, _): &(ClassTally, Vec<Mark>)) -> f64 {
 const SHAPES: [ShapeKind; 3] = [ShapeKind::Sphere, ShapeKind::Quad, ShapeKind::Triangle];
 
 fn catalogue(shape: ShapeKind) -> Vec<Variant> {
-    let mut list = variants::buggy();
-    list.extend(variants::buggy_extra());
+    let mut list = mistakes::buggy();
+    list.extend(mistakes::buggy_extra());
     list.retain(|v| v.shape == shape);
     list
 }
@@ -202,7 +202,7 @@ fn no_constant_or_random_answer_earns_more_than_2_percent_of_any_group() {
                 let f = fraction(&run_strategy(&cases, &s));
                 assert!(f <= 0.02, "seed {seed} {shape}: {name} earns {f:.4}");
             }
-            for v in variants::honest().iter().filter(|v| v.shape == shape) {
+            for v in mistakes::honest().iter().filter(|v| v.shape == shape) {
                 let r = run_variant(&cases, v);
                 assert_eq!(fraction(&r), 1.0, "seed {seed}: {} {:?}", v.name, r.0);
             }
@@ -372,7 +372,7 @@ fn measure_the_candidate_rules_on_the_catalogued_mistakes() {
             "chosen"
         );
         let mut rows = runs;
-        for v in variants::honest()
+        for v in mistakes::honest()
             .iter()
             .filter(|v| v.shape == shape)
             .take(1)

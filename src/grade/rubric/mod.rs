@@ -165,7 +165,7 @@ pub enum GroupKind {
     /// One image against the reference of a scene.
     Image,
     /// Functions of the rubric's `week` (weeks 5 to 10), through the protocol's function
-    /// requests ([`crate::functions`]).
+    /// requests ([`crate::weekly`]).
     Functions,
 }
 
@@ -370,7 +370,7 @@ pub struct Rubric {
     pub alpha: Option<f64>,
     /// Versions of a function the course itself has, accepted as passing where the answers fit
     /// them (`older_direct_term_one_over_d`: week 5's earlier direct term). The names are the
-    /// week's catalogue's alternatives ([`crate::functions::checks::alternatives`]).
+    /// week's catalogue's alternatives ([`crate::weekly::checks::alternatives`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub accept: Vec<String>,
     /// The groups, in report order.

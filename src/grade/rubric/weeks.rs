@@ -27,8 +27,8 @@ use std::fmt::Write as _;
 
 use std::path::Path;
 
-use crate::functions::Week;
 use crate::grade::rubric::{Group, GroupKind, Rubric, RubricError, WEEK04_RUBRIC};
+use crate::weekly::Week;
 
 /// The names of the built-in rubrics.
 pub const BUILTIN_RUBRICS: &[&str] = &[
@@ -61,7 +61,7 @@ pub fn week_render_spp(week: Week) -> u32 {
 }
 
 /// A group of a week's functions in its built-in rubric: its id, name, points and the ids of
-/// its functions (`crate::functions::checks`' ids).
+/// its functions (`crate::weekly::checks`' ids).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FunctionGroup {
     /// Its id (`functions.materials`).
@@ -409,7 +409,7 @@ impl Rubric {
                 }
                 return Ok(());
             }
-            Some(n) => crate::functions::Week::new(n).ok_or_else(|| {
+            Some(n) => crate::weekly::Week::new(n).ok_or_else(|| {
                 self.invalid(format!(
                     "week = {n}: function checks exist for weeks 5 to 10 (leave week out for week 4)"
                 ))
@@ -422,7 +422,7 @@ impl Rubric {
                 )));
             }
         }
-        let known = crate::functions::checks::alternatives(week);
+        let known = crate::weekly::checks::alternatives(week);
         for name in &self.accept {
             if !known.contains(&name.as_str()) {
                 return Err(self.invalid(format!(
@@ -461,7 +461,7 @@ impl Rubric {
                 g.id
             )));
         }
-        let Some(week) = self.week.and_then(crate::functions::Week::new) else {
+        let Some(week) = self.week.and_then(crate::weekly::Week::new) else {
             return Err(self.invalid(format!(
                 "functions group {:?} needs the rubric's week (week = 5 to 10)",
                 g.id
@@ -474,7 +474,7 @@ impl Rubric {
                 g.id
             )));
         }
-        let known = crate::functions::checks::function_ids(week);
+        let known = crate::weekly::checks::function_ids(week);
         for f in names {
             if !known.contains(&f.as_str()) {
                 return Err(self.invalid(format!(
@@ -540,7 +540,7 @@ mod tests {
             assert!((points - FUNCTION_POINTS).abs() < 1e-9, "{name}: {points}");
             // Every scored function is one the week checks in its own version, and not one the
             // checks hold as given by the skeleton.
-            let checks = crate::functions::checks::week_checks(week, 0);
+            let checks = crate::weekly::checks::week_checks(week, 0);
             for f in &own {
                 let c = checks.iter().find(|c| c.id == *f);
                 let c =

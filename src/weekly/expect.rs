@@ -107,7 +107,7 @@ impl Expected {
             let bad = |what: &str| {
                 Err(format!(
                     "{key} = {}, expected {}{what}",
-                    got.map_or("(missing)".to_string(), crate::functions::expect::show),
+                    got.map_or("(missing)".to_string(), crate::weekly::expect::show),
                     want.describe()
                 ))
             };

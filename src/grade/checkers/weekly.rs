@@ -16,10 +16,10 @@
 //! catalogue's names and sentences). What the submission said (an exception's text) is only in
 //! the function result's `failure.problem`, which the reports quote as untrusted text.
 
-use crate::functions::{FunctionResult, Status};
 use crate::grade::checkers::FunctionsOutcome;
 use crate::grade::result::{CheckResult, CheckStatus};
 use crate::grade::rubric::{Group, GroupKind, Rubric, Visibility};
+use crate::weekly::{FunctionResult, Status};
 
 /// The id of the unscored check that lists the failing functions that carry no points.
 pub const UNSCORED_ID: &str = "functions.unscored";
@@ -226,9 +226,9 @@ fn unscored_check(unscored: &[&FunctionResult], rubric: &Rubric) -> CheckResult 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::functions::run::{CaseCounts, NamedMistake};
-    use crate::functions::samplers::Standing;
-    use crate::functions::{FunctionOptions, Week, WeekReport};
+    use crate::weekly::run::{CaseCounts, NamedMistake};
+    use crate::weekly::samplers::Standing;
+    use crate::weekly::{FunctionOptions, Week, WeekReport};
 
     fn result(id: &str, week: u8, status: Status, mistake: Option<&str>) -> FunctionResult {
         FunctionResult {

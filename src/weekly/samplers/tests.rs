@@ -3,7 +3,7 @@
 //! `docs/weekly-checks.md`).
 
 use super::*;
-use crate::functions::stats::DEFAULT_ALPHA;
+use crate::weekly::stats::DEFAULT_ALPHA;
 
 /// Every check of the catalogue, in a setting like the one the weekly runs use.
 pub(crate) fn every_check() -> Vec<(&'static str, SamplerCheck)> {

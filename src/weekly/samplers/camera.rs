@@ -201,7 +201,7 @@ impl SamplerCheck {
                     doubled,
                 ),
                 square_hypothesis(|r| {
-                    let p = simulate::in_square(r);
+                    let p = mistakes::in_square(r);
                     [p.x, p.y, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
                 }),
             ],

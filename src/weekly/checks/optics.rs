@@ -14,13 +14,13 @@ use super::{
     Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, steer,
     stream, week,
 };
-use crate::functions::expect::{Class, Expected, Want};
-use crate::functions::samplers::{
-    DIELECTRIC_SAMPLES, DielectricSetting, Sample, SamplerCheck, Standing,
-};
-use crate::functions::simulate;
 use crate::oracle::band::Iv;
 use crate::render::{halfvector, reflect, refracted, schlick};
+use crate::weekly::expect::{Class, Expected, Want};
+use crate::weekly::samplers::mistakes;
+use crate::weekly::samplers::{
+    DIELECTRIC_SAMPLES, DielectricSetting, Sample, SamplerCheck, Standing,
+};
 
 mod dielectric;
 
@@ -127,7 +127,7 @@ fn arriving(n: DVec3, tangent: DVec3, theta: f64) -> DVec3 {
 
 /// A random unit normal, a unit direction arriving at it, and its tangent.
 fn random_arrival(r: &mut crate::render::PixelSampler) -> (DVec3, DVec3) {
-    let n = simulate::unit_vector(r);
+    let n = mistakes::unit_vector(r);
     let t = n.any_orthonormal_pair().0;
     let theta = r.next_f64() * 1.55;
     let phi = r.next_f64() * std::f64::consts::TAU;
@@ -156,8 +156,8 @@ fn reflect_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "reflect");
     for _ in 0..8 {
-        let n = simulate::unit_vector(&mut r);
-        let v = simulate::unit_vector(&mut r) * (0.5 + 9.5 * r.next_f64());
+        let n = mistakes::unit_vector(&mut r);
+        let v = mistakes::unit_vector(&mut r) * (0.5 + 9.5 * r.next_f64());
         inputs.push((v, n));
     }
     let mut cases = Vec::new();
@@ -477,8 +477,8 @@ fn halfvector_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "halfvector");
     for _ in 0..6 {
-        let v = simulate::unit_vector(&mut r) * (0.5 + 12.0 * r.next_f64());
-        let l = simulate::unit_vector(&mut r) * (0.5 + 3.0 * r.next_f64());
+        let v = mistakes::unit_vector(&mut r) * (0.5 + 12.0 * r.next_f64());
+        let l = mistakes::unit_vector(&mut r) * (0.5 + 3.0 * r.next_f64());
         inputs.push((v, l));
     }
     let (mut unit, mut of_units) = (Vec::new(), Vec::new());
@@ -602,7 +602,7 @@ fn mirror_check(seed: u64) -> FunctionCheck {
     for k in 0..6 {
         let (n, v) = random_arrival(&mut r);
         let d = v * (0.5 + 14.0 * r.next_f64());
-        let point = simulate::unit_vector(&mut r) * 3.0;
+        let point = mistakes::unit_vector(&mut r) * 3.0;
         // Every other one from inside (the outward normal faces away from the ray).
         let outward = if k % 2 == 0 { n } else { -n };
         inputs.push(HitInput {
@@ -675,10 +675,10 @@ pub(crate) fn scatter_samples(answer: &serde_json::Value) -> Result<Vec<Sample>,
             if s.is_null() {
                 return Ok([f64::NAN; 9]);
             }
-            let v = crate::functions::expect::numbers(Some(s), 9).ok_or_else(|| {
+            let v = crate::weekly::expect::numbers(Some(s), 9).ok_or_else(|| {
                 format!(
                     "a sample is not 9 numbers: {}",
-                    crate::functions::expect::show(s)
+                    crate::weekly::expect::show(s)
                 )
             })?;
             let mut out = [0.0; 9];

@@ -15,15 +15,15 @@ use super::optics::sample_requests;
 use super::{
     Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, stream, week,
 };
-use crate::functions::expect::{Class, Expected, Want, numbers};
-use crate::functions::samplers::{
-    CAMERA_SAMPLES, DISK_SAMPLES, JitterSetting, Sample, SamplerCheck, Standing,
-};
-use crate::functions::simulate;
 use crate::geometry::{Interval, MovingSphere, Ray, Shape, Sphere};
 use crate::oracle::classify::classify;
 use crate::oracle::vectors::{Class as HitClass, RaySpec, ShapeSpec};
 use crate::scene::{Camera, CameraSettings};
+use crate::weekly::expect::{Class, Expected, Want, numbers};
+use crate::weekly::samplers::mistakes;
+use crate::weekly::samplers::{
+    CAMERA_SAMPLES, DISK_SAMPLES, JitterSetting, Sample, SamplerCheck, Standing,
+};
 
 /// A camera as a request states it (the course's `Camera` fields set before `init_camera`).
 #[derive(Clone, Copy, Debug)]
@@ -122,11 +122,11 @@ fn camera_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "camera");
     for _ in 0..4 {
-        let from = 5.0 * simulate::unit_vector(&mut r);
+        let from = 5.0 * mistakes::unit_vector(&mut r);
         inputs.push(CameraInput {
             settings: CameraSettings {
                 look_from: from.to_array(),
-                look_at: (0.5 * simulate::unit_vector(&mut r)).to_array(),
+                look_at: (0.5 * mistakes::unit_vector(&mut r)).to_array(),
                 up: [0.0, 1.0, 0.0],
                 vfov: 20.0 + 100.0 * r.next_f64(),
                 focus_distance: 1.0 + 9.0 * r.next_f64(),
@@ -249,7 +249,7 @@ fn camera_samples(answer: &serde_json::Value) -> Result<Vec<[f64; 7]>, String> {
             let v = numbers(Some(s), 7).ok_or_else(|| {
                 format!(
                     "a sample is not 7 numbers: {}",
-                    crate::functions::expect::show(s)
+                    crate::weekly::expect::show(s)
                 )
             })?;
             let mut out = [0.0; 7];
@@ -384,8 +384,8 @@ fn move_sphere_check(seed: u64) -> FunctionCheck {
     let mut r = stream(seed, "move-sphere");
     for _ in 0..6 {
         inputs.push((
-            3.0 * simulate::unit_vector(&mut r),
-            3.0 * simulate::unit_vector(&mut r),
+            3.0 * mistakes::unit_vector(&mut r),
+            3.0 * mistakes::unit_vector(&mut r),
             r.next_f64(),
         ));
     }
@@ -457,12 +457,12 @@ fn moving_inputs(seed: u64) -> Vec<(DVec3, DVec3, DVec3, DVec3, f64)> {
     ));
     let mut r = stream(seed, "moving-intersect");
     for _ in 0..8 {
-        let c0 = 2.0 * simulate::unit_vector(&mut r);
-        let c1 = c0 + simulate::unit_vector(&mut r);
+        let c0 = 2.0 * mistakes::unit_vector(&mut r);
+        let c1 = c0 + mistakes::unit_vector(&mut r);
         let t = r.next_f64();
         let at = c0 + (c1 - c0) * t;
-        let origin = at + 5.0 * simulate::unit_vector(&mut r);
-        let d = (at + 0.8 * simulate::unit_vector(&mut r) - origin) * (0.5 + r.next_f64());
+        let origin = at + 5.0 * mistakes::unit_vector(&mut r);
+        let d = (at + 0.8 * mistakes::unit_vector(&mut r) - origin) * (0.5 + r.next_f64());
         inputs.push((c0, c1, origin, d, t));
     }
     inputs

@@ -12,7 +12,7 @@
 //!   estimated once from a seeded Rust simulation of the mistake where it has no closed form),
 //!   tested by Pearson's chi-square, or by the exact binomial test when there are two cells, at
 //!   the false-alarm rate asked ([`super::stats::DEFAULT_ALPHA`] by default);
-//! - a **generator** ([`super::simulate`]): the same sampler in Rust, so that
+//! - a **generator** ([`super::samplers::mistakes`]): the same sampler in Rust, so that
 //!   [`rejection_rate`] measures the false-alarm rate of the course's hypothesis on honest
 //!   samples and the power against each mistake with many seeds.
 //!
@@ -26,12 +26,12 @@ use std::sync::OnceLock;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use super::simulate;
 use super::stats::{TestResult, binomial, chi_square};
 use crate::render::PixelSampler;
 
 mod camera;
 mod directions;
+pub mod mistakes;
 mod surfaces;
 
 pub use camera::JitterSetting;
@@ -59,7 +59,7 @@ pub enum Standing {
     Alternative,
     /// The course's behaviour, reached another way (the work split differently between
     /// functions, another convention for the same input): named, and not charged
-    /// ([`crate::functions::departures`]).
+    /// ([`crate::weekly::departures`]).
     Departure,
 }
 
@@ -369,7 +369,7 @@ fn square_cell(u: f64, v: f64) -> usize {
 
 const SQUARE_CELLS: usize = 64;
 
-/// `d` in the frame of the unit axis `n` (the frame of [`simulate::about`]).
+/// `d` in the frame of the unit axis `n` (the frame of [`mistakes::about`]).
 fn local_to(n: DVec3, d: DVec3) -> DVec3 {
     let (t, b) = n.any_orthonormal_pair();
     DVec3::new(d.dot(t), d.dot(b), d.dot(n))

@@ -90,14 +90,14 @@ impl SamplerCheck {
                 Box::new(move |s| lobe_cell(local_to(n, v3(s, 1).normalize_or_zero()))),
             ),
             Probs::Equal,
-            Box::new(move |r| sample_of(p, n + simulate::unit_vector(r), a)),
+            Box::new(move |r| sample_of(p, n + mistakes::unit_vector(r), a)),
         );
         let normalised = surface.lobe(
             "n_plus_u_normalised",
             Standing::Mistake,
             "n + u normalised (the course leaves it as it is: its length 2 cos(theta) weighs week 8's cosine)",
             Probs::Equal,
-            move |r| (n + simulate::unit_vector(r)).normalize(),
+            move |r| (n + mistakes::unit_vector(r)).normalize(),
             false,
         );
         let hemisphere = surface.lobe(
@@ -105,7 +105,7 @@ impl SamplerCheck {
             Standing::Mistake,
             "a uniform unit vector flipped to the normal's side: the hemisphere uniformly instead of the cosine lobe",
             Probs::Simulated(OnceLock::new()),
-            move |r| simulate::about(n, simulate::uniform_hemisphere(r)),
+            move |r| mistakes::about(n, mistakes::uniform_hemisphere(r)),
             false,
         );
         SamplerCheck {
@@ -129,7 +129,7 @@ impl SamplerCheck {
             Standing::Course,
             "a unit direction with density cos(theta) / pi about the normal",
             Probs::Equal,
-            move |r| simulate::about(n, simulate::cosine_hemisphere(r)),
+            move |r| mistakes::about(n, mistakes::cosine_hemisphere(r)),
             true,
         );
         let hemisphere = surface.lobe(
@@ -137,7 +137,7 @@ impl SamplerCheck {
             Standing::Mistake,
             "the hemisphere about the normal sampled uniformly instead of the cosine lobe",
             Probs::Simulated(OnceLock::new()),
-            move |r| simulate::about(n, simulate::uniform_hemisphere(r)),
+            move |r| mistakes::about(n, mistakes::uniform_hemisphere(r)),
             false,
         );
         let wrong_axis = Hypothesis::new(
@@ -154,8 +154,8 @@ impl SamplerCheck {
             ),
             Probs::Simulated(OnceLock::new()),
             Box::new(move |r| {
-                let c = simulate::cosine_hemisphere(r);
-                sample_of(p, simulate::about(n, DVec3::new(c.z, c.y, c.x)), a)
+                let c = mistakes::cosine_hemisphere(r);
+                sample_of(p, mistakes::about(n, DVec3::new(c.z, c.y, c.x)), a)
             }),
         );
         let kept_week5 = Hypothesis::new(
@@ -177,7 +177,7 @@ impl SamplerCheck {
                 Box::new(move |s| lobe_cell(local_to(n, v3(s, 1).normalize_or_zero()))),
             ),
             Probs::Equal,
-            Box::new(move |r| sample_of(p, n + simulate::unit_vector(r), a)),
+            Box::new(move |r| sample_of(p, n + mistakes::unit_vector(r), a)),
         );
         SamplerCheck {
             kind: SamplerKind::LambertianCosine,
@@ -276,7 +276,7 @@ impl MetalSetting {
             ),
             Probs::Equal,
             Box::new(move |r| {
-                let d = mirror + radius * simulate::unit_vector(r);
+                let d = mirror + radius * mistakes::unit_vector(r);
                 let a = if d.dot(m.normal) <= 1e-8 {
                     DVec3::ZERO
                 } else {
@@ -331,7 +331,7 @@ impl SamplerCheck {
                 Box::new(move |r| {
                     sample_of(
                         m.point,
-                        m.mirror + m.roughness * simulate::in_ball(r),
+                        m.mirror + m.roughness * mistakes::in_ball(r),
                         m.albedo,
                     )
                 }),

@@ -41,7 +41,7 @@ fn dielectric_inputs(seed: u64) -> Vec<DielectricInput> {
         let (n, v) = random_arrival(&mut r);
         let d = v * (0.5 + 9.0 * r.next_f64());
         let outward = if k % 2 == 0 { n } else { -n };
-        let point = simulate::unit_vector(&mut r);
+        let point = mistakes::unit_vector(&mut r);
         inputs.push(DielectricInput {
             hit: HitInput {
                 origin: point - d,

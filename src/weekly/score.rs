@@ -248,7 +248,7 @@ pub fn score(report: &WeekReport) -> WeekScore {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::functions::checks::week_checks;
+    use crate::weekly::checks::week_checks;
 
     /// Every group names functions the week introduces and its skeleton does not hold, each in
     /// one group only, and the points add up to 100; every such function is in a group.

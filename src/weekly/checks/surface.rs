@@ -12,12 +12,12 @@ use serde_json::json;
 
 use super::optics::HitInput;
 use super::{Body, CASE_TIMEOUT, Case, FunctionCheck, Variant, jnum, jvec, py, stream, week};
-use crate::functions::expect::{Class, Expected, Want};
-use crate::functions::samplers::Standing;
-use crate::functions::simulate;
 use crate::geometry::{Interval, Quad, Ray, Shape};
 use crate::render::sphere_uv;
 use crate::scene::{Profile, Texture, TextureImage};
+use crate::weekly::expect::{Class, Expected, Want};
+use crate::weekly::samplers::Standing;
+use crate::weekly::samplers::mistakes;
 
 pub(crate) fn checks(seed: u64) -> Vec<FunctionCheck> {
     vec![
@@ -56,7 +56,7 @@ fn sphere_uv_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "sphere-uv");
     for _ in 0..8 {
-        normals.push(simulate::unit_vector(&mut r));
+        normals.push(mistakes::unit_vector(&mut r));
     }
     let mut cases = Vec::new();
     let (mut swapped, mut no_offset, mut flipped) = (Vec::new(), Vec::new(), Vec::new());
@@ -143,9 +143,9 @@ fn quad_uv_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "quad-uv");
     for _ in 0..6 {
-        let q = 2.0 * simulate::unit_vector(&mut r);
-        let u = simulate::unit_vector(&mut r) * (0.5 + 2.0 * r.next_f64());
-        let mut v = simulate::unit_vector(&mut r) * (0.5 + 2.0 * r.next_f64());
+        let q = 2.0 * mistakes::unit_vector(&mut r);
+        let u = mistakes::unit_vector(&mut r) * (0.5 + 2.0 * r.next_f64());
+        let mut v = mistakes::unit_vector(&mut r) * (0.5 + 2.0 * r.next_f64());
         if u.cross(v).length() < 0.3 * u.length() * v.length() {
             v = u.cross(v).cross(u).normalize() * v.length();
         }
@@ -322,7 +322,7 @@ fn checker_points(seed: u64) -> Vec<(f64, DVec3)> {
     let mut r = stream(seed, "checker");
     for k in 0..10 {
         let s = [0.32, 0.12, 1.0, 0.05][k % 4];
-        points.push((s, 3.0 * simulate::unit_vector(&mut r)));
+        points.push((s, 3.0 * mistakes::unit_vector(&mut r)));
     }
     points
 }
@@ -559,8 +559,8 @@ fn textured_check(seed: u64) -> FunctionCheck {
     let mut cases = Vec::new();
     let mut uv_instead = Vec::new();
     for k in 0..6 {
-        let n = simulate::unit_vector(&mut r);
-        let point = 2.0 * simulate::unit_vector(&mut r);
+        let n = mistakes::unit_vector(&mut r);
+        let point = 2.0 * mistakes::unit_vector(&mut r);
         let h = HitInput {
             origin: point + 2.0 * n,
             direction: -2.0 * n,

@@ -11,9 +11,6 @@ use glam::DVec3;
 use serde_json::json;
 
 use super::{Body, CASE_TIMEOUT, Case, FunctionCheck, Variant, jnum, jvec, py, stream, week};
-use crate::functions::expect::{Class, Expected, Want};
-use crate::functions::samplers::Standing;
-use crate::functions::simulate;
 use crate::geometry::Ray;
 use crate::oracle::classify::classify;
 use crate::oracle::vectors::{Class as HitClass, RaySpec, ShapeSpec};
@@ -22,6 +19,9 @@ use crate::scene::{
     Background, CameraSettings, ImageSettings, Integrator, MaterialEntry, MaterialKind,
     ObjectEntry, Profile, RenderSettings, SceneDescription, World,
 };
+use crate::weekly::expect::{Class, Expected, Want};
+use crate::weekly::samplers::Standing;
+use crate::weekly::samplers::mistakes;
 
 /// A material of the light checks.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -431,12 +431,12 @@ fn occlusion_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "occlusion");
     for _ in 0..10 {
-        let c = 2.0 * simulate::unit_vector(&mut r);
-        let p = c + (0.3 + 4.0 * r.next_f64()) * simulate::unit_vector(&mut r);
+        let c = 2.0 * mistakes::unit_vector(&mut r);
+        let p = c + (0.3 + 4.0 * r.next_f64()) * mistakes::unit_vector(&mut r);
         let mut objects = vec![light(c)];
         for _ in 0..3 {
             let t = r.next_f64() * 1.6;
-            let center = p + t * (c - p) + 0.4 * simulate::unit_vector(&mut r);
+            let center = p + t * (c - p) + 0.4 * mistakes::unit_vector(&mut r);
             objects.push(Obj::Sphere {
                 center,
                 radius: 0.1 + 0.3 * r.next_f64(),

@@ -18,8 +18,8 @@ use serde_json::json;
 use super::camera::{CameraInput, dof_camera};
 use super::steer::{self, Behaviour};
 use super::{Body, CASE_TIMEOUT, Case, FunctionCheck, jnum, py, stream, week};
-use crate::functions::expect::{Class, Expected, Want, numbers};
-use crate::functions::samplers::{JitterSetting, Sample, SamplerCheck};
+use crate::weekly::expect::{Class, Expected, Want, numbers};
+use crate::weekly::samplers::{JitterSetting, Sample, SamplerCheck};
 
 pub(crate) fn checks(seed: u64) -> Vec<FunctionCheck> {
     vec![camera_ray_check(seed, 9), camera_ray_check(seed, 10)]

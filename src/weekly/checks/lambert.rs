@@ -17,14 +17,14 @@ use super::{
     Body, CASE_TIMEOUT, Case, FunctionCheck, SAMPLES_TIMEOUT, Variant, jnum, jvec, py, steer,
     stream, week,
 };
-use crate::functions::expect::{Class, Expected, Want, numbers};
-use crate::functions::samplers::{
+use crate::oracle::band::Iv;
+use crate::render::{Onb, reflect};
+use crate::weekly::expect::{Class, Expected, Want, numbers};
+use crate::weekly::samplers::mistakes;
+use crate::weekly::samplers::{
     HEMISPHERE_SAMPLES, LAMBERTIAN_SAMPLES, METAL_SAMPLES, MetalSetting, Sample, SamplerCheck,
     Standing, UNIT_SPHERE_SAMPLES,
 };
-use crate::functions::simulate;
-use crate::oracle::band::Iv;
-use crate::render::{Onb, reflect};
 
 pub(crate) fn checks(seed: u64) -> Vec<FunctionCheck> {
     vec![
@@ -52,7 +52,7 @@ pub(crate) fn vector_samples(answer: &serde_json::Value) -> Result<Vec<Sample>, 
             let v = numbers(Some(s), 3).ok_or_else(|| {
                 format!(
                     "a sample is not 3 numbers: {}",
-                    crate::functions::expect::show(s)
+                    crate::weekly::expect::show(s)
                 )
             })?;
             Ok([v[0], v[1], v[2], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -125,9 +125,9 @@ fn lambertian_hits(seed: u64, id: &str) -> Vec<HitInput> {
     }];
     let mut r = stream(seed, id);
     for k in 0..5 {
-        let n = simulate::unit_vector(&mut r);
-        let point = 2.0 * simulate::unit_vector(&mut r);
-        let mut d = simulate::unit_vector(&mut r) * 3.0;
+        let n = mistakes::unit_vector(&mut r);
+        let point = 2.0 * mistakes::unit_vector(&mut r);
+        let mut d = mistakes::unit_vector(&mut r) * 3.0;
         if d.dot(n) > -0.1 {
             d -= (d.dot(n) + 1.0) * n;
         }
@@ -310,8 +310,8 @@ fn onb_check(seed: u64) -> FunctionCheck {
     ];
     let mut r = stream(seed, "onb");
     for _ in 0..6 {
-        let w = simulate::unit_vector(&mut r) * (0.2 + 3.0 * r.next_f64());
-        let l = simulate::unit_vector(&mut r) * 2.0;
+        let w = mistakes::unit_vector(&mut r) * (0.2 + 3.0 * r.next_f64());
+        let l = mistakes::unit_vector(&mut r) * 2.0;
         inputs.push((w, l));
     }
     let mut cases = Vec::new();
@@ -480,9 +480,9 @@ fn metal_inputs(seed: u64) -> Vec<(HitInput, f64, Vec<f64>)> {
     ];
     let mut r = stream(seed, "metal");
     for k in 0..6 {
-        let n = simulate::unit_vector(&mut r);
-        let point = simulate::unit_vector(&mut r);
-        let mut d = simulate::unit_vector(&mut r) * (0.5 + 5.0 * r.next_f64());
+        let n = mistakes::unit_vector(&mut r);
+        let point = mistakes::unit_vector(&mut r);
+        let mut d = mistakes::unit_vector(&mut r) * (0.5 + 5.0 * r.next_f64());
         if d.dot(n) > -0.05 {
             d -= (d.dot(n) + 1.0) * n;
         }

@@ -19,8 +19,8 @@
 
 use glam::DVec3;
 
-use crate::functions::samplers::{Sample, SamplerCheck};
 use crate::render::PixelSampler;
+use crate::weekly::samplers::{Sample, SamplerCheck};
 
 /// What any answer of a steered case must satisfy when it is not the course's exact one: the
 /// answer's `result` object in, what is wrong out.
@@ -114,7 +114,7 @@ pub(crate) fn scatter_sample(answer: &serde_json::Value) -> Result<Sample, Strin
     }
     let mut s = [0.0; 9];
     for (k, key) in ["origin", "direction", "attenuation"].iter().enumerate() {
-        let v = crate::functions::expect::numbers(answer.get(*key), 3)
+        let v = crate::weekly::expect::numbers(answer.get(*key), 3)
             .ok_or_else(|| format!("its {key} is not 3 numbers"))?;
         s[3 * k..3 * k + 3].copy_from_slice(&v);
     }

@@ -8,7 +8,7 @@ use std::time::Duration;
 use serde_json::{Value, json};
 
 use super::*;
-use crate::functions::checks::week_checks;
+use crate::weekly::checks::week_checks;
 
 /// Answers every request with `answer(request)`.
 struct StandIn<F: FnMut(&Value) -> Reply> {
@@ -145,7 +145,7 @@ fn a_sampler_answers_exactly_the_samples_asked_for() {
     let r = run(&c, |req| {
         let n = req["n"].as_u64().unwrap() as usize;
         let samples: Vec<[f64; 3]> = (0..n)
-            .map(|_| crate::functions::simulate::unit_vector(&mut rng).to_array())
+            .map(|_| crate::weekly::samplers::mistakes::unit_vector(&mut rng).to_array())
             .collect();
         Reply::Result(json!({"samples": samples}))
     });
@@ -174,7 +174,7 @@ fn drawn_otherwise(c: &FunctionCheck) -> impl FnMut(&Value) -> Reply {
                 .collect::<Vec<_>>(),
         );
         let n = if d.dot(n) < 0.0 { n } else { -n };
-        let dir = n + crate::functions::simulate::unit_vector(&mut rng);
+        let dir = n + crate::weekly::samplers::mistakes::unit_vector(&mut rng);
         Reply::Result(json!({
             "scattered": true, "origin": req["hit"]["point"], "direction": dir.to_array(),
             "time": 0.0, "attenuation": req["material"]["albedo"],

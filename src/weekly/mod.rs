@@ -7,7 +7,7 @@
 //! - [`expect`]: what a deterministic request must answer, and judging an answer.
 //! - [`stats`]: chi-square and binomial tests at a stated false-alarm rate.
 //! - [`samplers`]: each random function's invariants, cells and catalogued mistakes.
-//! - [`simulate`]: the same samplers (and mistakes) in Rust, to measure false alarms and power.
+//! - [`samplers::mistakes`]: the same samplers (and mistakes) in Rust, to measure false alarms and power.
 //! - [`checks`]: each week's functions, their cases, expected answers and mistakes.
 //! - [`run`]: running a week's checks and judging them ([`WeekReport`]).
 //! - [`departures`]: departures that keep the course's behaviour, named and not charged.
@@ -23,7 +23,6 @@ pub mod run;
 pub mod runner;
 pub mod samplers;
 pub mod score;
-pub mod simulate;
 pub mod stats;
 pub mod submission;
 pub mod week;

@@ -16,10 +16,10 @@ use super::optics::HitInput;
 use super::{
     Body, CASE_TIMEOUT, Case, FunctionCheck, Normalise, Variant, jnum, jvec, py, stream, week,
 };
-use crate::functions::expect::{Class, Expected, Want};
-use crate::functions::samplers::Standing;
-use crate::functions::simulate;
 use crate::render::{blinn, cook_torrance, halfvector, phong};
+use crate::weekly::expect::{Class, Expected, Want};
+use crate::weekly::samplers::Standing;
+use crate::weekly::samplers::mistakes;
 
 /// One BRDF case: the hit (the view ray arriving at it), and the light's direction.
 #[derive(Clone, Copy)]
@@ -64,15 +64,15 @@ fn inputs(seed: u64, id: &str) -> Vec<Input> {
     ];
     let mut r = stream(seed, id);
     for _ in 0..10 {
-        let n = simulate::unit_vector(&mut r);
-        let point = simulate::unit_vector(&mut r);
+        let n = mistakes::unit_vector(&mut r);
+        let point = mistakes::unit_vector(&mut r);
         // A view from the normal's side, of length 1 to 15, and a light on that side too.
-        let mut view = simulate::unit_vector(&mut r);
+        let mut view = mistakes::unit_vector(&mut r);
         if view.dot(n) > -0.1 {
             view -= (view.dot(n) + 1.0) * n;
         }
         let view = view.normalize() * (1.0 + 14.0 * r.next_f64());
-        let mut l = simulate::unit_vector(&mut r);
+        let mut l = mistakes::unit_vector(&mut r);
         if l.dot(n) < 0.1 {
             l += (0.1 - l.dot(n) + r.next_f64()) * n;
         }
@@ -210,7 +210,7 @@ fn model_check(seed: u64, is_blinn: bool) -> FunctionCheck {
 
 /// A grey colour answer (the code made to return a colour) read as the course's number.
 fn grey_as_number(answer: serde_json::Value) -> serde_json::Value {
-    use crate::functions::expect::vector;
+    use crate::weekly::expect::vector;
     if answer.get("value").is_some() {
         return answer;
     }

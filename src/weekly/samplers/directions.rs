@@ -47,7 +47,7 @@ impl SamplerCheck {
                 Box::new(|s| ((v3(s, 0).length().powi(3) * 10.0) as usize).min(9)),
             ),
             Probs::Equal,
-            Box::new(|r| sample_of(simulate::in_ball(r), DVec3::ZERO, DVec3::ZERO)),
+            Box::new(|r| sample_of(mistakes::in_ball(r), DVec3::ZERO, DVec3::ZERO)),
         );
         SamplerCheck {
             kind: SamplerKind::UnitSphere,
@@ -57,7 +57,7 @@ impl SamplerCheck {
                 Standing::Course,
                 "a unit vector, uniform on the sphere",
                 Probs::Equal,
-                simulate::unit_vector,
+                mistakes::unit_vector,
             ),
             mistakes: vec![
                 ball,
@@ -66,14 +66,14 @@ impl SamplerCheck {
                     Standing::Mistake,
                     "a point of the cube normalised without rejecting those outside the ball (the cube's corners are over-represented)",
                     Probs::Simulated(OnceLock::new()),
-                    simulate::unit_vector_from_cube,
+                    mistakes::unit_vector_from_cube,
                 ),
                 sphere_hypothesis(
                     "unit_vector_uniform_angles",
                     Standing::Mistake,
                     "the polar angle drawn uniformly (the poles are over-represented)",
                     Probs::Simulated(OnceLock::new()),
-                    simulate::unit_vector_uniform_angles,
+                    mistakes::unit_vector_uniform_angles,
                 ),
             ],
         }
@@ -113,14 +113,14 @@ impl SamplerCheck {
                 Standing::Course,
                 "a unit vector of the upper hemisphere with density cos(theta) / pi",
                 Probs::Equal,
-                simulate::cosine_hemisphere,
+                mistakes::cosine_hemisphere,
             ),
             mistakes: vec![hemisphere(
                 "hemisphere_instead_of_cosine_lobe",
                 Standing::Mistake,
                 "the hemisphere sampled uniformly (z = r2) instead of the cosine lobe (z = sqrt(1 - r2))",
                 Probs::Simulated(OnceLock::new()),
-                simulate::uniform_hemisphere,
+                mistakes::uniform_hemisphere,
             )],
         }
     }
@@ -149,10 +149,10 @@ impl SamplerCheck {
                 Box::new(disk_invariant),
                 (DISK_CELLS, Box::new(|s| disk_cell(s[0], s[1]))),
                 Probs::Equal,
-                Box::new(|r| sample_of(simulate::in_disk(r), DVec3::ZERO, DVec3::ZERO)),
+                Box::new(|r| sample_of(mistakes::in_disk(r), DVec3::ZERO, DVec3::ZERO)),
             ),
             mistakes: vec![
-                square_hypothesis(|r| sample_of(simulate::in_square(r), DVec3::ZERO, DVec3::ZERO)),
+                square_hypothesis(|r| sample_of(mistakes::in_square(r), DVec3::ZERO, DVec3::ZERO)),
                 Hypothesis::new(
                     "disk_radius_uniform",
                     Standing::Mistake,
@@ -161,7 +161,7 @@ impl SamplerCheck {
                     (DISK_CELLS, Box::new(|s| disk_cell(s[0], s[1]))),
                     Probs::Simulated(OnceLock::new()),
                     Box::new(|r| {
-                        sample_of(simulate::disk_radius_uniform(r), DVec3::ZERO, DVec3::ZERO)
+                        sample_of(mistakes::disk_radius_uniform(r), DVec3::ZERO, DVec3::ZERO)
                     }),
                 ),
             ],
