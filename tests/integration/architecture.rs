@@ -182,10 +182,6 @@ const FOLDERS_BEING_SPLIT: &[(&str, &str)] = &[
     ),
     ("src/cli", "the binary: one file per subcommand"),
     (
-        "src/weekly",
-        "the weekly checks: run, runner, report, stats, samplers, week",
-    ),
-    (
         "src/compare",
         "the comparison: verdict, stats, diagnosis, reports, FLIP, two-sample",
     ),
