@@ -4,7 +4,7 @@
 //! bgr,
 //! fov, missing, sky.
 
-use rtoracle::compare::mistakes::{Mistake, render_with_mistake};
+use rtoracle::compare::diagnose::mistakes::{Mistake, render_with_mistake};
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();

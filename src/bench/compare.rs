@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
-use crate::compare::mistakes::{Mistake, render_with_mistake};
+use crate::compare::diagnose::mistakes::{Mistake, render_with_mistake};
 use crate::compare::{CandidateImage, CompareOptions, Golden, compare_file, compare_image};
 
 fn median(mut v: Vec<Duration>) -> Duration {

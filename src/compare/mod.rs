@@ -13,8 +13,6 @@ pub mod diagnose;
 pub mod encoding;
 pub mod flip;
 pub mod heatmap;
-mod hypotheses;
-pub mod mistakes;
 pub mod noise_model;
 pub mod regions;
 pub mod report;

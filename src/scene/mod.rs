@@ -11,14 +11,11 @@ mod builtin;
 mod camera;
 mod description;
 mod error;
-mod file;
 mod material;
-mod mitsuba;
 mod object;
 mod profile;
 mod settings;
 mod texture;
-mod validate;
 mod world;
 
 pub use accel::bvh::BVH_MIN_OBJECTS;
@@ -33,13 +30,14 @@ pub use builtin::{
     rtiow_final_scene,
 };
 pub use camera::{Camera, CameraSettings};
+pub use description::mitsuba::{MitsubaError, to_mitsuba_xml};
+pub use description::validate::{MAX_DEPTH_LIMIT, MAX_SIDE};
 pub use description::{
     ImageSettings, MaterialEntry, MaterialKind, ObjectEntry, SceneDescription, TextureEntry,
     TextureKind,
 };
 pub use error::SceneError;
 pub use material::Material;
-pub use mitsuba::{MitsubaError, to_mitsuba_xml};
 pub use object::{Object, Scene, SceneObject};
 pub use profile::Profile;
 pub use settings::{
@@ -49,5 +47,4 @@ pub use settings::{
 pub use texture::{
     GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,
 };
-pub use validate::{MAX_DEPTH_LIMIT, MAX_SIDE};
 pub use world::{PointLight, World};

@@ -181,14 +181,6 @@ const FOLDERS_BEING_SPLIT: &[(&str, &str)] = &[
         "the sandbox: start, view, limits, watchdogs, identity, reaper",
     ),
     ("src/cli", "the binary: one file per subcommand"),
-    (
-        "src/compare",
-        "the comparison: verdict, stats, diagnosis, reports, FLIP, two-sample",
-    ),
-    (
-        "src/scene",
-        "scenes: materials, textures, objects, camera, files, world",
-    ),
 ];
 
 #[test]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use rayon::prelude::*;
-use rtoracle::compare::mistakes::{MUST_FAIL, Mistake, render_with_mistake};
+use rtoracle::compare::diagnose::mistakes::{MUST_FAIL, Mistake, render_with_mistake};
 use rtoracle::compare::{CandidateImage, CompareOptions, Comparison, Golden, compare_image};
 use rtoracle::image_io::Rgb8Image;
 use rtoracle::render::{PixelJitter, RenderOptions, render};

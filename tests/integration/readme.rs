@@ -26,7 +26,7 @@
 //!   `python:VARIANT=FOLDER` is the `check` fixture `tests/fixtures/python/variants/VARIANT` (the
 //!   common modules, then the variant's) by `rtoracle::bench::harness::assemble_fixture`, and
 //!   `mistake:SCENE:MISTAKE=FILE.png` is the built-in `SCENE` rendered with a mistake of
-//!   `rtoracle::compare::mistakes` (`MISTAKE` by the names `examples/mistake.rs` takes) by
+//!   `rtoracle::compare::diagnose::mistakes` (`MISTAKE` by the names `examples/mistake.rs` takes) by
 //!   `render_with_mistake`, at the scene's samples per pixel and seed 1: the PNG that
 //!   `cargo run --release --example mistake -- SCENE MISTAKE FILE.png` writes;
 //! - `<!-- setup: SHELL -->`: the shell line runs, silently, in the page's folder (after the
@@ -150,7 +150,7 @@ fn parse_fixtures(spec: &str) -> Result<Vec<Fixture>, String> {
                     Some((scene, mistake))
                         if word.contains('=')
                             && rtoracle::scene::builtin(scene).is_ok()
-                            && rtoracle::compare::mistakes::Mistake::from_argument(mistake).is_some() =>
+                            && rtoracle::compare::diagnose::mistakes::Mistake::from_argument(mistake).is_some() =>
                     {
                         Ok(Fixture::Mistake {
                             scene: scene.to_string(),
@@ -201,11 +201,15 @@ fn make_fixture(fixture: &Fixture, dir: &Path) -> Result<(), String> {
             file,
         } => {
             let description = rtoracle::scene::builtin(scene).map_err(|e| e.to_string())?;
-            let mistake = rtoracle::compare::mistakes::Mistake::from_argument(mistake)
+            let mistake = rtoracle::compare::diagnose::mistakes::Mistake::from_argument(mistake)
                 .ok_or("an unknown mistake")?;
             let spp = description.image.samples_per_pixel;
-            let image =
-                rtoracle::compare::mistakes::render_with_mistake(&description, mistake, spp, 1);
+            let image = rtoracle::compare::diagnose::mistakes::render_with_mistake(
+                &description,
+                mistake,
+                spp,
+                1,
+            );
             rtoracle::image_io::write_png(&dir.join(file), &image).map_err(|e| e.to_string())
         }
     }

@@ -56,14 +56,14 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use super::error::SceneError;
-use super::texture::{RgbPicture, generated_picture, read_picture};
-use super::{
+use crate::geometry::{MovingSphere, Quad, Sphere, Triangle};
+use crate::scene::error::SceneError;
+use crate::scene::texture::{RgbPicture, generated_picture, read_picture};
+use crate::scene::{
     Camera, CameraSettings, ImageSettings, Material, MaterialEntry, MaterialKind, Object,
     ObjectEntry, Profile, RenderSettings, Scene, SceneDescription, SceneObject, Texture,
     TextureEntry, TextureImage, TextureKind, World,
 };
-use crate::geometry::{MovingSphere, Quad, Sphere, Triangle};
 
 impl SceneDescription {
     /// A course-profile, week-4 scene (no `[render]` table, no textures) of these parts.

@@ -1,6 +1,10 @@
 //! A scene as a scene file states it ([`SceneDescription`]): the types of its tables, each with
-//! what its keys mean. Reading and writing the file is `scene::file`, checking it
-//! `scene::validate`.
+//! what its keys mean. Reading and writing the file is `file`, checking it `validate`, and
+//! writing it for Mitsuba 3 `mitsuba`.
+
+pub(super) mod file;
+pub(super) mod mitsuba;
+pub(super) mod validate;
 
 use std::path::PathBuf;
 

@@ -6,9 +6,9 @@ use std::collections::HashSet;
 
 use glam::DVec3;
 
-use super::error::invalid;
-use super::texture::{GENERATED_PICTURES, read_picture};
-use super::{
+use crate::scene::error::invalid;
+use crate::scene::texture::{GENERATED_PICTURES, read_picture};
+use crate::scene::{
     MaterialEntry, MaterialKind, ObjectEntry, PixelSampling, Profile, SceneDescription, SceneError,
     TextureEntry, TextureKind,
 };

@@ -26,7 +26,9 @@
 
 use std::fmt::Write as _;
 
-use super::{Background, MaterialEntry, MaterialKind, ObjectEntry, Profile, SceneDescription};
+use crate::scene::{
+    Background, MaterialEntry, MaterialKind, ObjectEntry, Profile, SceneDescription,
+};
 
 /// Why a scene cannot be written for Mitsuba (one line).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -144,7 +146,7 @@ pub fn to_mitsuba_xml(d: &SceneDescription) -> Result<String, MitsubaError> {
     }
     let camera = d.camera(None);
     let mut out = String::new();
-    out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!-- Written by rtoracle (scene::mitsuba): the reference's physics where Mitsuba shares it. -->\n<scene version=\"3.0.0\">\n");
+    out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!-- Written by rtoracle (scene::description::mitsuba): the reference's physics where Mitsuba shares it. -->\n<scene version=\"3.0.0\">\n");
     let _ = writeln!(
         out,
         "    <integrator type=\"path\"><integer name=\"max_depth\" value=\"{}\"/></integrator>",

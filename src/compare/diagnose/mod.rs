@@ -1,9 +1,16 @@
 //! When an image fails: test the common mistakes as alternative hypotheses and name the one
 //! that explains the image.
+//!
+//! `hypotheses` holds each mistake's transform of the golden (a scale, a zoom, a colour change);
+//! [`mistakes`] is the catalogue of those mistakes injected into the reference renderer, the
+//! images the comparison must reject and this diagnosis must name (used by tests and the
+//! benchmark).
+
+mod hypotheses;
+pub mod mistakes;
 
 use rayon::prelude::*;
 
-use super::hypotheses;
 use super::{
     CandidateImage, CompareOptions, Diagnosis, ENCODINGS, Encoding, Evaluation, Golden,
     HypothesisScore, evaluate,
