@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 
-use super::bwrap;
 use super::identity::{self, running_as_root};
 use super::lifecycle::Sandbox;
 use super::policy::{Isolation, Mode, SandboxError, SandboxPolicy};
+use super::start::bwrap;
 
 /// Whether bubblewrap works here, probed once per process (as the identity it would run as):
 /// `Err` says why not.

@@ -6,10 +6,10 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use super::bwrap;
 use super::identity::running_as_root;
 use super::lifecycle::Sandbox;
 use super::policy::{Isolation, SandboxPolicy};
+use super::start::bwrap;
 
 /// What the sandbox did, for the report.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -160,7 +160,7 @@ impl Sandbox {
                 std::fs::read_to_string(group.path().join("memory.max"))
                     .unwrap_or_default()
                     .trim(),
-                super::cgroup::CPU_WEIGHT
+                super::bounds::cgroup::CPU_WEIGHT
             )),
             _ => None,
         };

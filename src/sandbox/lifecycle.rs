@@ -7,11 +7,12 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use super::admission::InfoSlot;
+use super::bounds::reaper::Reaper;
+use super::bounds::{cgroup, held, ipc, scratch, watchdog};
 use super::identity::{self, running_as_root};
 use super::policy::{Isolation, SandboxError, SandboxPolicy};
-use super::reaper::Reaper;
-use super::{bwrap, cgroup, held, ipc, scratch, view, watchdog};
+use super::start::admission::InfoSlot;
+use super::start::{bwrap, view};
 
 /// A prepared sandbox: a temporary folder holding copies of the files, the policy, the
 /// isolation and the identity the code runs as.

@@ -15,7 +15,7 @@
 //!   is probed once per process (it fails in containers that refuse user namespaces). The code
 //!   runs in new user, PID, mount, IPC, network, UTS (and cgroup, where allowed) namespaces, with
 //!   `--die-with-parent`, `--new-session`, `--disable-userns`, `--cap-drop ALL`, a cleared
-//!   environment and a view of its own ([`view`], [`bwrap`]): the system's `/usr` and `/lib*`,
+//!   environment and a view of its own ([`start::view`], [`start::bwrap`]): the system's `/usr` and `/lib*`,
 //!   the loader's `/etc` files, a read-only `/dev` (but a 4 MiB tmpfs at `/dev/shm`, for
 //!   `multiprocessing`), a `/tmp` that is a tmpfs of bounded size, the
 //!   sandbox folder at `/sandbox`, and the paths exposed read-only (an interpreter and its
@@ -28,7 +28,7 @@
 //!   limits, its own session, the per-submission uid and gid, with the sandbox folder owned by
 //!   that uid, mode `0700`, and, each where the kernel allows it (attempted, verified from
 //!   `/proc/<pid>/ns`, never assumed): a network namespace, an IPC namespace with its limits
-//!   ([`ipc`]; System V objects die with it, and are swept by owner where it cannot be made),
+//!   ([`bounds::ipc`]; System V objects die with it, and are swept by owner where it cannot be made),
 //!   and a mount namespace in which the child builds the same view as bubblewrap's on a new root
 //!   (`pivot_root`, `pivot`), with a `/proc` mounted `hidepid=2` (the code sees only its own
 //!   processes: not the grader's command line, which names its binary, rubric and folders).
@@ -45,13 +45,13 @@
 //!   sandbox's processes alone (a harness that is not root gave a fork bomb no limit: 1527 forks
 //!   in 2 s); where it cannot be set, that process is killed. File descriptors other than the
 //!   standard three are closed.
-//! - **Every byte it holds bounded and counted, nothing left** ([`watchdog`], [`held`],
-//!   [`scratch`], [`ipc`]): a watchdog ends the code once its files (its folder, its `/tmp`
+//! - **Every byte it holds bounded and counted, nothing left** ([`bounds::watchdog`], [`bounds::held`],
+//!   [`bounds::scratch`], [`bounds::ipc`]): a watchdog ends the code once its files (its folder, its `/tmp`
 //!   tmpfs, what a per-submission uid owns in the host's world-writable folders, the unlinked
 //!   files and memfds its processes hold open) pass the policy's `disk_bytes`, or the resident
 //!   memory of all its processes and its System V shared memory together pass `memory_bytes`;
 //!   the tmpfs's size and the IPC namespace's `shmall` bound them between two ticks, and
-//!   cgroups v2 where the host delegates them ([`cgroup`]). What a uid left in the host's
+//!   cgroups v2 where the host delegates them ([`bounds::cgroup`]). What a uid left in the host's
 //!   folders and IPC namespace is swept when the sandbox goes.
 //! - **No rtoracle binary reachable** ([`oracles`]): every rtoracle binary the view would show
 //!   is covered with an empty file, found by inode or content, never by name.
@@ -84,40 +84,30 @@
 //! does, with far fewer users).
 //!
 //! # Where each part lives
-//! `policy` (limits, modes, isolations), `detect` (which isolation works here, and
-//! [`Sandbox::new`]), `lifecycle` (a [`Sandbox`]: its folder, identity, watchdog and cleanup),
-//! `command` ([`Sandbox::command`]), `admission` (bubblewrap's first process, limited before it
-//! goes on), `child` (between fork and exec), `pivot` (the fallback's view, made in the child),
-//! `probe` (trusted helpers run inside), `facts` ([`SandboxFacts`]), `reaper` ([`Reaper`]),
-//! `paths` ([`replace_path`]), `originals` ([`keep_from_sandboxes`]); and the public [`view`]
-//! (what the code sees of the host), [`bwrap`] (bubblewrap's command line), [`identity`] (uids),
-//! [`ipc`] (IPC limits and objects), [`oracles`] (rtoracle binaries), [`cgroup`], [`scratch`]
-//! (what the code may write where), [`held`] (what its processes hold) and [`watchdog`] (the
-//! limits enforced while it runs).
+//! Two rooms and the sandbox's own files. [`start`]: the command that runs a program inside
+//! ([`Sandbox::command`]), bubblewrap's command line, the child between fork and exec, the
+//! fallback's view made in the child, what the code sees of the host, and bubblewrap's first
+//! process limited before it goes on. [`bounds`]: what the code may write where, what its
+//! processes hold, its IPC, its cgroup, the watchdog that enforces the limits while it runs and
+//! the [`Reaper`]. Here: `policy` (limits, modes, isolations), `detect` (which isolation works
+//! here, and [`Sandbox::new`]), `lifecycle` (a [`Sandbox`]: its folder, identity, watchdog and
+//! cleanup), `probe` (trusted helpers run inside), `facts` ([`SandboxFacts`]), `paths`
+//! ([`replace_path`]), `originals` ([`keep_from_sandboxes`]), [`identity`] (uids) and
+//! [`oracles`] (rtoracle binaries).
 
-mod admission;
-pub mod bwrap;
-pub mod cgroup;
-mod child;
-mod command;
+pub mod bounds;
 mod detect;
 mod facts;
-pub mod held;
 pub mod identity;
-pub mod ipc;
 mod lifecycle;
 pub mod oracles;
 mod originals;
 mod paths;
-mod pivot;
 mod policy;
 mod probe;
-mod reaper;
-pub mod scratch;
-pub mod view;
-pub mod watchdog;
+pub mod start;
 
-pub use command::SANDBOX_PATH;
+pub use bounds::reaper::{Reaper, kill_group};
 pub use detect::{bubblewrap_works, isolation_for};
 pub use facts::{SandboxFacts, announce, announce_on_stderr};
 pub use identity::{lookup_user, running_as_root};
@@ -125,7 +115,7 @@ pub use lifecycle::{MAX_COPIED_FILE_BYTES, Sandbox};
 pub use originals::{Restore, keep_from_sandboxes};
 pub use paths::replace_path;
 pub use policy::{Isolation, Mode, SandboxError, SandboxPolicy};
-pub use reaper::{Reaper, kill_group};
+pub use start::command::SANDBOX_PATH;
 
 #[cfg(test)]
 mod tests;

@@ -87,7 +87,7 @@ pub struct SandboxPolicy {
     /// CPU seconds per process (`RLIMIT_CPU`; a restart starts afresh).
     pub cpu_seconds: u64,
     /// Address space of each process in bytes (`RLIMIT_AS`), and the resident memory of all the
-    /// code's processes together ([`Watchdog`](super::watchdog::Watchdog)).
+    /// code's processes together ([`Watchdog`](super::bounds::watchdog::Watchdog)).
     pub memory_bytes: u64,
     /// Open files (`RLIMIT_NOFILE`).
     pub open_files: u64,
@@ -97,7 +97,7 @@ pub struct SandboxPolicy {
     /// bubblewrap's user namespace for any harness (elsewhere it would count every process of
     /// the harness's user).
     pub processes: u64,
-    /// Bytes the code may keep in files, its `/tmp` included ([`Watchdog`](super::watchdog::Watchdog)).
+    /// Bytes the code may keep in files, its `/tmp` included ([`Watchdog`](super::bounds::watchdog::Watchdog)).
     #[serde(default = "default_disk_bytes")]
     pub disk_bytes: u64,
     /// Try a new network namespace in the fallback (bubblewrap always makes one).

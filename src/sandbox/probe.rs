@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
+use super::bounds::reaper::kill_group;
 use super::lifecycle::Sandbox;
-use super::reaper::kill_group;
 
 impl Sandbox {
     /// as an interpreter's. Returns the exit status's success and stdout, or why it did not run.

@@ -911,7 +911,7 @@ fn in_the_fallback_the_host_is_read_only_but_the_code_s_own_folder() {
     // Outside the shared folders, as a batch folder would be (a checkout under /tmp puts the
     // target folder inside one).
     let shared = |p: &Path| {
-        rtoracle::sandbox::scratch::SHARED_ROOTS
+        rtoracle::sandbox::bounds::scratch::SHARED_ROOTS
             .iter()
             .any(|root| p.starts_with(root))
     };

@@ -4,10 +4,10 @@
 //!
 //! Promises: it measures the blocks the sandbox folder holds, the tmpfs of the code's own view
 //! (`/tmp`), for a per-submission uid the blocks of everything that uid owns under
-//! [`SHARED_ROOTS`](super::scratch::SHARED_ROOTS), and the code's processes ([`Members`]: those
+//! [`SHARED_ROOTS`](crate::sandbox::bounds::scratch::SHARED_ROOTS), and the code's processes ([`Members`]: those
 //! of its uid, of its bubblewrap PID namespaces, or of its sessions): the unlinked files and
 //! memfds they hold open count as files, and their resident memory (a page shared by forked
-//! processes once) and their System V shared memory as memory ([`super::held`]). Past the
+//! processes once) and their System V shared memory as memory ([`crate::sandbox::bounds::held`]). Past the
 //! policy's `disk_bytes` (or [`MAX_ENTRIES`] files and folders, or [`MAX_NESTING`] levels) or
 //! `memory_bytes` (or when the kernel ended a process at its cgroup's `memory.max`) it ends the
 //! code's processes and records why ([`Watchdog::violation`]); the session then says so instead
@@ -20,9 +20,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use super::held::{Members, process_usage};
-use super::reaper::Reaper;
-use super::scratch::{MAX_ENTRIES, MAX_NESTING, Usage, owned_usage, usage_of_tree};
+use crate::sandbox::bounds::held::{Members, process_usage};
+use crate::sandbox::bounds::reaper::Reaper;
+use crate::sandbox::bounds::scratch::{
+    MAX_ENTRIES, MAX_NESTING, Usage, owned_usage, usage_of_tree,
+};
 
 /// The limits the [`Watchdog`] enforces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +38,7 @@ pub struct Limits {
 
 /// Whether the kernel ended a process of the cgroup at `memory.max` (where it has one).
 fn cgroup_ran_out(cgroup: Option<&std::path::Path>) -> bool {
-    cgroup.is_some_and(|c| super::cgroup::oom_kills_in(c) > 0)
+    cgroup.is_some_and(|c| crate::sandbox::bounds::cgroup::oom_kills_in(c) > 0)
 }
 
 /// How often the watchdog measures.

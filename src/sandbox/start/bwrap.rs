@@ -1,7 +1,7 @@
 //! The bubblewrap command line: which namespaces, which view, what is mounted where, and
 //! reading back what bubblewrap made (`--info-fd`).
 //!
-//! Promises: the sandbox sees the system view and the exposed paths ([`super::view`]: read-only,
+//! Promises: the sandbox sees the system view and the exposed paths ([`crate::sandbox::start::view`]: read-only,
 //! its rtoracle binaries covered with an empty file), a fresh `/proc` of the new PID namespace, a
 //! minimal read-only `/dev` whose `/dev/shm` is a tmpfs of [`SHM_BYTES`] (the semaphores and
 //! locks of Python's `multiprocessing`), a `/tmp` that is a tmpfs of bounded size
@@ -13,7 +13,7 @@
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use super::view::{SystemEntry, View, system};
+use crate::sandbox::start::view::{SystemEntry, View, system};
 
 /// The size of the tmpfs at `/dev/shm`: room for the POSIX semaphores and locks of Python's
 /// `multiprocessing` (a `Pool` makes a handful, a page each), small enough that what it holds

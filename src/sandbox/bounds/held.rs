@@ -1,6 +1,6 @@
 //! What a sandbox's processes hold: which processes are its code's ([`Members`]), their
 //! resident memory (a page shared by forked processes once), the unlinked files and memfds they
-//! hold open, the System V shared memory of a uid or of their own IPC namespaces ([`super::ipc`]),
+//! hold open, the System V shared memory of a uid or of their own IPC namespaces ([`crate::sandbox::bounds::ipc`]),
 //! and the tmpfs of their own view.
 
 use std::collections::{HashMap, HashSet};
@@ -149,7 +149,7 @@ pub fn process_usage(members: &Members) -> ProcessUsage {
     let mut views: HashMap<u64, u32> = HashMap::new();
     let mut ipcs: HashMap<u64, u32> = HashMap::new();
     let mut files = HashSet::new();
-    for (pid, proc_dir) in super::identity::proc_entries() {
+    for (pid, proc_dir) in crate::sandbox::identity::proc_entries() {
         if pid == std::process::id() || !is_member(members, &proc_dir, &sessions, &namespaces) {
             continue;
         }
@@ -177,9 +177,9 @@ pub fn process_usage(members: &Members) -> ProcessUsage {
     }
     usage.tmpfs_bytes = views.values().map(|&pid| tmpfs_bytes_of(pid)).sum();
     let theirs: Vec<u32> = ipcs.values().copied().collect();
-    usage.ipc_bytes = super::ipc::shm_bytes_of(&theirs).unwrap_or(0);
+    usage.ipc_bytes = crate::sandbox::bounds::ipc::shm_bytes_of(&theirs).unwrap_or(0);
     if let Members::Uid(uid) = members {
-        let own_ns: u64 = super::ipc::ipc_objects(*uid)
+        let own_ns: u64 = crate::sandbox::bounds::ipc::ipc_objects(*uid)
             .iter()
             .filter(|o| o.table == "shm")
             .map(|o| o.bytes)
@@ -200,12 +200,12 @@ mod tests {
     /// made a forking submission "hold more than 1 GiB" that it did not hold).
     #[test]
     fn memory_shared_by_forked_children_is_counted_once() {
-        if !super::super::running_as_root() || !Path::new("/usr/bin/python3").exists() {
+        if !crate::sandbox::running_as_root() || !Path::new("/usr/bin/python3").exists() {
             eprintln!("skipped: needs root and /usr/bin/python3");
             return;
         }
         use std::os::unix::process::CommandExt;
-        let uid = super::super::identity::allocate();
+        let uid = crate::sandbox::identity::allocate();
         let mut parent = std::process::Command::new("/usr/bin/python3")
             .args([
                 "-c",
@@ -228,7 +228,7 @@ mod tests {
         std::thread::sleep(Duration::from_millis(200));
         let cheap = process_usage(&Members::Uid(uid));
         let exact = cheap.proportional();
-        super::super::identity::kill_all(uid);
+        crate::sandbox::identity::kill_all(uid);
         let _ = parent.wait();
         assert_eq!(seen.processes, 21, "{seen:?}");
         // Resident sets count the 100 MiB 21 times; proportional sets about once.
@@ -242,12 +242,12 @@ mod tests {
     /// A uid's System V segment with no process left counts as the uid's memory.
     #[test]
     fn a_uid_s_segment_counts_as_its_memory() {
-        if !super::super::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
+        if !crate::sandbox::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
             eprintln!("skipped: needs root and ipcmk");
             return;
         }
         use std::os::unix::process::CommandExt;
-        let uid = super::super::identity::allocate();
+        let uid = crate::sandbox::identity::allocate();
         let out = std::process::Command::new("/usr/bin/ipcmk")
             .args(["-M", "1048576"])
             .uid(uid)
@@ -256,7 +256,7 @@ mod tests {
             .unwrap();
         assert!(out.status.success(), "{out:?}");
         let usage = process_usage(&Members::Uid(uid));
-        assert_eq!(super::super::ipc::sweep_ipc(uid), 1);
+        assert_eq!(crate::sandbox::bounds::ipc::sweep_ipc(uid), 1);
         assert_eq!(usage.memory, 1 << 20, "no process, the segment alone");
     }
 }

@@ -12,7 +12,7 @@
 //!   library tree (`lib`, `lib64`, `pyvenv.cfg`), never the rest of that `bin/` (where a venv
 //!   holding the student wheel keeps an `rtoracle`); for another program or a file, its folder;
 //!   the file alone in a shared folder (`/tmp`, `/home`, a home, ...).
-//! - [`View::new`] covers every rtoracle binary the view would show ([`super::oracles`]: by
+//! - [`View::new`] covers every rtoracle binary the view would show ([`crate::sandbox::oracles`]: by
 //!   inode or content, not by name): in the exposed paths (looked at in depth), in the system's
 //!   program folders and `/usr/local` (by the marker's ELF section), and the running binary
 //!   wherever it lies in the view.
@@ -20,7 +20,7 @@
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use super::oracles;
+use crate::sandbox::oracles;
 
 /// Top-level folders of the host shown read-only (or as the links they are).
 const SYSTEM: [&str; 7] = [

@@ -5,16 +5,16 @@ use std::path::PathBuf;
 use std::process::Child;
 use std::sync::{Arc, Mutex};
 
-use super::identity;
+use crate::sandbox::identity;
 
 /// Ends what a sandbox's code started: its process groups and, for a per-submission uid, every
 /// process of that uid. Cheap to clone; usable after the sandbox is gone.
 #[derive(Clone, Debug)]
 pub struct Reaper {
-    pub(super) uid: Option<u32>,
-    pub(super) groups: Arc<Mutex<Vec<i32>>>,
+    pub(in crate::sandbox) uid: Option<u32>,
+    pub(in crate::sandbox) groups: Arc<Mutex<Vec<i32>>>,
     /// The sandbox's cgroup, whose `cgroup.kill` ends every process in it.
-    pub(super) cgroup: Option<PathBuf>,
+    pub(in crate::sandbox) cgroup: Option<PathBuf>,
 }
 
 impl Reaper {
@@ -50,7 +50,7 @@ impl Reaper {
     }
 }
 
-/// Kills a child spawned from [`Sandbox::command`](super::Sandbox::command) and everything in its process group, and
+/// Kills a child spawned from [`Sandbox::command`](crate::sandbox::Sandbox::command) and everything in its process group, and
 /// reaps it.
 pub fn kill_group(child: &mut Child) {
     // SAFETY: the child leads its own process group (setsid) and is not reaped yet, so its pid

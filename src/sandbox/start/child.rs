@@ -2,16 +2,16 @@
 //! own session, no inherited descriptors, the fallback's namespaces and read-only view, the
 //! limits, the identity, and death with the harness.
 
-use super::ipc::Limits as IpcLimits;
-use super::pivot::ViewPlan;
-use super::policy::SandboxPolicy;
+use crate::sandbox::bounds::ipc::Limits as IpcLimits;
+use crate::sandbox::policy::SandboxPolicy;
+use crate::sandbox::start::pivot::ViewPlan;
 
 /// `RLIMIT_MSGQUEUE`: the bytes of POSIX message queues the code's user may hold.
 const MSGQUEUE_BYTES: u64 = 1 << 20;
 
 /// Everything the child's set-up needs, made before the fork (after it, nothing may allocate).
 #[derive(Debug)]
-pub(super) struct ChildSetup {
+pub(in crate::sandbox) struct ChildSetup {
     policy: SandboxPolicy,
     /// `(uid, gid)` to switch to.
     switch_to: Option<(u32, u32)>,
@@ -27,7 +27,7 @@ pub(super) struct ChildSetup {
 
 /// What the fallback's child attempts: namespaces, the limits of its IPC namespace, its view.
 #[derive(Debug)]
-pub(super) struct Fallback {
+pub(in crate::sandbox) struct Fallback {
     /// A network namespace too.
     pub network: bool,
     /// Written inside its new IPC namespace.
@@ -40,7 +40,7 @@ impl ChildSetup {
     /// The set-up of a child under `policy`, switching to `switch_to`, with the fallback's
     /// namespaces when `fallback`, keeping `keep` open, joining the cgroup whose `cgroup.procs`
     /// is `cgroup`.
-    pub(super) fn new(
+    pub(in crate::sandbox) fn new(
         policy: &SandboxPolicy,
         switch_to: Option<(u32, u32)>,
         fallback: Option<Fallback>,
@@ -66,7 +66,7 @@ impl ChildSetup {
     /// async-signal-safe system calls (setsid, open, write, close, unshare, mount,
     /// mount_setattr, pivot_root, chdir, setrlimit, setgroups, setgid, setuid, prctl, getppid,
     /// fcntl, close_range) and allocates nothing.
-    pub(super) unsafe fn run(&self) -> std::io::Result<()> {
+    pub(in crate::sandbox) unsafe fn run(&self) -> std::io::Result<()> {
         // SAFETY: the caller's contract; each call is a plain system call on owned data.
         unsafe {
             if libc::setsid() < 0 {

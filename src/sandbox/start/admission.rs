@@ -6,12 +6,12 @@ use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::ipc::Limits as IpcLimits;
+use crate::sandbox::bounds::ipc::Limits as IpcLimits;
 
 /// The harness's side of one bubblewrap start: the descriptors bubblewrap is given, and the
 /// harness's copies of them, which must live until the command is spawned and then close.
 #[derive(Debug)]
-pub(super) struct Admission {
+pub(in crate::sandbox) struct Admission {
     /// bubblewrap's `--info-fd`.
     pub info_fd: i32,
     /// bubblewrap's `--block-fd`.
@@ -23,7 +23,7 @@ pub(super) struct Admission {
 
 /// The limits set on a bubblewrap sandbox's first process before it goes on.
 #[derive(Debug)]
-pub(super) struct Limits {
+pub(in crate::sandbox) struct Limits {
     /// `RLIMIT_NPROC` (a harness that is not root: see [`admit`]).
     pub processes: Option<u64>,
     /// Written inside its IPC namespace (a root harness: only root may write them there).
@@ -33,7 +33,7 @@ pub(super) struct Limits {
 /// Starts the admission of one bubblewrap command ([`admit`] on a thread of its own), filling
 /// `slot` with what bubblewrap reports; `None` when its pipes or its thread cannot be made (the
 /// command must then fail: its processes could not be limited).
-pub(super) fn start(
+pub(in crate::sandbox) fn start(
     slot: Arc<InfoSlot>,
     limits: Limits,
     namespaces: Arc<Mutex<Vec<u64>>>,
@@ -53,19 +53,19 @@ pub(super) fn start(
 
 /// What bubblewrap's `--info-fd` said for one command, once its admission has read it.
 #[derive(Debug, Default)]
-pub(super) struct InfoSlot {
+pub(in crate::sandbox) struct InfoSlot {
     text: Mutex<Option<String>>,
     ready: std::sync::Condvar,
 }
 
 impl InfoSlot {
-    pub(super) fn set(&self, text: String) {
+    pub(in crate::sandbox) fn set(&self, text: String) {
         *self.text.lock().unwrap_or_else(|e| e.into_inner()) = Some(text);
         self.ready.notify_all();
     }
 
     /// The text, waiting up to `timeout` for it (empty when it does not come).
-    pub(super) fn wait(&self, timeout: Duration) -> String {
+    pub(in crate::sandbox) fn wait(&self, timeout: Duration) -> String {
         let guard = self.text.lock().unwrap_or_else(|e| e.into_inner());
         let (guard, _) = self
             .ready
@@ -128,7 +128,7 @@ fn admit(
 }
 
 /// A pipe whose both ends close on exec (the child's end is made inheritable in `pre_exec`).
-pub(super) fn cloexec_pipe() -> std::io::Result<(OwnedFd, OwnedFd)> {
+pub(in crate::sandbox) fn cloexec_pipe() -> std::io::Result<(OwnedFd, OwnedFd)> {
     let mut fds = [0; 2];
     // SAFETY: pipe2 writes two fds into the array on success.
     if unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {

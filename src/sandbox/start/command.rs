@@ -9,15 +9,15 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
 
-use super::admission::{self, InfoSlot};
-use super::bwrap;
-use super::child::{ChildSetup, Fallback};
-use super::identity::running_as_root;
-use super::ipc::Limits as IpcLimits;
-use super::lifecycle::Sandbox;
-use super::pivot::ViewPlan;
-use super::policy::Isolation;
-use super::view::{self, View};
+use crate::sandbox::bounds::ipc::Limits as IpcLimits;
+use crate::sandbox::identity::running_as_root;
+use crate::sandbox::lifecycle::Sandbox;
+use crate::sandbox::policy::Isolation;
+use crate::sandbox::start::admission::{self, InfoSlot};
+use crate::sandbox::start::bwrap;
+use crate::sandbox::start::child::{ChildSetup, Fallback};
+use crate::sandbox::start::pivot::ViewPlan;
+use crate::sandbox::start::view::{self, View};
 
 /// The `PATH` inside the sandbox (the harness's own `PATH` may lead to a root-only Python).
 pub const SANDBOX_PATH: &str = "/usr/local/bin:/usr/bin:/bin";

@@ -1,5 +1,5 @@
 //! The fallback's own view of the file system, made by its child in a mount namespace of its
-//! own (a root harness without bubblewrap): the same view as bubblewrap's ([`super::view`]), on
+//! own (a root harness without bubblewrap): the same view as bubblewrap's ([`crate::sandbox::start::view`]), on
 //! a new root that replaces the host's (`pivot_root`).
 //!
 //! Promises:
@@ -20,7 +20,7 @@ use std::ffi::CString;
 use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
 
-use super::view::{SystemEntry, View, system};
+use crate::sandbox::start::view::{SystemEntry, View, system};
 
 /// The device nodes of the minimal `/dev`.
 const DEVICES: [&str; 6] = ["null", "zero", "full", "random", "urandom", "tty"];
@@ -90,7 +90,7 @@ struct Planned {
 
 /// The whole view, ready to be applied in a child.
 #[derive(Debug)]
-pub(super) struct ViewPlan {
+pub(in crate::sandbox) struct ViewPlan {
     root: CString,
     steps: Vec<Planned>,
     /// The sandbox folder, the working directory once the root is swapped.
@@ -176,7 +176,12 @@ impl Planner {
 impl ViewPlan {
     /// The plan of `view` on a new root mounted on `root` (an empty folder), with the sandbox
     /// folder `dir` writable and a `/tmp` of `tmp_bytes`.
-    pub(super) fn new(view: &View, dir: &Path, root: &Path, tmp_bytes: u64) -> ViewPlan {
+    pub(in crate::sandbox) fn new(
+        view: &View,
+        dir: &Path,
+        root: &Path,
+        tmp_bytes: u64,
+    ) -> ViewPlan {
         let mut p = Planner {
             root: root.to_path_buf(),
             made: Default::default(),
@@ -221,7 +226,7 @@ impl ViewPlan {
         p.push(Step::ReadOnly(c(&under(root, Path::new("/dev")))), true);
         p.tmpfs(
             Path::new("/dev/shm"),
-            format!("size={},mode=1777", super::bwrap::SHM_BYTES),
+            format!("size={},mode=1777", crate::sandbox::start::bwrap::SHM_BYTES),
         );
         let proc_dir = under(root, Path::new("/proc"));
         p.folders(&proc_dir, true);
@@ -262,7 +267,7 @@ impl ViewPlan {
     /// # Safety
     /// Only in a child between `fork` and `exec`, in a mount namespace of its own whose mounts
     /// are private: it makes only system calls and allocates nothing.
-    pub(super) unsafe fn apply(&self) -> std::io::Result<()> {
+    pub(in crate::sandbox) unsafe fn apply(&self) -> std::io::Result<()> {
         for planned in &self.steps {
             // SAFETY: the caller's contract.
             match unsafe { run(&planned.step) } {

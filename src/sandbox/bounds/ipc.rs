@@ -213,13 +213,13 @@ mod tests {
     /// by owner and removed, and another uid's are not touched.
     #[test]
     fn a_uid_s_system_v_objects_are_measured_and_swept() {
-        if !super::super::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
+        if !crate::sandbox::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
             eprintln!("skipped: needs root and ipcmk");
             return;
         }
         use std::os::unix::process::CommandExt;
-        let uid = super::super::identity::allocate();
-        let other = super::super::identity::allocate();
+        let uid = crate::sandbox::identity::allocate();
+        let other = crate::sandbox::identity::allocate();
         let make = |uid: u32, args: &[&str]| {
             let out = std::process::Command::new("/usr/bin/ipcmk")
                 .args(args)
