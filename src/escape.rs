@@ -22,7 +22,7 @@
 //! `Untrusted` what a submission names or says, whole: its folder's name, each check's message
 //! (a render's exception, a copy finding, the code's error), each failing vector's message,
 //! why its code could not run and what it wrote to stderr
-//! (`tests/integration/hostile.rs` sends a hostile payload through every path into every
+//! (`tests/integration/attacks/hostile.rs` sends a hostile payload through every path into every
 //! format).
 //!
 //! No function here bounds length: caps belong to the harness that keeps the text ([`truncate`]

@@ -1,36 +1,15 @@
-//! One integration-test binary with a module per area (as ripgrep does).
+//! One integration-test binary with a module per area (as ripgrep does), each area a folder:
+//! render (the reference, goldens, Mitsuba), oracle, check (the protocol, the weekly and physics
+//! checks), compare, course (the course's real code), grade, attacks (hostile submissions and the
+//! sandbox) and cli (every subcommand's principles, the docs' examples).
 
 mod architecture;
-mod assignment;
 mod attacks;
-mod attacks_renders;
 mod check;
 mod cli;
 mod common;
 mod compare;
-mod compare_report;
-mod compare_two;
-mod course_code;
-mod course_grades;
-mod course_weeks;
-mod feedback;
-mod functions;
-mod golden;
+mod course;
 mod grade;
-mod grade_weeks;
-mod hostile;
-mod mitsuba;
 mod oracle;
-mod oracle_props;
-mod physics;
-mod protocol;
-mod raised;
-mod readme;
 mod render;
-mod render_weeks;
-mod renders;
-mod reports;
-mod sandbox;
-mod schemas;
-mod shards;
-mod verdicts;

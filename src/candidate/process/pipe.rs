@@ -33,7 +33,7 @@ pub const LINE_QUEUE: usize = 1024;
 
 /// The environment variable naming a file that every byte sent to a candidate is appended to:
 /// how the tests (and a wary instructor) see everything that left the grader, to check that no
-/// secret did (`tests/integration/attacks.rs`). The grader's own environment only: a candidate
+/// secret did (`tests/integration/attacks/mod.rs`). The grader's own environment only: a candidate
 /// never sees it.
 pub const RECORD_REQUESTS_ENV: &str = "RTORACLE_RECORD_REQUESTS";
 

@@ -19,7 +19,7 @@
 //! `lambda` times the golden's, plus the golden's own error and the code's half width. A render
 //! fails when that chance is below [`FLOOR_ALPHA`].
 //!
-//! Measured (`tests/integration/attacks_renders.rs`, `course_grades.rs`): the course's own
+//! Measured (`tests/integration/attacks/renders.rs`, `course_grades.rs`): the course's own
 //! renders pass it, and a reference render at 64 spp or more claimed as 2 to 5 spp fails it.
 
 use serde::Serialize;

@@ -2,7 +2,7 @@
 //! one check, whatever their layout: the word for its result, where an exception was raised, the
 //! body of a failing check and the short note on vectors where rounding decides.
 //!
-//! The promises, tested in `tests/integration/feedback.rs`: ambiguous vectors are never called
+//! The promises, tested in `tests/integration/grade/feedback.rs`: ambiguous vectors are never called
 //! failures (they "differ from the exact answer where rounding decides (not scored)", last and
 //! short); a missing image is "missing" wherever it is named; an exception names the file and
 //! line of the student's code it was raised in, and the same error is said once, not in every

@@ -1,6 +1,13 @@
 //! `rtoracle grade` and `rtoracle autograder` end to end on this repository's fixture
 //! submissions (tests/fixtures/submissions, images rendered at test time).
 
+mod feedback;
+mod reports;
+mod schemas;
+mod shards;
+mod verdicts;
+mod weeks;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Output;

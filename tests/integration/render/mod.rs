@@ -1,6 +1,11 @@
 //! The reference tracer end to end: agreement with the course's published images, analytic
 //! checks with closed forms, determinism, the scene files, and the command line's bad input.
 
+mod golden;
+mod mitsuba;
+mod renders;
+mod weeks;
+
 use std::path::Path;
 
 use rtoracle::geometry::DVec3;

@@ -5,7 +5,7 @@
 //! snapshotted at 256 spp (their 4096-spp renders would double this file's cost) and their
 //! committed goldens are checked against that render with an exact bound (see
 //! [`prefix_mean_bound`]). Review changed snapshots with `cargo insta review`, or accept them all
-//! with `INSTA_UPDATE=always cargo test --test integration golden::`.
+//! with `INSTA_UPDATE=always cargo test --test integration render::golden::`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -126,8 +126,8 @@ fn golden_dir() -> PathBuf {
 
 fn snapshot_file(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/integration/snapshots")
-        .join(format!("integration__golden__{name}.snap.exr"))
+        .join("tests/integration/render/snapshots")
+        .join(format!("integration__render__golden__{name}.snap.exr"))
 }
 
 fn committed(scene: &str) -> ExrImage {
@@ -277,7 +277,7 @@ fn snapshots_are_the_golden_files() {
         assert!(
             diff.is_match(),
             "golden/{scene}.exr vs its insta snapshot: {}; update both: `rtoracle golden`, then \
-             `INSTA_UPDATE=always cargo test --test integration golden::`",
+             `INSTA_UPDATE=always cargo test --test integration render::golden::`",
             diff.summary(snap.width * snap.height)
         );
     }

@@ -5,6 +5,10 @@
 //! so they hold whatever the real suite becomes; the CLI tests that run the built-in suite only
 //! rely on it having definite sphere and quad vectors (marked "suite:").
 
+mod physics;
+mod protocol;
+mod weekly;
+
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};

@@ -2,6 +2,9 @@
 //! mistake of IMAGES.md fails and the diagnosis names it, the course's PNGs pass, bad input
 //! exits 2 without leaving files behind.
 
+mod report;
+mod two;
+
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 

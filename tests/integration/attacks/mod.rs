@@ -16,6 +16,11 @@
 //! among them for the short sample lists): what the skeleton earns by itself elsewhere is the
 //! rubric weights' business.
 
+mod hostile;
+mod raised;
+mod renders;
+mod sandbox;
+
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;

@@ -38,7 +38,7 @@
 //! kind (bare, `text`, fenced with `~~~`, indented in a list...) fails the test: every transcript
 //! is a `console` block, or `console,no-run` with a reason.
 //!
-//! `RTORACLE_UPDATE_README=1 cargo test --release --test integration -- readme::` writes the real outputs
+//! `RTORACLE_UPDATE_README=1 cargo test --release --test integration -- cli::readme::` writes the real outputs
 //! of the examples that differ into their pages instead of comparing (the others keep their
 //! masked figures).
 //!
@@ -576,7 +576,7 @@ fn every_console_example_of_the_docs_is_real_output() {
     assert!(ran > 0, "no console block ran");
     assert!(
         failures.is_empty(),
-        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --release --test integration -- readme:: rewrites them):\n\n{}",
+        "{} examples of the docs differ (RTORACLE_UPDATE_README=1 cargo test --release --test integration -- cli::readme:: rewrites them):\n\n{}",
         failures.len(),
         failures.join("\n\n")
     );

@@ -13,6 +13,8 @@
 //! - SIGINT and SIGTERM mid-run: exit 130 / 143, no partial output, no temporary or sandbox
 //!   folder (the child gets a private `TMPDIR`).
 
+mod readme;
+
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::{Output, Stdio};

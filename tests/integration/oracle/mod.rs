@@ -1,6 +1,8 @@
 //! The oracle: `vectors` and `explain` on the command line, the fuzz corpora replayed, the
 //! filter against exact arithmetic on a million cases, and the reference against the oracle.
 
+mod props;
+
 use std::path::Path;
 
 use crate::common::*;
