@@ -45,6 +45,7 @@ pub use settings::{
     PixelSampling, RenderSettings,
 };
 pub use texture::{
-    GENERATED_PICTURES, RgbPicture, Texture, TextureImage, generated_picture, read_picture,
+    GENERATED_PICTURES, PictureError, RgbPicture, Texture, TextureImage, generated_picture,
+    read_picture,
 };
 pub use world::{PointLight, World};

@@ -188,24 +188,48 @@ pub struct RgbPicture {
     pub data: Vec<u8>,
 }
 
+/// Why a picture file cannot be a texture; each says so in a few words, to follow the file's
+/// name.
+#[derive(Debug, thiserror::Error)]
+pub enum PictureError {
+    /// There is no file at the path.
+    #[error("no such file")]
+    Missing,
+    /// The path is a folder.
+    #[error("it is a folder, not an image")]
+    Folder,
+    /// The file could not be read.
+    #[error("{0}")]
+    Unreadable(std::io::Error),
+    /// The content is no image format rtoracle knows.
+    #[error("not a PNG or JPEG image")]
+    NotAnImage,
+    /// An image, of a format other than PNG and JPEG (its name).
+    #[error("a {0} image, not a PNG or JPEG")]
+    OtherFormat(String),
+    /// A PNG or JPEG its decoder refused (the decoder's words).
+    #[error("cannot decode it: {0}")]
+    Undecodable(String),
+}
+
 /// Reads a PNG or JPEG file as 8-bit RGB (grey, palette, alpha and 16-bit images are converted:
-/// alpha dropped, 16 bits rounded to 8), or says why it cannot, in a few words.
+/// alpha dropped, 16 bits rounded to 8), or says why it cannot.
 ///
 /// The format is decided by the file's content, not its name. JPEG is decoded by the `image`
 /// crate's decoder, whose output can differ by a code here and there from the libjpeg build
 /// Pillow uses: a texture's golden is the reference's decoding.
-pub fn read_picture(path: &Path) -> Result<RgbPicture, String> {
+pub fn read_picture(path: &Path) -> Result<RgbPicture, PictureError> {
     let bytes = std::fs::read(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".to_string(),
-        std::io::ErrorKind::IsADirectory => "it is a folder, not an image".to_string(),
-        _ => e.to_string(),
+        std::io::ErrorKind::NotFound => PictureError::Missing,
+        std::io::ErrorKind::IsADirectory => PictureError::Folder,
+        _ => PictureError::Unreadable(e),
     })?;
-    let format = image::guess_format(&bytes).map_err(|_| "not a PNG or JPEG image".to_string())?;
+    let format = image::guess_format(&bytes).map_err(|_| PictureError::NotAnImage)?;
     if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
-        return Err(format!("a {format:?} image, not a PNG or JPEG"));
+        return Err(PictureError::OtherFormat(format!("{format:?}")));
     }
     let decoded = image::load_from_memory_with_format(&bytes, format)
-        .map_err(|e| format!("cannot decode it: {e}"))?;
+        .map_err(|e| PictureError::Undecodable(e.to_string()))?;
     let rgb = decoded.to_rgb8();
     Ok(RgbPicture {
         width: rgb.width() as usize,

@@ -64,6 +64,30 @@ fn hex_of(busy: &[(u32, [u8; 3])]) -> String {
     s
 }
 
+/// Why an entry file cannot be merged; each says so in words that follow the file's name.
+#[derive(Debug, thiserror::Error)]
+pub enum EntryError {
+    /// The file could not be read.
+    #[error("cannot read it ({0})")]
+    Unreadable(std::io::Error),
+    /// Its content is not an entry's JSON.
+    #[error("not a batch entry of rtoracle's: {0}")]
+    NotAnEntry(serde_json::Error),
+    /// An entry of another layout (another version of rtoracle wrote it).
+    #[error(
+        "a batch entry of layout {schema} {version}, this rtoracle reads {ENTRY_SCHEMA} {ENTRY_VERSION}"
+    )]
+    OtherLayout {
+        /// The layout's name the file states.
+        schema: String,
+        /// Its version.
+        version: u32,
+    },
+    /// A fingerprint's record is malformed (what is wrong with it).
+    #[error("{0}")]
+    BadFingerprint(String),
+}
+
 fn busy_of(hex: &str) -> Result<Vec<(u32, [u8; 3])>, String> {
     if hex.len() % 14 != 0 || !hex.is_ascii() {
         return Err("a fingerprint's busy pixels are not 7-byte hex records".into());
@@ -108,15 +132,14 @@ impl EntryFile {
     }
 
     /// Reads the entry file at `path`: the report with its fingerprints and failed vectors.
-    pub fn read(path: &Path) -> Result<GradeReport, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read it ({e})"))?;
-        let entry: EntryFile = serde_json::from_str(&text)
-            .map_err(|e| format!("not a batch entry of rtoracle's: {e}"))?;
+    pub fn read(path: &Path) -> Result<GradeReport, EntryError> {
+        let text = std::fs::read_to_string(path).map_err(EntryError::Unreadable)?;
+        let entry: EntryFile = serde_json::from_str(&text).map_err(EntryError::NotAnEntry)?;
         if entry.schema != ENTRY_SCHEMA || entry.version != ENTRY_VERSION {
-            return Err(format!(
-                "a batch entry of layout {} {}, this rtoracle reads {ENTRY_SCHEMA} {ENTRY_VERSION}",
-                entry.schema, entry.version
-            ));
+            return Err(EntryError::OtherLayout {
+                schema: entry.schema,
+                version: entry.version,
+            });
         }
         let mut report = entry.report;
         report.code.failed_vectors = entry.failed_vectors;
@@ -133,7 +156,8 @@ impl EntryFile {
                 };
                 Ok((f.group, Arc::new(fingerprint)))
             })
-            .collect::<Result<_, String>>()?;
+            .collect::<Result<_, String>>()
+            .map_err(EntryError::BadFingerprint)?;
         Ok(report)
     }
 }

@@ -287,7 +287,7 @@ pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<Vec<BatchEntry>, Mer
                 Ok(_) => {
                     let folder = dir.join(row.name.as_file_name());
                     let report = EntryFile::read(&folder.join(ENTRY_FILE))
-                        .map_err(|why| refuse(&folder.join(ENTRY_FILE), why))?;
+                        .map_err(|why| refuse(&folder.join(ENTRY_FILE), why.to_string()))?;
                     (
                         BatchEntry {
                             name: row.name.clone(),

@@ -78,6 +78,20 @@ pub fn folder_name(name: &std::ffi::OsStr) -> String {
 /// an error row of the batch, not graded (its reports would take their place).
 pub const BATCH_FILES: [&str; 3] = ["gradebook.csv", "summary.md", "batch.json"];
 
+/// Why a text is not a shard (`K/N`); each names the text.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum ShardError {
+    /// No `/` between two numbers.
+    #[error("{0:?} is not K/N (shard K of N, as 2/3)")]
+    NotKOfN(String),
+    /// K or N is not a whole number.
+    #[error("{0:?} is not K/N with whole numbers (as 2/3)")]
+    NotWhole(String),
+    /// N is 0, or K is 0 or past N.
+    #[error("{0:?}: K must be from 1 to N, and N at least 1")]
+    OutOfRange(String),
+}
+
 /// One share of a batch: shard `k` of `n` (1 <= k <= n), as `--shard K/N` names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shard {
@@ -89,16 +103,16 @@ pub struct Shard {
 
 impl Shard {
     /// Reads `K/N`.
-    pub fn parse(text: &str) -> Result<Shard, String> {
+    pub fn parse(text: &str) -> Result<Shard, ShardError> {
         let (k, n) = text
             .split_once('/')
-            .ok_or_else(|| format!("{text:?} is not K/N (shard K of N, as 2/3)"))?;
+            .ok_or_else(|| ShardError::NotKOfN(text.to_string()))?;
         let (k, n) = match (k.trim().parse::<u64>(), n.trim().parse::<u64>()) {
             (Ok(k), Ok(n)) => (k, n),
-            _ => return Err(format!("{text:?} is not K/N with whole numbers (as 2/3)")),
+            _ => return Err(ShardError::NotWhole(text.to_string())),
         };
         if n == 0 || k == 0 || k > n {
-            return Err(format!("{text:?}: K must be from 1 to N, and N at least 1"));
+            return Err(ShardError::OutOfRange(text.to_string()));
         }
         Ok(Shard { k, n })
     }

@@ -156,7 +156,7 @@ impl SceneDescription {
     /// The picture of image texture `t`, read from its file or generated.
     fn picture(&self, t: &TextureEntry) -> Result<RgbPicture, String> {
         match (&t.file, &t.generated) {
-            (Some(file), _) => read_picture(&self.resolve(file)),
+            (Some(file), _) => read_picture(&self.resolve(file)).map_err(|e| e.to_string()),
             (None, Some(name)) => {
                 generated_picture(name).ok_or_else(|| format!("no generated picture '{name}'"))
             }
