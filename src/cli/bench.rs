@@ -6,6 +6,7 @@
 //! memory, the machine's load) are shared by all of them.
 
 mod baseline;
+mod mitsuba;
 mod render;
 
 use std::process::{Command, ExitCode};

@@ -6,7 +6,8 @@
 //! week 8's Phong scene (the BRDF integrator, a point light and its shadow rays at every bounce,
 //! a checker ground). In the same run it times a plain C loop doing the same work
 //! ([`baseline`](super::baseline), `benches/baseline.c` built with `cc -O3`) and checks that it
-//! renders the same film bit for bit; then it measures the peak memory of a large
+//! renders the same film bit for bit; then it times the scenes whose physics Mitsuba 3 shares
+//! against Mitsuba ([`mitsuba`](super::mitsuba)), and measures the peak memory of a large
 //! `rtoracle render`.
 
 use std::process::{Command, ExitCode, Stdio};
@@ -36,7 +37,7 @@ const GOAL_SPEEDUP: f64 = 1.8;
 const BUDGET_BYTES_PER_PIXEL: u64 = 64;
 const BUDGET_FIXED_BYTES: u64 = 50_000_000;
 
-/// `rtoracle bench render [--runs N] [--memory-width W] [--cc CC]`
+/// `rtoracle bench render [--runs N] [--memory-width W] [--cc CC] [--mitsuba-spp N] [--python PY]`
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Runs of each timing; the fastest is reported.
@@ -49,6 +50,13 @@ pub struct Args {
     /// The C compiler that builds the baseline.
     #[arg(long, value_name = "CC", default_value = "cc")]
     cc: String,
+    /// Samples per pixel of the renders timed against Mitsuba 3.
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = crate::cli::num::spp)]
+    mitsuba_spp: u32,
+    /// The Python that imports Mitsuba 3 (`pip install mitsuba`); without it the comparison says
+    /// it was skipped.
+    #[arg(long, value_name = "PY", default_value = "python3")]
+    python: String,
 }
 
 /// A scene ready to render both ways.
@@ -99,8 +107,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => outln!("machine: {cores} cores, vector instructions {vector}")?,
     }
     let counts: Vec<usize> = if cores > 1 { vec![1, cores] } else { vec![1] };
+    let pools = counts
+        .iter()
+        .map(|&n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map(|pool| (n, pool))
+                .context("cannot start the worker threads")
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let baseline = CBaseline::build(&args.cc);
-    let (timings, c) = time_scenes(&scenes, &counts, args.runs, &baseline)?;
+    let (timings, c) = time_scenes(&scenes, &pools, args.runs, &baseline)?;
     let mut timings = timings.into_iter();
     let one = timings.next().expect("one thread timed");
     outln!()?;
@@ -110,6 +128,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(all) => all_threads(&scenes, &one, &all, cores)?,
         None => outln!("all threads: skipped, this machine has one core")?,
     }
+    outln!()?;
+    super::mitsuba::compare(&super::mitsuba::Options {
+        python: &args.python,
+        spp: args.mitsuba_spp,
+        runs: args.runs,
+        pools: &pools,
+    })?;
     outln!()?;
     memory(args.memory_width)?;
     Ok(ExitCode::SUCCESS)
@@ -283,27 +308,18 @@ fn same_means(a: Option<&Film>, b: Option<&Film>) -> bool {
     }
 }
 
-/// Renders each scene `runs` times on a pool of each of the `threads` counts and with the C
+/// Renders each scene `runs` times on each of the `pools` (its thread count, the pool) and with the C
 /// loop (on this thread, when it was built), and keeps the best times of each: per scene, its
 /// renders take turns within each run, so a change in the machine's speed (a burst of load
 /// elsewhere, a slower hour of a virtual machine) hits rtoracle and the C loop alike. The C
 /// loop's result holds how many pixels of its film differ from the reference's one-thread film.
 fn time_scenes(
     scenes: &[Prepared],
-    threads: &[usize],
+    pools: &[(usize, rayon::ThreadPool)],
     runs: u32,
     baseline: &Result<CBaseline, String>,
 ) -> anyhow::Result<(Vec<Vec<Timing>>, Vec<CTiming>)> {
-    let pools = threads
-        .iter()
-        .map(|&n| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .context("cannot start the worker threads")
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut timings: Vec<Vec<Timing>> = threads
+    let mut timings: Vec<Vec<Timing>> = pools
         .iter()
         .map(|_| {
             scenes
@@ -326,7 +342,7 @@ fn time_scenes(
         .collect();
     for _ in 0..runs {
         for (k, scene) in scenes.iter().enumerate() {
-            for (pool, per_scene) in pools.iter().zip(&mut timings) {
+            for ((_, pool), per_scene) in pools.iter().zip(&mut timings) {
                 let timing = &mut per_scene[k];
                 let options = RenderOptions {
                     samples_per_pixel: scene.spp,

@@ -163,6 +163,8 @@ const VALUE_OPTIONS: &[(&str, &str, bool, bool)] = &[
     ("bench render", "--runs", true, false),
     ("bench render", "--memory-width", true, false),
     ("bench render", "--cc", false, false),
+    ("bench render", "--mitsuba-spp", true, false),
+    ("bench render", "--python", false, false),
     ("bench oracle", "--cases", true, false),
 ];
 

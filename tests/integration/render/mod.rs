@@ -976,17 +976,19 @@ fn a_texture_file_is_read_relative_to_the_scene_file() {
 /// glass and Lambertian) and week 8's Phong (shadow rays and BRDFs), against `benches/baseline.c`,
 /// and reports that the C loop rendered each one's film bit for bit; and the films on all
 /// threads are the one-thread films. Without a C compiler the C columns say why, and the rest
-/// still runs.
+/// still runs. Against Mitsuba 3 it times both shared scenes on the scalar variant where Python
+/// imports mitsuba (required with `RTORACLE_REQUIRE_MITSUBA=1`), and says it skipped with a
+/// Python that cannot run it.
 #[test]
 fn bench_render_finds_the_c_loops_films_the_same_bit_for_bit() {
     let has_cc = std::process::Command::new("cc")
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success());
-    let run = |cc: &str| {
+    let run = |cc: &str, python: &str| {
         let out = rtoracle()
             .args(["bench", "render", "--runs", "1", "--memory-width", "16"])
-            .args(["--cc", cc])
+            .args(["--cc", cc, "--mitsuba-spp", "2", "--python", python])
             .output()
             .unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
@@ -1004,8 +1006,12 @@ fn bench_render_finds_the_c_loops_films_the_same_bit_for_bit() {
         "week06-dielectric",
         "week08-phong",
     ];
+    let has_mitsuba = std::process::Command::new("python3")
+        .args(["-c", "import mitsuba"])
+        .output()
+        .is_ok_and(|o| o.status.success());
     if has_cc {
-        let stdout = run("cc");
+        let stdout = run("cc", "python3");
         for scene in scenes {
             let row = stdout
                 .lines()
@@ -1018,10 +1024,48 @@ fn bench_render_finds_the_c_loops_films_the_same_bit_for_bit() {
                 || stdout.contains("this machine has one core"),
             "{stdout}"
         );
+        if has_mitsuba {
+            for scene in ["week05-quad", "week05-quad-light"] {
+                let row = stdout
+                    .lines()
+                    .find(|l| l.trim_start().starts_with(&format!("{scene} ")))
+                    .unwrap_or_else(|| panic!("no Mitsuba row for {scene}: {stdout}"));
+                assert!(
+                    row.contains("scalar_rgb") && row.contains("Mitsuba"),
+                    "{row}"
+                );
+                let ratios = row
+                    .split_whitespace()
+                    .filter_map(|w| w.strip_suffix('x')?.parse::<f64>().ok())
+                    .filter(|r| r.is_finite() && *r > 0.0)
+                    .count();
+                assert_eq!(ratios, 2, "one ratio on one thread, one on all: {row}");
+            }
+            assert!(
+                stdout.contains(
+                    "goal: ahead of Mitsuba's scalar_rgb on every scene, on one core and on all: "
+                ),
+                "{stdout}"
+            );
+        } else {
+            assert!(
+                std::env::var_os("RTORACLE_REQUIRE_MITSUBA").is_none(),
+                "RTORACLE_REQUIRE_MITSUBA is set and python3 cannot import mitsuba"
+            );
+            eprintln!(
+                "SKIPPED: python3 cannot import mitsuba, bench render's Mitsuba rows not run"
+            );
+        }
     } else {
         eprintln!("SKIPPED: no `cc` here, the C loop's films were not compared");
     }
-    let stdout = run("/nonexistent/cc");
+    let stdout = run("/nonexistent/cc", "/nonexistent/python");
+    assert!(
+        stdout
+            .contains("against Mitsuba 3 (scalar_rgb): skipped, /nonexistent/python cannot run it")
+            && stdout.contains("goal: ahead of Mitsuba's scalar_rgb: not measured"),
+        "{stdout}"
+    );
     for scene in scenes {
         let row = stdout
             .lines()
