@@ -136,3 +136,36 @@ pub fn assert_bad_input(out: &Output, needle: &str) {
         "stderr should mention {needle:?}: {stderr}"
     );
 }
+
+/// Folders shared by the tests of a module for the whole run (made once, kept in a `static`),
+/// removed when the test process exits: a `static` is never dropped, so without this they would
+/// stay in the temporary folder after every run.
+static REMOVED_AT_EXIT: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+extern "C" fn remove_shared_folders() {
+    if let Ok(dirs) = REMOVED_AT_EXIT.lock() {
+        for dir in dirs.iter() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+}
+
+/// Makes a temporary folder named `prefix...` that lives until the test process exits (the
+/// test harness exits through `exit`, which runs the removal registered here).
+pub fn shared_temporary_folder(prefix: &str) -> &'static Path {
+    static REGISTERED: std::sync::Once = std::sync::Once::new();
+    REGISTERED.call_once(|| {
+        // SAFETY: registers a plain function with no arguments; it only locks a static and
+        // removes folders.
+        unsafe {
+            libc::atexit(remove_shared_folders);
+        }
+    });
+    let dir = tempfile::Builder::new()
+        .prefix(prefix)
+        .tempdir()
+        .unwrap()
+        .keep();
+    REMOVED_AT_EXIT.lock().unwrap().push(dir.clone());
+    Box::leak(dir.into_boxed_path())
+}

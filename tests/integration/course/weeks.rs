@@ -89,16 +89,13 @@ impl Job {
 
 /// The stand-in textures (`make_textures.py`), made once per test run.
 fn textures(python: &Path) -> &'static Path {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    static DIR: OnceLock<&'static Path> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tempfile::Builder::new()
-            .prefix("rtoracle-course-textures-")
-            .tempdir()
-            .unwrap();
+        let dir = crate::common::shared_temporary_folder("rtoracle-course-textures-");
         let out = Command::new(python)
             .arg("-B")
             .arg(weeks_dir().join("make_textures.py"))
-            .arg(dir.path())
+            .arg(dir)
             .output()
             .unwrap();
         assert!(
@@ -108,7 +105,6 @@ fn textures(python: &Path) -> &'static Path {
         );
         dir
     })
-    .path()
 }
 
 fn render(python: &Path, job: &Job) -> Rendered {

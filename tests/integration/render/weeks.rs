@@ -46,16 +46,13 @@ fn python() -> Option<&'static Path> {
 /// A work folder per test process: the stand-in pictures (`make_textures.py`) and the goldens'
 /// cache, shared by the tests of this module.
 fn work(python: &Path) -> &'static Path {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    static DIR: OnceLock<&'static Path> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tempfile::Builder::new()
-            .prefix("rtoracle-render-weeks-")
-            .tempdir()
-            .unwrap();
+        let dir = crate::common::shared_temporary_folder("rtoracle-render-weeks-");
         let out = Command::new(python)
             .arg("-B")
             .arg(weeks_dir().join("make_textures.py"))
-            .arg(dir.path().join("textures"))
+            .arg(dir.join("textures"))
             .output()
             .unwrap();
         assert!(
@@ -65,7 +62,6 @@ fn work(python: &Path) -> &'static Path {
         );
         dir
     })
-    .path()
 }
 
 /// The built-in `scene` as a scene file at [`WIDTH`] and `spp`, reading the stand-in pictures.
