@@ -33,7 +33,7 @@
 //!   JUnit, Markdown), and the Gradescope autograder package.
 //! - [`physics`]: physics checks that need no golden: a renderer's materials (sampling, pdf,
 //!   weights, energy, reciprocity) through the protocol's material requests, and furnace scenes.
-//! - [`bench`]: the figures of `rtoracle bench` and `cargo bench`, each against a baseline
+//! - [`bench`](mod@bench): the figures of `rtoracle bench` and `cargo bench`, each against a baseline
 //!   measured in the same run.
 #![warn(missing_docs)]
 #![deny(clippy::undocumented_unsafe_blocks)]

@@ -4,7 +4,7 @@
 //! which rows of a render are checked can all be known in advance (`rtoracle vectors --seed S`
 //! prints the suite). So it never leaves the grader: every seed that goes into a request (a
 //! render's, a sampler's, a steered scattering's) and every generator whose output a request
-//! shows (the vector suite, a check's random inputs) is [`derive`]d from the secret and the
+//! shows (the vector suite, a check's random inputs) is `derive`d from the secret and the
 //! purpose it serves, by a keyed one-way function: HMAC-SHA256 (RFC 2104) keyed with the
 //! secret, over the purpose's name. Knowing one derived seed (a render request's, printed by a
 //! hostile submission) gives neither the secret nor any other purpose's seed: that would take
@@ -41,7 +41,7 @@ pub fn derive(secret: u64, purpose: &str) -> u64 {
     u64::from_le_bytes(bytes[..8].try_into().expect("8 bytes"))
 }
 
-/// [`derive`], kept to 32 bits (a seed that Python's and numpy's generators take as it is).
+/// `derive`, kept to 32 bits (a seed that Python's and numpy's generators take as it is).
 pub fn derive32(secret: u64, purpose: &str) -> u32 {
     (derive(secret, purpose) & 0xFFFF_FFFF) as u32
 }

@@ -13,7 +13,8 @@
 //!   watertight rule, the [`CheckReport`] and its text, Python reproductions, and the known
 //!   mistake that explains the failures ([`judging::diagnose`]).
 //! - [`fuzzing`]: random cases classified by the oracle, the fuzz driver and shrinking.
-//! - [`rust`]: the [`Candidate`] trait and [`check_candidate`] for Rust implementations.
+//! - [`rust`]: the [`Candidate`](rust::Candidate) trait and
+//!   [`check_candidate`](rust::check_candidate) for Rust implementations.
 //! - Here: [`check_command`] and [`check_session`], one candidate checked against a list of
 //!   cases, start to report.
 
@@ -24,17 +25,11 @@ pub mod rust;
 #[cfg(test)]
 pub(crate) mod test_cases;
 
-pub use crate::sandbox::SandboxPolicy;
-pub use judging::check::{FailureKind, Verdict, judge};
-pub use judging::report::{CheckReport, Counts, Failure, RunInfo, build_report};
-pub use process::command::CandidateCommand;
-pub use process::error::HarnessError;
-pub use process::options::RunOptions;
-pub use process::outcome::Outcome;
-pub use process::protocol::{Answer, CandidateError, Hello};
-pub use process::session::{CallOutcome, Session};
-pub use rust::{Candidate, Reference, check_candidate};
-
+use self::judging::report::{CheckReport, RunInfo, build_report};
+use self::process::command::CandidateCommand;
+use self::process::error::HarnessError;
+use self::process::options::RunOptions;
+use self::process::session::Session;
 use crate::oracle::vectors::Case;
 
 /// Runs `cases` through a started session and builds the report.

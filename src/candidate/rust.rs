@@ -4,7 +4,9 @@
 //! [`check_candidate`] from a test:
 //!
 //! ```
-//! use rtoracle::candidate::{Answer, Candidate, check_candidate};
+//! use rtoracle::candidate::process::protocol::Answer;
+//! use rtoracle::candidate::rust::Candidate;
+//! use rtoracle::candidate::rust::check_candidate;
 //! use rtoracle::oracle::vectors::{RaySpec, ShapeSpec};
 //!
 //! /// A tracer under test; here rtoracle's own reference stands in for it.

@@ -7,14 +7,15 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::candidate::{
-    CandidateCommand, RunOptions, SandboxPolicy, check_command, process::python,
-};
+use rtoracle::candidate::process::command::CandidateCommand;
+use rtoracle::candidate::process::options::RunOptions;
+use rtoracle::candidate::{check_command, process::python};
 use rtoracle::oracle::vectors::{Case, read_vectors};
 use rtoracle::oracle::{
     Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
 };
 use rtoracle::sandbox::SandboxError;
+use rtoracle::sandbox::SandboxPolicy;
 use rtoracle::weekly::{FunctionOptions, Week, check_week, detect};
 
 /// Which candidate to run (shared by `check` and `fuzz`; `check` without either checks the

@@ -7,7 +7,8 @@ use std::time::Duration;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rtoracle::candidate::fuzzing::fuzz::{FuzzOptions, fuzz};
-use rtoracle::candidate::{RunOptions, Session};
+use rtoracle::candidate::process::options::RunOptions;
+use rtoracle::candidate::process::session::Session;
 use rtoracle::oracle::vectors::ShapeKind;
 
 /// Cases run when neither `--cases` nor `--time` is given.

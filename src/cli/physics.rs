@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use rtoracle::candidate::RunOptions;
+use rtoracle::candidate::process::options::RunOptions;
 use rtoracle::physics::materials::check_candidate_materials;
 use rtoracle::physics::{Family, MaterialCase, MaterialOptions, default_materials};
 
@@ -165,7 +165,8 @@ fn furnace(args: Args) -> anyhow::Result<ExitCode> {
         let command = args.target.command(&args.sandbox)?;
         let run = run_options(&args);
         rtoracle::sandbox::announce_on_stderr();
-        let mut session = rtoracle::candidate::Session::start(command, run).context("physics")?;
+        let mut session = rtoracle::candidate::process::session::Session::start(command, run)
+            .context("physics")?;
         let mut renderer =
             CandidateRenderer::new(&mut session, Duration::from_millis(args.timeout_ms));
         check_furnaces(&mut renderer, options)

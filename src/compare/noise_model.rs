@@ -7,9 +7,9 @@
 //! one-bounce colours; they do not cover a rare bright path (a specular lobe met by a scattered
 //! ray, a bounce into a small light), whose probability is too small to show in the variance
 //! but whose samples lie far away. The golden's measured deviations do: the pixel scale's bound
-//! ([`Golden::tail_bound`]) takes the largest of them over a 5x5 neighbourhood, so a path the
+//! (`Golden::tail_bound`) takes the largest of them over a 5x5 neighbourhood, so a path the
 //! golden saw once in the ~25 M samples around a pixel counts as possible there. The sums over
-//! tiles and the image keep the edge-tolerant bound ([`Golden::bound`]): one rare sample moves a
+//! tiles and the image keep the edge-tolerant bound (`Golden::bound`): one rare sample moves a
 //! sum of hundreds of pixels by a small share of its standard deviation, while the largest
 //! bound of its terms, which Bernstein's inequality charges to the whole sum, would cost a
 //! tile most of its power (a missing shadow in a 32x32 image of a point light passed with it).

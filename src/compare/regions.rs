@@ -2,7 +2,7 @@
 //!
 //! The statistic finds the regions (the verdict); this module ranks them by what a reader
 //! learns from them, not by where they are: first the region with the most evidence (its area
-//! times the strength of its differences, `|z|` capped at [`Z_CAP`] per pixel, so a large region
+//! times the strength of its differences, `|z|` capped at `Z_CAP` per pixel, so a large region
 //! beats a small one whose `z` saturates), then, for the regions listed, each next one the one
 //! whose evidence is greatest after a discount for lying near a region already listed, so the
 //! first crops show distinct places. Each region says, per channel, whether the candidate is

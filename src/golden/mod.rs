@@ -1,7 +1,7 @@
 //! Golden images: the reference's high-sample renders that candidates are judged against, for
 //! every scene, built-in or file, made one way.
 //!
-//! A golden is an OpenEXR file ([`format`]): the scene rendered by [`crate::render::render`] at
+//! A golden is an OpenEXR file (`format`): the scene rendered by [`crate::render::render`] at
 //! its own size with `M` samples per pixel and seed [`GOLDEN_SEED`], holding the per-pixel mean
 //! (`R`, `G`, `B`), the per-sample variance of each channel (the `variance` layer), and string
 //! attributes saying what it was made from. Its bytes depend only on the scene, the samples per

@@ -9,7 +9,7 @@
 //! checker is [`CompareImageChecker`] ([`checkers::images`]), the noise-aware comparison against
 //! the golden of a built-in scene (embedded) or of an instructor's scene file (the rubric's, or
 //! rendered once and cached). Image groups are rendered by the grader from the submission's own
-//! code by default ([`checkers::rendered`](mod@render)): the code checker renders, the image checker judges
+//! code by default ([`checkers::rendered`]): the code checker renders, the image checker judges
 //! the render.
 //!
 //! Four rooms, and the single-submission path on top:
@@ -18,7 +18,7 @@
 //!   credit ([`rubric::credit`]) and the points of each group ([`rubric::score`]).
 //! - [`checkers`]: the two interfaces and their real implementations: the course's code through
 //!   the `check` harness ([`checkers::code`]), the weekly function checks
-//!   ([`checkers::weekly`]), images against their reference ([`checkers::images`]), renders
+//!   (`checkers::weekly`), images against their reference ([`checkers::images`]), renders
 //!   asked of the submission's own code ([`checkers::rendered`], [`checkers::noise_floor`]) and
 //!   copied images ([`checkers::copies`]).
 //! - [`batch`]: a folder of submissions in parallel, the gradebook, one shard's entry
@@ -57,14 +57,17 @@ pub use checkers::code::CourseCodeChecker;
 pub use checkers::images::CompareImageChecker;
 pub use checkers::weekly::{UNSCORED_ID, function_checks};
 pub use checkers::{
-    CodeChecker, CodeOutcome, FailureKind, FailureSummary, FunctionsOutcome, GroupCounts,
-    ImageChecker, ImageOutcome, ImageVerdict, SceneFile, SceneSource,
+    CodeChecker, CodeOutcome, FailureSummary, FunctionsOutcome, GroupCounts, ImageChecker,
+    ImageOutcome, ImageVerdict,
 };
 pub use report::{Format, write_reports};
 pub use result::{
     CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, GradeError, GradeReport, ImageResult,
     Reproducibility, round2, smallest_failure,
 };
-pub use rubric::{GoldenFile, Group, GroupKind, ImageSource, Rubric, RubricError, Visibility};
+pub use rubric::{
+    GoldenFile, Group, GroupKind, ImageSource, Rubric, RubricError, SceneFile, SceneSource,
+    Visibility,
+};
 pub use run::grade;
 pub use write::{REPORT_FOLDER, grade_to_dir};

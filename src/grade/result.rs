@@ -9,8 +9,9 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use super::checkers::copies::{CopyFinding, Fingerprint};
-use super::checkers::{FailureKind, FailureSummary, GroupCounts, ImageVerdict};
+use super::checkers::{FailureSummary, GroupCounts, ImageVerdict};
 use super::rubric::Visibility;
+use crate::candidate::judging::check::FailureKind;
 use crate::escape::Untrusted;
 use crate::output::OutputError;
 

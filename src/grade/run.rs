@@ -1,14 +1,13 @@
 //! Grading one submission: the code groups through a [`CodeChecker`], the image groups through an
 //! [`ImageChecker`], scored into a [`GradeReport`].
 
+use crate::candidate::judging::check::FailureKind;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
 use super::checkers::copies::{CopyFinding, Fingerprint, recognise};
-use super::checkers::{
-    CodeChecker, CodeOutcome, FailureKind, ImageChecker, ImageOutcome, ImageVerdict,
-};
+use super::checkers::{CodeChecker, CodeOutcome, ImageChecker, ImageOutcome, ImageVerdict};
 use super::result::{CodeRun, GradeError, GradeReport, Reproducibility, round2};
 use super::rubric::score::{code_check, heatmap_name, image_check};
 use super::rubric::{Group, GroupKind, Rubric, SceneSource};

@@ -211,14 +211,14 @@ impl FurnaceRenderer for ReferenceRenderer {
 /// A candidate's renders through the protocol's render requests (a started session), each
 /// within `time_limit`.
 pub struct CandidateRenderer<'a> {
-    session: &'a mut crate::candidate::Session,
+    session: &'a mut crate::candidate::process::session::Session,
     time_limit: std::time::Duration,
 }
 
 impl<'a> CandidateRenderer<'a> {
     /// Renders through `session`, each image within `time_limit`.
     pub fn new(
-        session: &'a mut crate::candidate::Session,
+        session: &'a mut crate::candidate::process::session::Session,
         time_limit: std::time::Duration,
     ) -> Self {
         CandidateRenderer {

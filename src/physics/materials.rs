@@ -653,15 +653,15 @@ fn mark_findings(
 /// is the family of rtoracle's models whose breaches are findings about the model (`None`: every
 /// breach is the candidate's).
 pub fn check_candidate_materials(
-    command: crate::candidate::CandidateCommand,
-    run: crate::candidate::RunOptions,
+    command: crate::candidate::process::command::CandidateCommand,
+    run: crate::candidate::process::options::RunOptions,
     cases: &[MaterialCase],
     options: MaterialOptions,
     reference: Option<super::models::Family>,
-) -> Result<MaterialsReport, crate::candidate::HarnessError> {
+) -> Result<MaterialsReport, crate::candidate::process::error::HarnessError> {
     let label = command.label.clone();
     let timeout = run.timeout;
-    let mut session = crate::candidate::Session::start(command, run)?;
+    let mut session = crate::candidate::process::session::Session::start(command, run)?;
     let mut runner = crate::weekly::SessionRunner::new(&mut session);
     let mut source = super::source::ProtocolSource::new(&mut runner, label, timeout);
     let mut model = reference.map(super::models::ModelSource::new);

@@ -59,7 +59,7 @@ fn background(world: &World, direction: DVec3, unit_y: Option<f64>) -> DVec3 {
 
 /// The radiance along a camera ray in `world`, drawing from `sampler`: the profile's integrator.
 ///
-/// One [`Path`] taken one [`step`] at a time, each step given the closest hit of the path's ray.
+/// One `Path` taken one `step` at a time, each step given the closest hit of the path's ray.
 /// The renderer's lanes of paths (`render::fast::lanes`) take the same steps, four paths at a time.
 #[inline(always)]
 pub fn trace(world: &World, ray: &Ray, sampler: &mut PixelSampler) -> DVec3 {

@@ -1,6 +1,6 @@
 //! How untrusted code is started: the one place that spawns a candidate or a student's
 //! submission (`check --python-course`, `check --adapter`, `fuzz` and `grade` all come here,
-//! through [`candidate::Session`](crate::candidate::Session)). What it does, for a reader who
+//! through [`Session`](crate::candidate::process::session::Session)). What it does, for a reader who
 //! runs it: `docs/sandbox.md`.
 //!
 //! # What it promises

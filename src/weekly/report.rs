@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::run::{FunctionResult, Status, WeekReport};
 use super::samplers::Standing;
 use super::score::WeekScore;
-use crate::candidate::CheckReport;
+use crate::candidate::judging::report::CheckReport;
 use crate::escape::{terminal_line, terminal_text};
 
 /// What `rtoracle check --json` prints says it is: [`CheckDocument::schema`].

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use crate::candidate::CandidateError;
+use crate::candidate::process::protocol::CandidateError;
 
 /// What a function request got.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,16 +69,16 @@ pub trait FunctionRunner {
     fn call(&mut self, request: &serde_json::Value, timeout: Duration) -> Reply;
 }
 
-/// A candidate's [`Session`](crate::candidate::Session) as a [`FunctionRunner`]: ids `f1`,
+/// A candidate's [`Session`](crate::candidate::process::session::Session) as a [`FunctionRunner`]: ids `f1`,
 /// `f2`, ... in the order of the calls.
 pub struct SessionRunner<'a> {
-    session: &'a mut crate::candidate::Session,
+    session: &'a mut crate::candidate::process::session::Session,
     next: u64,
 }
 
 impl<'a> SessionRunner<'a> {
     /// Function requests through `session`.
-    pub fn new(session: &'a mut crate::candidate::Session) -> Self {
+    pub fn new(session: &'a mut crate::candidate::process::session::Session) -> Self {
         SessionRunner { session, next: 0 }
     }
 }
@@ -89,7 +89,7 @@ impl FunctionRunner for SessionRunner<'_> {
     }
 
     fn call(&mut self, request: &serde_json::Value, timeout: Duration) -> Reply {
-        use crate::candidate::CallOutcome;
+        use crate::candidate::process::session::CallOutcome;
         self.next += 1;
         let id = format!("f{}", self.next);
         match self.session.call(&id, request, timeout) {

@@ -12,10 +12,14 @@ use super::run::{FunctionOptions, WeekReport, run_week};
 use super::runner::SessionRunner;
 use super::score::{WeekScore, score};
 use super::week::Week;
-use crate::candidate::{
-    CandidateCommand, CheckReport, HarnessError, Outcome, RunOptions, Session, build_report,
-    run_info,
-};
+use crate::candidate::judging::report::CheckReport;
+use crate::candidate::judging::report::build_report;
+use crate::candidate::process::command::CandidateCommand;
+use crate::candidate::process::error::HarnessError;
+use crate::candidate::process::options::RunOptions;
+use crate::candidate::process::outcome::Outcome;
+use crate::candidate::process::session::Session;
+use crate::candidate::run_info;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// The tag given to a sphere vector not scored because the course's `get_uv` raised on it.

@@ -222,6 +222,59 @@ fn no_folder_holds_more_than_about_a_dozen_files() {
     );
 }
 
+/// Modules that still show two surfaces, public files and re-exports of their items (so an item
+/// has two paths): each goes when its re-exports do (or its files become private), and the test
+/// fails when an entry is no longer needed, so the list only shrinks.
+const TWO_SURFACES: &[&str] = &[
+    "src/compare/mod.rs",
+    "src/golden/mod.rs",
+    "src/grade/mod.rs",
+    "src/oracle/mod.rs",
+    "src/physics/mod.rs",
+    "src/sandbox/mod.rs",
+    "src/weekly/mod.rs",
+    "src/weekly/samplers/mod.rs",
+];
+
+/// One surface per module: a module's own file either re-exports its children's items (a facade
+/// over private files) or declares public files, not both.
+#[test]
+fn a_module_shows_one_surface() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    collect_rs(&root.join("src"), &mut files);
+    let mut both = BTreeSet::new();
+    for file in &files {
+        let text = std::fs::read_to_string(file).unwrap();
+        let code = blank_test_items(&blank_literals(&text));
+        let public_file = code.lines().any(|l| l.starts_with("pub mod "));
+        let reexport = code.lines().any(|l| l.starts_with("pub use "));
+        if public_file && reexport {
+            let name = file
+                .strip_prefix(&root)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            both.insert(name);
+        }
+    }
+    for listed in TWO_SURFACES {
+        assert!(
+            both.contains(*listed),
+            "{listed} shows one surface now: remove it from TWO_SURFACES"
+        );
+    }
+    let new: Vec<_> = both
+        .iter()
+        .filter(|f| !TWO_SURFACES.contains(&f.as_str()))
+        .collect();
+    assert!(
+        new.is_empty(),
+        "{new:?} both declare public files and re-export items: keep one surface (re-exports \
+         over private files, or public files imported where they are defined)"
+    );
+}
+
 /// docs/ARCHITECTURE.md's "Where to find things" names files and folders a newcomer opens
 /// first: each must exist.
 #[test]

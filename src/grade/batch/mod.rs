@@ -816,8 +816,9 @@ fn common_failures(md: &mut String, graded: &[&RowScores]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::candidate::judging::check::FailureKind;
+    use crate::grade::checkers::FailureSummary;
     use crate::grade::checkers::fakes::*;
-    use crate::grade::checkers::{FailureKind, FailureSummary};
 
     /// Makes a submission folder with fake images for each of `names` in a new temporary
     /// folder and grades them as a batch with `code` (JSON reports into its `out`). Returns the

@@ -11,16 +11,19 @@ use crate::candidate::judging::check::{
     FailureKind as CheckKind, Verdict, decide_winding, judge_exact_wound, judge_wound,
 };
 use crate::candidate::judging::report::python_repro;
+use crate::candidate::process::command::CandidateCommand;
+use crate::candidate::process::error::HarnessError;
+use crate::candidate::process::options::RunOptions;
+use crate::candidate::process::outcome::Outcome;
 use crate::candidate::process::python;
 use crate::candidate::process::render_request::{RenderJob, RenderOutcome, render_scene};
-use crate::candidate::{
-    CandidateCommand, HarnessError, Outcome, RunOptions, SandboxPolicy, Session,
-};
+use crate::candidate::process::session::Session;
 use crate::grade::checkers::{CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts};
 use crate::grade::rubric::credit;
 use crate::grade::rubric::sha256_hex;
 use crate::oracle::default_suite;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
+use crate::sandbox::SandboxPolicy;
 
 /// Checks a submission's `RT_object.py` with the course adapter of `rtoracle check
 /// --python-course`: one sandboxed interpreter per submission, restarted after a crash; a
@@ -259,7 +262,10 @@ impl CodeChecker for CourseCodeChecker {
 /// What the reports say when the submission cannot be imported: the exception and where the
 /// submission raised it (`SyntaxError: expected ':' (RT_object.py, line 19)`), then Python's
 /// traceback, with the submission's file names.
-fn import_failure(e: &crate::candidate::CandidateError, paths: &PathStripper) -> String {
+fn import_failure(
+    e: &crate::candidate::process::protocol::CandidateError,
+    paths: &PathStripper,
+) -> String {
     let mut text = format!(
         "importing the submission failed: {}",
         paths.strip(&e.to_string())

@@ -24,7 +24,7 @@ use super::rubric::credit::ClassTally;
 use crate::oracle::vectors::ShapeKind;
 use crate::scene::SceneDescription;
 
-pub use super::rubric::{SceneFile, SceneSource};
+use super::rubric::{SceneFile, SceneSource};
 
 /// Checks the intersection code of a submission.
 pub trait CodeChecker: Sync {
@@ -68,7 +68,7 @@ pub trait CodeChecker: Sync {
     }
 }
 
-pub use crate::candidate::process::render_request::{RenderJob, RenderOutcome, RenderedImage};
+use crate::candidate::process::render_request::{RenderJob, RenderOutcome, RenderedImage};
 
 /// What running a week's function checks on a submission found.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -210,7 +210,7 @@ pub struct GroupCounts {
 }
 
 /// How one vector went wrong: the `check` harness's own kinds.
-pub use crate::candidate::FailureKind;
+use crate::candidate::judging::check::FailureKind;
 
 /// One failing vector, ready to be shown to a student.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -3,7 +3,7 @@
 //! For each such group the grader asks the submission, through the protocol's `render` request
 //! ([`crate::candidate::process::render_request`]), to render the group's scene at the group's `spp` within its
 //! `render_seconds`, in the sandbox, with one interpreter per submission for all its groups
-//! ([`course_render`]). The render is judged by the image checker against the golden at the spp
+//! (`course_render`). The render is judged by the image checker against the golden at the spp
 //! it was rendered with ([`ImageChecker::check_render`]); the points come from that judgement.
 //! An uploaded image of the group is still read and judged, and reported beside it, but earns
 //! nothing. A render that raises, hangs, declines, returns NaN or the wrong size scores 0 for
@@ -20,9 +20,9 @@
 //! A film, a render or a picture could be one the submission carries (the reference's own
 //! render made at home, a classmate's), answered by a `main.py` that saves it or by a module
 //! that replaces the adapter's renderer. So every render group is also rendered as a *variant*
-//! ([`variant_of`]): the same scene from a camera the grader moves (`look_from` and `look_at`
+//! (`variant_of`): the same scene from a camera the grader moves (`look_from` and `look_at`
 //! moved by 3 to 6% and 1 to 3% of their distance, the field of view scaled by 3 to 6% either
-//! way, in directions and amounts drawn from [`variant_key`], which follows the rubric's secret
+//! way, in directions and amounts drawn from `variant_key`, which follows the rubric's secret
 //! seed and the group), at half the width. The submission renders it the same way as the scene
 //! (its `main.py` function moves its camera in `init_camera`), the reference renders the same
 //! variant on the spot ([`ImageChecker::check_variant`]), and the group earns its points only

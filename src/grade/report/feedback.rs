@@ -10,9 +10,10 @@
 
 use std::fmt::Write;
 
+use crate::candidate::judging::check::FailureKind;
 use crate::escape::{Untrusted, markdown_block, markdown_inline};
 use crate::grade::result::smallest_case_sentence;
-use crate::grade::{CheckResult, CheckStatus, FailureKind, FailureSummary, smallest_failure};
+use crate::grade::{CheckResult, CheckStatus, FailureSummary, smallest_failure};
 
 use crate::grade::rubric::score::MISSING;
 
@@ -130,7 +131,7 @@ pub(crate) fn raised_at_in(traceback: &str) -> Option<RaisedAt> {
 }
 
 /// Where the exception of a failure that raised one was raised: the place the code sent with
-/// it (the adapter's `file` and `line`, [`crate::candidate::CandidateError`]), else its
+/// it (the adapter's `file` and `line`, [`crate::candidate::process::protocol::CandidateError`]), else its
 /// traceback's last frame of the submission ([`raised_at_in`]).
 pub(crate) fn raised_at(f: &FailureSummary) -> Option<RaisedAt> {
     if f.kind != FailureKind::Error {

@@ -3,7 +3,7 @@
 //! `score`, `max_score`, `status` (`passed` / `failed`), `output`, `visibility` and `tags`.
 //!
 //! Every `output` is Markdown, and says so (`"output_format": "md"`, at the top and in each
-//! test): the same words as `feedback.md` ([`super::feedback`]), escaped only where Markdown
+//! test): the same words as `feedback.md` (`super::feedback`), escaped only where Markdown
 //! would otherwise change them. The tests come in rubric order, the notes on ambiguous vectors
 //! (not scored) last.
 

@@ -3,12 +3,12 @@
 //! later.
 //!
 //! The page: the score and a table of the scored checks; a section per check that lost points
-//! (what [`super::feedback`] says of it); what passed; the heatmaps; last, short, the vectors
+//! (what `super::feedback` says of it); what passed; the heatmaps; last, short, the vectors
 //! where rounding decides and the code differs from the exact answer (not scored, never called
 //! failures).
 //!
 //! Everything the submission controls is escaped with [`crate::escape`]: its folder name with
-//! [`markdown_inline`], exception messages and tracebacks in a [`markdown_block`] whose fence
+//! `markdown_inline`, exception messages and tracebacks in a `markdown_block` whose fence
 //! nothing inside can close, so the only heading at the top level is the real score and no
 //! link, image or HTML comes from the submission.
 

@@ -102,8 +102,9 @@ pub fn exception_of(check: &super::CheckResult) -> Option<crate::escape::Untrust
             .filter(|w| w.starts_with("raised "));
     }
     let f = super::smallest_failure(&check.failures)?;
-    (f.kind == super::FailureKind::Error && f.message.starts_with("raised "))
-        .then(|| f.message.clone())
+    (f.kind == crate::candidate::judging::check::FailureKind::Error
+        && f.message.starts_with("raised "))
+    .then(|| f.message.clone())
 }
 
 /// Writes `report` in each of `formats` into the existing folder `out_dir` (each file whole or

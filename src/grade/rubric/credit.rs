@@ -22,8 +22,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::candidate::Outcome;
 use crate::candidate::judging::check::{NORMAL_TOL, Verdict, Winding};
+use crate::candidate::process::outcome::Outcome;
 use crate::oracle::vectors::{Case, Class};
 
 /// The credit of a hit at the right `t`, before its normal and `front_face`.
@@ -208,7 +208,7 @@ pub fn expects_hit(case: &Case) -> bool {
 }
 
 /// The answer of `outcome` when it is a hit delivered cleanly (no stray output, no error).
-fn clean_hit(outcome: &Outcome) -> Option<&crate::candidate::Answer> {
+fn clean_hit(outcome: &Outcome) -> Option<&crate::candidate::process::protocol::Answer> {
     let Outcome::Answered { answer, junk } = outcome else {
         return None;
     };

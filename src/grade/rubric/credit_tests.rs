@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use super::*;
-use crate::candidate::Answer;
 use crate::candidate::judging::check::{decide_winding, judge_wound};
+use crate::candidate::process::protocol::Answer;
 use crate::oracle::default_suite;
 use crate::oracle::generate::{add, scale};
 use crate::oracle::mistakes::{self, Variant};

@@ -1,10 +1,11 @@
 //! Scoring: from what the checkers found and the rubric's groups to the checks and their points.
 
+use crate::candidate::judging::check::FailureKind;
 use std::path::Path;
 
 use crate::grade::checkers::copies::CopyFinding;
 use crate::grade::checkers::{
-    CodeOutcome, FailureKind, FailureSummary, GroupCounts, ImageOutcome, ImageVerdict,
+    CodeOutcome, FailureSummary, GroupCounts, ImageOutcome, ImageVerdict,
 };
 use crate::grade::result::{
     CheckResult, CheckStatus, FAILURES_SHOWN, ImageResult, round2, simplicity,

@@ -2,7 +2,7 @@
 //! `--print-rubric week06`, `autograder --rubric week06`), as TOML text a course can print,
 //! edit and give back as a file.
 //!
-//! Week 4's is [`WEEK04_RUBRIC`](crate::grade::rubric::WEEK04_RUBRIC). From week 5 on, a week's points
+//! Week 4's is [`WEEK04_RUBRIC`]. From week 5 on, a week's points
 //! go only to that week's own tasks: what the week's skeleton leaves blank and the instructor's
 //! solution fills in (the course's code, `weekNN/skeleton` against `weekNN/solution`). Out of
 //! 100 points:
@@ -364,7 +364,7 @@ fn week_rubric_toml(week: Week) -> String {
 
 impl Rubric {
     /// The built-in rubric `name` (`week04` ... `week10`,
-    /// [`BUILTIN_RUBRICS`](BUILTIN_RUBRICS)), or `None`.
+    /// [`BUILTIN_RUBRICS`]), or `None`.
     pub fn builtin(name: &str) -> Option<Rubric> {
         let text = builtin_rubric_toml(name)?;
         Some(Rubric::from_toml(&text, "built-in").expect("the built-in rubrics are valid"))

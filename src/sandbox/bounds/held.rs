@@ -8,7 +8,7 @@ use std::os::unix::fs::MetadataExt;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-/// Which processes are the code's, for the [`Watchdog`].
+/// Which processes are the code's, for the `Watchdog`.
 #[derive(Clone, Debug)]
 pub enum Members {
     /// Every process of a per-submission uid (a root harness).

@@ -63,7 +63,7 @@ impl std::fmt::Debug for Watchdog {
 
 impl Watchdog {
     /// Starts measuring `dir`, the processes of `members` (and, for a uid, what it owns under
-    /// [`SHARED_ROOTS`]) against `limits`; `reaper` ends the code on a violation.
+    /// `SHARED_ROOTS`) against `limits`; `reaper` ends the code on a violation.
     pub fn start(dir: PathBuf, members: Members, limits: Limits, reaper: Reaper) -> Watchdog {
         let cgroup = reaper.cgroup.clone();
         let uid = match members {

@@ -1,8 +1,8 @@
-//! Starting the code: the command that runs a program inside a sandbox ([`command`]), under
+//! Starting the code: the command that runs a program inside a sandbox (`command`), under
 //! bubblewrap ([`bwrap`]) or the fallback, whose child sets everything up between `fork` and
-//! `exec` ([`child`](mod@child)), what the code sees of the host ([`view`], and [`pivot`] for
+//! `exec` (`child`), what the code sees of the host ([`view`], and `pivot` for
 //! the fallback's own root), and letting a bubblewrap sandbox's first process start
-//! ([`admission`]).
+//! (`admission`).
 
 pub(super) mod admission;
 pub mod bwrap;

@@ -58,7 +58,7 @@ pub enum SystemEntry {
     Link(PathBuf, OsString),
 }
 
-/// The system view of this host: [`SYSTEM`] as folders or links, then [`ETC`] where present.
+/// The system view of this host: `SYSTEM` as folders or links, then `ETC` where present.
 pub fn system() -> Vec<SystemEntry> {
     let mut out = Vec::new();
     for s in SYSTEM {

@@ -77,7 +77,7 @@ pub enum Body {
         normalise: Option<Normalise>,
     },
     /// Cases whose random numbers the requests steer (the values of the course's
-    /// `random_double`, or of the camera's generator), judged as [`steer`] says: right when the
+    /// `random_double`, or of the camera's generator), judged as `steer` says: right when the
     /// answer is the course's, or when it keeps its case's behaviour and the statistical
     /// checks `partners` passed.
     Steered {

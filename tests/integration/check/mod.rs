@@ -14,8 +14,12 @@ use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use rtoracle::bench::harness::{assemble_fixture, course_python_or_skip};
+use rtoracle::candidate::check_command;
 use rtoracle::candidate::fuzzing::generate::random_cases;
-use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
+use rtoracle::candidate::judging::check::FailureKind;
+use rtoracle::candidate::judging::report::CheckReport;
+use rtoracle::candidate::process::command::CandidateCommand;
+use rtoracle::candidate::process::options::RunOptions;
 use rtoracle::oracle::vectors::{Case, ShapeKind};
 
 use crate::common::*;
@@ -71,7 +75,7 @@ fn check_on(variant: &str, cases: &[Case], options: RunOptions) -> CheckReport {
     check_command(course(dir.path()), cases, options).unwrap()
 }
 
-fn group(r: &CheckReport, kind: ShapeKind) -> rtoracle::candidate::Counts {
+fn group(r: &CheckReport, kind: ShapeKind) -> rtoracle::candidate::judging::report::Counts {
     r.by_shape[&kind]
 }
 
@@ -972,7 +976,7 @@ fn the_candidate_gets_no_network_when_the_platform_allows_it() {
     let mine = std::fs::read_link("/proc/self/ns/net").unwrap();
     // An "adapter" that reports its network namespace on stderr, then speaks no protocol.
     let command = CandidateCommand::adapter("sh -c 'readlink /proc/self/ns/net >&2'").unwrap();
-    let err = match rtoracle::candidate::Session::start(command, fast()) {
+    let err = match rtoracle::candidate::process::session::Session::start(command, fast()) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("it does not answer the hello"),
     };

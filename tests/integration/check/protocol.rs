@@ -5,8 +5,12 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use rtoracle::candidate::check_command;
 use rtoracle::candidate::fuzzing::generate::random_cases;
-use rtoracle::candidate::{CandidateCommand, CheckReport, FailureKind, RunOptions, check_command};
+use rtoracle::candidate::judging::check::FailureKind;
+use rtoracle::candidate::judging::report::CheckReport;
+use rtoracle::candidate::process::command::CandidateCommand;
+use rtoracle::candidate::process::options::RunOptions;
 use rtoracle::oracle::vectors::{Case, Class, ShapeKind};
 
 use crate::common::*;

@@ -10,7 +10,9 @@ use std::sync::OnceLock;
 use std::time::Duration;
 
 use rtoracle::bench::harness::course_python_or_skip;
-use rtoracle::candidate::{CandidateCommand, RunOptions, Session};
+use rtoracle::candidate::process::command::CandidateCommand;
+use rtoracle::candidate::process::options::RunOptions;
+use rtoracle::candidate::process::session::Session;
 use rtoracle::weekly::{FunctionRunner, Reply, SessionRunner};
 use serde_json::json;
 

@@ -8,9 +8,10 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use pulldown_cmark::{Event, HeadingLevel, Parser, Tag, TagEnd};
+use rtoracle::candidate::judging::check::FailureKind;
 use rtoracle::grade::{
-    CodeChecker, CodeOutcome, FailureKind, FailureSummary, Format, GroupCounts, ImageChecker,
-    ImageOutcome, ImageVerdict, Rubric, grade_to_dir,
+    CodeChecker, CodeOutcome, FailureSummary, Format, GroupCounts, ImageChecker, ImageOutcome,
+    ImageVerdict, Rubric, grade_to_dir,
 };
 use rtoracle::oracle::vectors::ShapeKind;
 
