@@ -3,7 +3,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use rtoracle::escape::terminal_line;
-use rtoracle::golden::embedded::SPP_VARIANTS;
+use rtoracle::golden::SPP_VARIANTS;
 use rtoracle::golden::{
     GOLDEN_SEED, GOLDEN_SPP, GoldenScene, Tolerance, cache_dir, compare_goldens, golden_file_name,
     golden_of, golden_spp, render_golden_bytes,

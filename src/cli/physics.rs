@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::candidate::process::options::RunOptions;
-use rtoracle::physics::materials::check_candidate_materials;
+use rtoracle::physics::check_candidate_materials;
 use rtoracle::physics::{Family, MaterialCase, MaterialOptions, default_materials};
 
 use super::check::{SandboxArgs, Target};
@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long, value_name = "JSON", value_parser = material)]
     material: Vec<MaterialCase>,
     /// Samples per outgoing direction (100 to 1,000,000).
-    #[arg(long, value_name = "N", default_value_t = rtoracle::physics::materials::DEFAULT_SAMPLES, value_parser = samples)]
+    #[arg(long, value_name = "N", default_value_t = rtoracle::physics::DEFAULT_SAMPLES, value_parser = samples)]
     samples: usize,
     /// Seeds the normals, the outgoing directions and the random numbers sent.
     #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
@@ -52,10 +52,10 @@ pub struct Args {
     #[arg(long, requires = "furnace", conflicts_with_all = ["python_course", "adapter"])]
     reference: bool,
     /// With --furnace: samples per pixel of each render (1 to 4096).
-    #[arg(long, value_name = "N", default_value_t = rtoracle::physics::furnace::DEFAULT_SPP, value_parser = furnace_spp, requires = "furnace")]
+    #[arg(long, value_name = "N", default_value_t = rtoracle::physics::DEFAULT_SPP, value_parser = furnace_spp, requires = "furnace")]
     furnace_spp: u32,
     /// With --furnace: renders of each scene, each with its own seed (2 to 64).
-    #[arg(long, value_name = "K", default_value_t = rtoracle::physics::furnace::DEFAULT_RENDERS, value_parser = renders, requires = "furnace")]
+    #[arg(long, value_name = "K", default_value_t = rtoracle::physics::DEFAULT_RENDERS, value_parser = renders, requires = "furnace")]
     renders: usize,
 }
 
@@ -140,9 +140,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// `rtoracle physics --furnace`: the furnace scenes, rendered by the candidate (or the reference)
 /// and judged against their exact images.
 fn furnace(args: Args) -> anyhow::Result<ExitCode> {
-    use rtoracle::physics::furnace::{
-        CandidateRenderer, FurnaceOptions, ReferenceRenderer, check_furnaces,
-    };
+    use rtoracle::physics::{CandidateRenderer, FurnaceOptions, ReferenceRenderer, check_furnaces};
     if args.target.python_course.is_some() {
         anyhow::bail!(
             "--furnace takes --adapter or --reference, not --python-course: the course's \

@@ -8,13 +8,13 @@
 //! pixel, the seed and the tool version: not on the machine or its number of threads
 //! ([`crate::image_io::encode_exr`]).
 //!
-//! What a golden is made from is a [`GoldenScene`] ([`source`]): the scene, the profile it is
+//! What a golden is made from is a [`GoldenScene`] (`source.rs`): the scene, the profile it is
 //! rendered in, and the content of every other file it reads. [`golden_of`] gives the golden of
 //! any of them with at least `M` samples per pixel, used by `compare`, `grade`, `golden FILE.toml`
 //! and `autograder` alike:
-//! 1. a built-in scene's golden compiled into the library ([`embedded`]), when it was made from
+//! 1. a built-in scene's golden compiled into the library (`embedded.rs`), when it was made from
 //!    the scene as it is now and has enough samples;
-//! 2. else the one in the cache ([`cache`]: `<cache folder>/goldens/`, keyed by the scene's
+//! 2. else the one in the cache (`cache.rs`: `<cache folder>/goldens/`, keyed by the scene's
 //!    content, the profile, the samples per pixel, the cache's format and the tool version; the
 //!    key and the folder are documented there), when it is a golden of this scene;
 //! 3. else rendered now (one line on stderr says so, with indicatif's bar when stderr is a
@@ -23,21 +23,24 @@
 //! `M` for a candidate of `N` samples per pixel is [`golden_spp`]`(N) = max(4096, 100 N)`. The
 //! committed goldens of the built-in scenes (`golden/*.exr`, [`GOLDEN_SPP`]) are written and
 //! checked by `rtoracle golden`, which renders them fresh ([`render_golden_bytes`]) and compares
-//! pixels with [`compare_goldens`] ([`diff`]); the test suite keeps them as insta snapshots.
+//! pixels with [`compare_goldens`] (`diff.rs`); the test suite keeps them as insta snapshots.
 
-pub mod cache;
-pub mod diff;
-pub mod embedded;
-pub mod encode;
-pub mod format;
-pub mod source;
+mod cache;
+mod diff;
+mod embedded;
+mod encode;
+mod format;
+mod source;
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub use cache::{CACHE_FORMAT, cache_dir, cache_file};
 pub use diff::{GoldenDiff, PixelDifference, Tolerance, compare_goldens};
-pub use embedded::{embedded_golden, embedded_golden_image, embedded_scenes};
+pub use embedded::{
+    SPP_VARIANTS, embedded_golden, embedded_golden_image, embedded_goldens, embedded_scenes,
+    variant_file_name,
+};
 pub use encode::golden_attributes;
 pub use format::{
     ATTR_CAMERA, ATTR_DEVIATION, ATTR_INPUTS, ATTR_PROFILE, ATTR_SAMPLING, ATTR_SCENE,

@@ -51,7 +51,7 @@ pub const WEEK_RENDER_SECONDS: f64 = 120.0;
 /// `render_jittered` takes `floor(sqrt(5))^2 = 4` samples and their sum is divided by 5, as the
 /// course's film does (a count that is not a square keeps that departure visible in the
 /// golden; at 4 it would vanish). The goldens of those scenes at 5 are compiled in
-/// ([`crate::golden::embedded::SPP_VARIANTS`]).
+/// ([`crate::golden::SPP_VARIANTS`]).
 pub fn week_render_spp(week: Week) -> u32 {
     match week.number() {
         ..=7 => 2,
@@ -579,7 +579,7 @@ mod tests {
                 if crate::golden::at_spp(&scene, g.render_spp()).is_some() {
                     let wanted = (g.scene.as_deref().unwrap(), g.render_spp());
                     assert!(
-                        crate::golden::embedded::SPP_VARIANTS.contains(&wanted),
+                        crate::golden::SPP_VARIANTS.contains(&wanted),
                         "{name}: {wanted:?} has no committed golden"
                     );
                 }

@@ -299,11 +299,11 @@ fn embedded_goldens_are_the_files() {
     files.sort();
     let mut embedded: Vec<String> = embedded_scenes().into_iter().map(String::from).collect();
     // With the goldens of the jittered scenes at the built-in rubrics' samples per pixel.
-    for (scene, spp) in rtoracle::golden::embedded::SPP_VARIANTS {
+    for (scene, spp) in rtoracle::golden::SPP_VARIANTS {
         embedded.push(format!("{scene}.spp{spp}"));
         let file = std::fs::read(golden_dir().join(format!("{scene}.spp{spp}.exr"))).unwrap();
         assert!(
-            rtoracle::golden::embedded::embedded_goldens(scene).any(|(_, b)| b == file.as_slice()),
+            rtoracle::golden::embedded_goldens(scene).any(|(_, b)| b == file.as_slice()),
             "{scene} at {spp} spp: the embedded golden is stale; rebuild"
         );
         let fits = GoldenScene::builtin_at_spp(scene, *spp)
