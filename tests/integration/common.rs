@@ -169,3 +169,70 @@ pub fn shared_temporary_folder(prefix: &str) -> &'static Path {
     REMOVED_AT_EXIT.lock().unwrap().push(dir.clone());
     Box::leak(dir.into_boxed_path())
 }
+
+/// Inserts `line` as the first line of the body of the first `def NAME(` found in `files`, in
+/// their order (after the line starting with `after`, when given), indented as the body is;
+/// returns the file and the inserted line's number (1-based), or `None` when no file has it.
+pub fn insert_first_in_def(
+    files: &[PathBuf],
+    name: &str,
+    after: Option<&str>,
+    line: &str,
+) -> Option<(PathBuf, usize)> {
+    for path in files {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        let start = match after {
+            Some(a) => match lines.iter().position(|l| l.starts_with(a)) {
+                Some(i) => i,
+                None => continue,
+            },
+            None => 0,
+        };
+        let Some(def) = (start..lines.len())
+            .find(|&i| lines[i].trim_start().starts_with(&format!("def {name}(")))
+        else {
+            continue;
+        };
+        // The body: the first line of code after the `def` (which may span lines up to its
+        // `:`), past blank lines and comments.
+        let colon = (def..lines.len())
+            .find(|&i| lines[i].trim_end().ends_with(':'))
+            .unwrap();
+        let body = (colon + 1..lines.len())
+            .find(|&i| {
+                let t = lines[i].trim();
+                !t.is_empty() && !t.starts_with('#')
+            })
+            .unwrap();
+        let indent: String = lines[body]
+            .chars()
+            .take_while(|c| c.is_whitespace())
+            .collect();
+        lines.insert(body, format!("{indent}{line}"));
+        std::fs::write(path, lines.join("\n") + "\n").unwrap();
+        return Some((path.clone(), body + 1));
+    }
+    None
+}
+
+/// `examples/adapter-c/adapter.c` built with `cc` (or `$CC`, and `extra` flags) in `dir`, or
+/// `None` after saying the test is skipped.
+pub fn build_c_adapter(dir: &Path, name: &str, extra: &[&str]) -> Option<PathBuf> {
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let exe = dir.join(name);
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/adapter.c");
+    let built = Command::new(&cc)
+        .args(["-O2", "-Wall", "-Werror"])
+        .args(extra)
+        .arg("-o")
+        .arg(&exe)
+        .arg(&source)
+        .arg("-lm")
+        .status();
+    if !built.map(|s| s.success()).unwrap_or(false) {
+        eprintln!("skipped: no working C compiler ({cc})");
+        return None;
+    }
+    Some(exe)
+}

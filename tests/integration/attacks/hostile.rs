@@ -79,41 +79,9 @@ fn insert_into(dir: &Path, name: &str, after: Option<&str>, line: &str) {
         .filter(|p| p.extension().is_some_and(|x| x == "py"))
         .collect();
     files.sort();
-    for path in files {
-        let text = std::fs::read_to_string(&path).unwrap();
-        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
-        let start = match after {
-            Some(a) => match lines.iter().position(|l| l.starts_with(a)) {
-                Some(i) => i,
-                None => continue,
-            },
-            None => 0,
-        };
-        let Some(def) = (start..lines.len())
-            .find(|&i| lines[i].trim_start().starts_with(&format!("def {name}(")))
-        else {
-            continue;
-        };
-        // The body: the first line of code after the `def` (which may span lines up to its
-        // `:`), past blank lines and comments.
-        let colon = (def..lines.len())
-            .find(|&i| lines[i].trim_end().ends_with(':'))
-            .unwrap();
-        let body = (colon + 1..lines.len())
-            .find(|&i| {
-                let t = lines[i].trim();
-                !t.is_empty() && !t.starts_with('#')
-            })
-            .unwrap();
-        let indent: String = lines[body]
-            .chars()
-            .take_while(|c| c.is_whitespace())
-            .collect();
-        lines.insert(body, format!("{indent}{line}"));
-        std::fs::write(&path, lines.join("\n") + "\n").unwrap();
-        return;
+    if insert_first_in_def(&files, name, after, line).is_none() {
+        panic!("no def {name} in {}", dir.display());
     }
-    panic!("no def {name} in {}", dir.display());
 }
 
 /// Every report of `out` and the terminal's text, checked for their formats; returns

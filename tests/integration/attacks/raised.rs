@@ -32,44 +32,13 @@ fn raise_in(dir: &Path, name: &str, after: Option<&str>, mark: &str) -> (String,
             .position(|f| *f == n)
             .unwrap_or(9)
     });
-    for path in files {
-        let text = std::fs::read_to_string(&path).unwrap();
-        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
-        let start = match after {
-            Some(a) => match lines.iter().position(|l| l.starts_with(a)) {
-                Some(i) => i,
-                None => continue,
-            },
-            None => 0,
-        };
-        let Some(def) = (start..lines.len())
-            .find(|&i| lines[i].trim_start().starts_with(&format!("def {name}(")))
-        else {
-            continue;
-        };
-        // The body: the first line of code after the `def` (which may span lines up to its
-        // `:`), past blank lines and comments.
-        let colon = (def..lines.len())
-            .find(|&i| lines[i].trim_end().ends_with(':'))
-            .unwrap();
-        let body = (colon + 1..lines.len())
-            .find(|&i| {
-                let t = lines[i].trim();
-                !t.is_empty() && !t.starts_with('#')
-            })
-            .unwrap();
-        let indent: String = lines[body]
-            .chars()
-            .take_while(|c| c.is_whitespace())
-            .collect();
-        lines.insert(body, format!("{indent}raise ZeroDivisionError(\"{mark}\")"));
-        std::fs::write(&path, lines.join("\n") + "\n").unwrap();
-        return (
-            path.file_name().unwrap().to_string_lossy().to_string(),
-            body + 1,
-        );
-    }
-    panic!("no def {name} in {}", dir.display());
+    let line = format!("raise ZeroDivisionError(\"{mark}\")");
+    let (path, number) = insert_first_in_def(&files, name, after, &line)
+        .unwrap_or_else(|| panic!("no def {name} in {}", dir.display()));
+    (
+        path.file_name().unwrap().to_string_lossy().to_string(),
+        number,
+    )
 }
 
 /// The places put into the week-9 submission `dir`: (what, "ZeroDivisionError: MARK (FILE,

@@ -1097,27 +1097,6 @@ fn bench_candidate_runs_from_a_copy_of_the_binary_in_an_empty_folder() {
     );
 }
 
-/// `examples/adapter-c/adapter.c` built with `cc` (and `extra` flags) in `dir`, or `None` after
-/// saying the test is skipped.
-fn build_c_adapter(dir: &Path, name: &str, extra: &[&str]) -> Option<PathBuf> {
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    let exe = dir.join(name);
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/adapter.c");
-    let built = std::process::Command::new(&cc)
-        .args(["-O2", "-Wall", "-Werror"])
-        .args(extra)
-        .arg("-o")
-        .arg(&exe)
-        .arg(&source)
-        .arg("-lm")
-        .status();
-    if !built.map(|s| s.success()).unwrap_or(false) {
-        eprintln!("skipped: no working C compiler ({cc})");
-        return None;
-    }
-    Some(exe)
-}
-
 /// `rtoracle check --adapter ./NAME ARGS --json` in `dir`: the exit code and the report.
 fn check_c(dir: &Path, name: &str, args: &[&str]) -> (Option<i32>, serde_json::Value) {
     let adapter = format!("./{name}");

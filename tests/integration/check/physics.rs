@@ -3,30 +3,11 @@
 //! through the course adapter; the furnaces through a fixture path tracer's render requests
 //! (honest and with each catalogued integrator mistake) and the reference; and bad input.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use crate::common::{CourseTree, assert_bad_input, course_week_copy, rtoracle, run_in};
-
-/// `examples/adapter-c/adapter.c` built with `extra` flags in `dir`, or `None` after saying the
-/// test is skipped.
-fn build(dir: &Path, name: &str, extra: &[&str]) -> Option<PathBuf> {
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    let exe = dir.join(name);
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/adapter.c");
-    let built = std::process::Command::new(&cc)
-        .args(["-O2", "-Wall", "-Werror"])
-        .args(extra)
-        .arg("-o")
-        .arg(&exe)
-        .arg(&source)
-        .arg("-lm")
-        .status();
-    if !built.map(|s| s.success()).unwrap_or(false) {
-        eprintln!("skipped: no working C compiler ({cc})");
-        return None;
-    }
-    Some(exe)
-}
+use crate::common::{
+    CourseTree, assert_bad_input, build_c_adapter, course_week_copy, rtoracle, run_in,
+};
 
 const LAMBERTIAN: &str = r#"{"type":"lambertian","albedo":[0.8,0.6,0.4]}"#;
 const METAL: &str = r#"{"type":"metal","albedo":[0.9,0.8,0.7],"roughness":0.3}"#;
@@ -86,7 +67,7 @@ fn laws_with(report: &serde_json::Value, index: usize, status: &str) -> Vec<Stri
 #[test]
 fn the_c_example_passes_and_each_catalogued_mistake_fails_its_law() {
     let tmp = tempfile::tempdir().unwrap();
-    let Some(_) = build(tmp.path(), "honest", &[]) else {
+    let Some(_) = build_c_adapter(tmp.path(), "honest", &[]) else {
         return;
     };
     let (code, report) = physics(tmp.path(), "honest", &[LAMBERTIAN, METAL, GLASS]);
@@ -108,7 +89,7 @@ fn the_c_example_passes_and_each_catalogued_mistake_fails_its_law() {
     ];
     for (mistake, material, laws) in cases {
         let name = mistake.to_lowercase();
-        build(tmp.path(), &name, &[&format!("-DMISTAKE_{mistake}")]).unwrap();
+        build_c_adapter(tmp.path(), &name, &[&format!("-DMISTAKE_{mistake}")]).unwrap();
         let (code, report) = physics(tmp.path(), &name, &[material]);
         assert_eq!(code, Some(1), "{mistake}: {report:#}");
         let failed = laws_with(&report, 0, "failed");
@@ -237,7 +218,7 @@ fn the_furnaces_pass_honest_estimators_and_fail_each_catalogued_mistake() {
 #[test]
 fn the_c_example_passes_the_furnaces_and_its_mistakes_fail_by_their_closed_form() {
     let tmp = tempfile::tempdir().unwrap();
-    let Some(_) = build(tmp.path(), "honest", &[]) else {
+    let Some(_) = build_c_adapter(tmp.path(), "honest", &[]) else {
         return;
     };
     let run = |name: &str| {
@@ -260,7 +241,7 @@ fn the_c_example_passes_the_furnaces_and_its_mistakes_fail_by_their_closed_form(
         ("UNIFORM_HEMISPHERE", None),
     ] {
         let name = mistake.to_lowercase();
-        build(tmp.path(), &name, &[&format!("-DMISTAKE_{mistake}")]).unwrap();
+        build_c_adapter(tmp.path(), &name, &[&format!("-DMISTAKE_{mistake}")]).unwrap();
         let (code, report) = run(&name);
         let Some(expected) = grey_ratio else {
             assert_eq!(code, Some(0), "{mistake}: {report:#}");
