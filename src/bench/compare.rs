@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
 use crate::compare::diagnose::mistakes::{Mistake, render_with_mistake};
-use crate::compare::{CandidateImage, CompareOptions, Golden, compare_file, compare_image};
+use crate::compare::{
+    CompareOptions, candidate::CandidateImage, compare_file, compare_image, noise_model::Golden,
+};
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();

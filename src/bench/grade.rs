@@ -13,8 +13,11 @@ use std::time::{Duration, Instant};
 
 use serde::Deserialize;
 
-use crate::grade::CompareImageChecker;
-use crate::grade::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
+use crate::grade::checkers::images::CompareImageChecker;
+use crate::grade::{
+    batch, checkers::ImageChecker, checkers::code::CourseCodeChecker, report::Format,
+    rubric::Rubric, write::grade_to_dir,
+};
 use crate::image_io::{Rgb8Image, write_png};
 use crate::render::{RenderOptions, render};
 
@@ -232,11 +235,11 @@ pub fn run() -> String {
     // The grader's renders measured on their own (one submission, one core); the other figures
     // judge the uploaded images, as they did before renders, so they stay comparable.
     let sandboxed = CourseCodeChecker::default();
-    let isolation = crate::sandbox::isolation_for(&sandboxed.policy)
+    let isolation = crate::sandbox::detect::isolation_for(&sandboxed.policy)
         .map_or_else(|e| format!("no sandbox: {e}"), |i| i.name().to_string());
     // The sandbox's share: the same work with the same limits and watchdog, no isolation.
     let unsandboxed = CourseCodeChecker {
-        policy: crate::sandbox::SandboxPolicy {
+        policy: crate::sandbox::policy::SandboxPolicy {
             unsandboxed: true,
             ..sandboxed.policy.clone()
         },
@@ -410,7 +413,7 @@ fn week08_one(work: &Path) -> WeekGrade {
             &submission,
             &rubric,
             &CourseCodeChecker {
-                week: rubric.week.and_then(crate::weekly::Week::new),
+                week: rubric.week.and_then(crate::weekly::week::Week::new),
                 time_budget: Some(Duration::from_secs_f64(rubric.code_time_budget_seconds)),
                 ..CourseCodeChecker::default()
             },
@@ -431,7 +434,7 @@ fn week08_one(work: &Path) -> WeekGrade {
 }
 
 /// Each rendered group's id, spp and seconds, from a report.
-fn render_times(report: &crate::grade::GradeReport) -> Vec<(String, u64, f64)> {
+fn render_times(report: &crate::grade::result::GradeReport) -> Vec<(String, u64, f64)> {
     report
         .checks
         .iter()

@@ -222,7 +222,7 @@ pub fn run(options: Options) -> Result<String, HarnessError> {
         return Ok(out);
     }
 
-    let suite = crate::oracle::default_suite(0);
+    let suite = crate::oracle::suite::default_suite(0);
     let t = Instant::now();
     let report = crate::candidate::check_command(
         CandidateCommand::python_course_with(honest.path(), Some(&python), false)?,

@@ -18,9 +18,9 @@
 //! - Here: [`check_command`] and [`check_session`], one candidate checked against a list of
 //!   cases, start to report.
 
-pub mod fuzzing;
-pub mod judging;
 pub mod process;
+pub mod judging;
+pub mod fuzzing;
 pub mod rust;
 #[cfg(test)]
 pub(crate) mod test_cases;

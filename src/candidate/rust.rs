@@ -25,7 +25,7 @@
 //!     }
 //! }
 //!
-//! let suite = rtoracle::oracle::default_suite(0);
+//! let suite = rtoracle::oracle::suite::default_suite(0);
 //! let report = check_candidate(&mut MyTracer, &suite);
 //! assert!(report.passed(), "{}", report.to_text(10));
 //! assert_eq!(report.counts.failed, 0);
@@ -106,7 +106,7 @@ pub fn run_candidate<C: Candidate + ?Sized>(candidate: &mut C, cases: &[Case]) -
         .collect()
 }
 
-/// Checks `candidate` against `cases` (e.g. [`crate::oracle::default_suite`]) and returns the
+/// Checks `candidate` against `cases` (e.g. [`crate::oracle::suite::default_suite`]) and returns the
 /// report.
 pub fn check_candidate<C: Candidate + ?Sized>(candidate: &mut C, cases: &[Case]) -> CheckReport {
     let outcomes = run_candidate(candidate, cases);

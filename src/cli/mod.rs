@@ -1,21 +1,17 @@
-//! The command line: one module per subcommand, each with its clap arguments and a `run`.
+//! The command line: one module per subcommand, each with its clap arguments and a `run`, in
+//! rooms by what the subcommands are for, in the order `rtoracle --help` lists them:
+//! [`reference`] (render, scenes, golden, vectors, explain), [`checking`] (check, fuzz, physics,
+//! compare), [`grading`] (grade, autograder) and [`bench`]; `out` (stdout and stderr that a
+//! closed pipe cannot make panic) and `args` (the options several share) serve them all.
 
 #[macro_use]
 mod out;
+mod args;
 
-mod autograder;
+mod reference;
+mod checking;
+mod grading;
 mod bench;
-mod check;
-mod compare;
-mod explain;
-mod fuzz;
-mod golden;
-mod grade;
-mod num;
-mod physics;
-mod render;
-mod scenes;
-mod vectors;
 
 use std::process::ExitCode;
 
@@ -32,29 +28,29 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Render a built-in scene or a TOML scene file to PNG or EXR.
-    Render(render::Args),
+    Render(reference::render::Args),
     /// List the built-in scenes, or print one as TOML.
-    Scenes(scenes::Args),
+    Scenes(reference::scenes::Args),
     /// Write or verify the golden EXRs of the built-in scenes.
-    Golden(golden::Args),
+    Golden(reference::golden::Args),
     /// Export intersection test vectors as JSON lines.
-    Vectors(vectors::Args),
+    Vectors(reference::vectors::Args),
     /// Explain, step by step, the oracle's answer for one vector.
-    Explain(explain::Args),
+    Explain(reference::explain::Args),
     /// Check an implementation against the intersection vectors.
     ///
     /// Exit codes: 0 every vector run passed (shapes the candidate does not support are not run,
     /// and said so; `--require triangle` makes that a failure), 1 a vector failed, 2 bad input or
     /// a harness error.
-    Check(check::Args),
+    Check(checking::check::Args),
     /// Differential fuzzing of an implementation against the oracle, with shrinking.
-    Fuzz(fuzz::Args),
+    Fuzz(checking::fuzz::Args),
     /// Physics checks that need no golden: a renderer's materials (sampling, pdf, weights,
     /// energy, reciprocity) through the protocol's material requests.
     ///
     /// Exit codes: 0 every law held (findings about a model aside), 1 a law failed or nothing
     /// could be checked, 2 bad input or a harness error.
-    Physics(physics::Args),
+    Physics(checking::physics::Args),
     /// Compare a rendered image with a golden, telling Monte Carlo noise from bugs; or two
     /// renders of the same scene with no golden (`compare A B`).
     ///
@@ -64,14 +60,14 @@ enum Command {
     /// folder of EXR renders of the scene with different seeds.
     ///
     /// Exit codes: 0 PASS (the differences are noise), 1 FAIL, 2 bad input.
-    Compare(compare::Args),
+    Compare(checking::compare::Args),
     /// Grade a submission (or a folder of them with --batch) and write the reports.
     ///
     /// Exit codes: 0 graded (whatever the score; the score is in the reports), 2 bad input or
     /// a harness error.
-    Grade(grade::Args),
+    Grade(grading::grade::Args),
     /// Build a Gradescope autograder package.
-    Autograder(autograder::Args),
+    Autograder(grading::autograder::Args),
     /// Measure speed (render, oracle, candidate, compare, grade) against baselines in the same run.
     Bench(bench::Args),
 }
@@ -82,7 +78,7 @@ pub const FAILED: u8 = 1;
 
 /// Parses the arguments and runs the subcommand. Usage errors are one line on stderr and exit 2.
 pub fn run() -> anyhow::Result<ExitCode> {
-    let command = num::allow_negative_numbers(Cli::command());
+    let command = args::allow_negative_numbers(Cli::command());
     let parsed = command
         .try_get_matches()
         .and_then(|m| Cli::from_arg_matches(&m));
@@ -102,17 +98,17 @@ pub fn run() -> anyhow::Result<ExitCode> {
         }
     };
     match cli.command {
-        Command::Render(args) => render::run(args),
-        Command::Scenes(args) => scenes::run(args),
-        Command::Golden(args) => golden::run(args),
-        Command::Vectors(args) => vectors::run(args),
-        Command::Explain(args) => explain::run(args),
-        Command::Check(args) => check::run(args),
-        Command::Fuzz(args) => fuzz::run(args),
-        Command::Physics(args) => physics::run(args),
-        Command::Compare(args) => compare::run(args),
-        Command::Grade(args) => grade::run(args),
-        Command::Autograder(args) => autograder::run(args),
+        Command::Render(args) => reference::render::run(args),
+        Command::Scenes(args) => reference::scenes::run(args),
+        Command::Golden(args) => reference::golden::run(args),
+        Command::Vectors(args) => reference::vectors::run(args),
+        Command::Explain(args) => reference::explain::run(args),
+        Command::Check(args) => checking::check::run(args),
+        Command::Fuzz(args) => checking::fuzz::run(args),
+        Command::Physics(args) => checking::physics::run(args),
+        Command::Compare(args) => checking::compare::run(args),
+        Command::Grade(args) => grading::grade::run(args),
+        Command::Autograder(args) => grading::autograder::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

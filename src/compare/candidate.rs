@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use super::{CompareError, Encoding};
+use super::{CompareError, encoding::Encoding};
 
 /// A candidate image: 8-bit codes (from a PNG or PPM) or linear values (from an EXR).
 #[derive(Clone, Debug, PartialEq)]

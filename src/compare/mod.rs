@@ -8,9 +8,8 @@
 //! adjusted with Šidák's formula over its tests. When an image fails, [`diagnose`] tests the
 //! common mistakes as alternative hypotheses. See `docs/comparing-images.md`.
 
-pub mod candidate;
-pub mod diagnose;
 pub mod encoding;
+pub mod candidate;
 pub mod flip;
 pub mod heatmap;
 pub mod noise_model;
@@ -19,19 +18,17 @@ pub mod report;
 pub mod stats;
 pub mod twosample;
 pub mod verdict;
+pub mod diagnose;
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-pub use candidate::CandidateImage;
-pub use encoding::{ENCODINGS, Encoding};
-pub use heatmap::write_heatmap;
-pub use noise_model::Golden;
-pub use report::{write_report, write_report_to};
-pub use verdict::{Evaluation, evaluate};
-
 use crate::image_io::ImageError;
+use candidate::CandidateImage;
+use encoding::Encoding;
+use noise_model::Golden;
+use verdict::evaluate;
 
 /// What stops a comparison (one line, naming the file when there is one).
 #[derive(Debug, thiserror::Error)]

@@ -11,7 +11,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::heatmap::heatmap_image;
-use super::{CandidateImage, CompareError, Comparison, Encoding, Golden};
+use super::{
+    CompareError, Comparison, candidate::CandidateImage, encoding::Encoding, noise_model::Golden,
+};
 use crate::escape::html;
 use crate::image_io::{Rgb8Image, encode_png};
 use crate::output::{OutputDir, OutputError, Replaceable};

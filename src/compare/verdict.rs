@@ -3,8 +3,8 @@
 
 use super::stats::{bernstein_p, sidak};
 use super::{
-    CandidateImage, CompareOptions, Comparison, Diagnosis, Encoding, Golden, NoiseCheck, Region,
-    ScaleResult, Verdict,
+    CompareOptions, Comparison, Diagnosis, NoiseCheck, Region, ScaleResult, Verdict,
+    candidate::CandidateImage, encoding::Encoding, noise_model::Golden,
 };
 
 /// The false-failure bound of the noise check (on top of the four scales' `alpha`).

@@ -6,10 +6,10 @@
 //! `t` when the interval *contains* it (closed), directions are never normalised, and the normal
 //! of a hit record is a unit vector that faces the incoming ray.
 
-mod hit;
 mod interval;
-mod quad;
 mod ray;
+mod hit;
+mod quad;
 mod sphere;
 mod triangle;
 

@@ -25,12 +25,12 @@
 //! checked by `rtoracle golden`, which renders them fresh ([`render_golden_bytes`]) and compares
 //! pixels with [`compare_goldens`] (`diff.rs`); the test suite keeps them as insta snapshots.
 
-mod cache;
+mod format;
 mod diff;
 mod embedded;
-mod encode;
-mod format;
 mod source;
+mod cache;
+mod encode;
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};

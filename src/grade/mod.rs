@@ -3,10 +3,10 @@
 //! `report.json`, Gradescope's `results.json`, `junit.xml` and a student's `feedback.md`; batches
 //! with a gradebook; and a Gradescope autograder package.
 //!
-//! Grading sees the code under test only through [`CodeChecker`] and the images only through
-//! [`ImageChecker`] ([`checkers`]). The code checker is [`CourseCodeChecker`] ([`checkers::code`]): the
+//! Grading sees the code under test only through [`CodeChecker`](checkers::CodeChecker) and the images only through
+//! [`ImageChecker`](checkers::ImageChecker) ([`checkers`]). The code checker is [`CourseCodeChecker`](checkers::code::CourseCodeChecker) ([`checkers::code`]): the
 //! `check` harness running the course adapter in the [sandbox](crate::sandbox); the image
-//! checker is [`CompareImageChecker`] ([`checkers::images`]), the noise-aware comparison against
+//! checker is [`CompareImageChecker`](checkers::images::CompareImageChecker) ([`checkers::images`]), the noise-aware comparison against
 //! the golden of a built-in scene (embedded) or of an instructor's scene file (the rubric's, or
 //! rendered once and cached). Image groups are rendered by the grader from the submission's own
 //! code by default ([`checkers::rendered`]): the code checker renders, the image checker judges
@@ -14,23 +14,23 @@
 //!
 //! Four rooms, and the single-submission path on top:
 //!
-//! - [`rubric`]: the [`Rubric`] (built-in weeks in [`rubric::weeks`], TOML files), partial
-//!   credit ([`rubric::credit`]) and the points of each group ([`rubric::score`]).
+//! - [`rubric`]: the [`Rubric`](rubric::Rubric) (built-in weeks in [`rubric::weeks`], TOML files), partial
+//!   credit ([`rubric::credit`]) and the points of each group ([`score`]).
 //! - [`checkers`]: the two interfaces and their real implementations: the course's code through
 //!   the `check` harness ([`checkers::code`]), the weekly function checks
-//!   (`checkers::weekly`), images against their reference ([`checkers::images`]), renders
+//!   (`score::weekly`), images against their reference ([`checkers::images`]), renders
 //!   asked of the submission's own code ([`checkers::rendered`], [`checkers::noise_floor`]) and
 //!   copied images ([`checkers::copies`]).
 //! - [`batch`]: a folder of submissions in parallel, the gradebook, one shard's entry
 //!   ([`batch::entry`]), the merge of shards ([`batch::merge`]) and the pairs whose noise is
 //!   shared ([`batch::shared_noise`]).
 //! - [`autograder`]: the Gradescope package ([`autograder::pack`]).
-//! - [`report`]: every format written from one [`GradeReport`].
-//! - Here: [`intake`] of a submission's files, the run ([`grade`]), the result model and
-//!   [`grade_to_dir`].
+//! - [`report`]: every format written from one [`GradeReport`](result::GradeReport).
+//! - Here: [`intake`] of a submission's files, the run ([`grade`](run::grade)), the result model and
+//!   [`grade_to_dir`](write::grade_to_dir).
 //!
 //! ```no_run
-//! use rtoracle::grade::{CompareImageChecker, CourseCodeChecker, Format, Rubric, grade_to_dir};
+//! use rtoracle::grade::{checkers::images::CompareImageChecker, checkers::code::CourseCodeChecker, report::Format, rubric::Rubric, write::grade_to_dir};
 //! let report = grade_to_dir(
 //!     "submission".as_ref(),
 //!     &Rubric::week04(),
@@ -40,34 +40,16 @@
 //!     &Format::ALL,
 //! )?;
 //! println!("{} / {}", report.score, report.max_score);
-//! # Ok::<(), rtoracle::grade::GradeError>(())
+//! # Ok::<(), rtoracle::grade::result::GradeError>(())
 //! ```
 
-pub mod autograder;
-pub mod batch;
-pub mod checkers;
-pub mod intake;
-pub mod report;
-mod result;
 pub mod rubric;
-mod run;
-mod write;
-
-pub use checkers::code::CourseCodeChecker;
-pub use checkers::images::CompareImageChecker;
-pub use checkers::weekly::{UNSCORED_ID, function_checks};
-pub use checkers::{
-    CodeChecker, CodeOutcome, FailureSummary, FunctionsOutcome, GroupCounts, ImageChecker,
-    ImageOutcome, ImageVerdict,
-};
-pub use report::{Format, write_reports};
-pub use result::{
-    CheckResult, CheckStatus, CodeRun, FAILURES_SHOWN, GradeError, GradeReport, ImageResult,
-    Reproducibility, round2, smallest_failure,
-};
-pub use rubric::{
-    GoldenFile, Group, GroupKind, ImageSource, Rubric, RubricError, SceneFile, SceneSource,
-    Visibility,
-};
-pub use run::grade;
-pub use write::{REPORT_FOLDER, grade_to_dir};
+pub mod checkers;
+pub mod autograder;
+pub mod intake;
+pub mod result;
+pub mod score;
+pub mod report;
+pub mod run;
+pub mod write;
+pub mod batch;

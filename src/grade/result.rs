@@ -109,7 +109,7 @@ pub struct CheckResult {
     /// For function checks that did not pass (and the unscored check's first failure): the
     /// function's result, with its smallest failing case and its reproduction.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub function: Option<crate::weekly::FunctionResult>,
+    pub function: Option<crate::weekly::run::FunctionResult>,
 }
 
 /// What was checked and with what, so a grade can be reproduced.

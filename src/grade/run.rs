@@ -9,8 +9,8 @@ use std::time::Instant;
 use super::checkers::copies::{CopyFinding, Fingerprint, recognise};
 use super::checkers::{CodeChecker, CodeOutcome, ImageChecker, ImageOutcome, ImageVerdict};
 use super::result::{CodeRun, GradeError, GradeReport, Reproducibility, round2};
-use super::rubric::score::{code_check, heatmap_name, image_check};
 use super::rubric::{Group, GroupKind, Rubric, SceneSource};
+use super::score::{code_check, heatmap_name, image_check};
 use crate::candidate::process::render_request::RenderOutcome;
 
 /// The size the image of `scene` must have, when `scene` is a built-in scene.
@@ -132,7 +132,7 @@ fn render_check(
     let mut check = image_check(g, judged, copy.clone(), out_dir);
     match &copy {
         Some(c) => check.message = c.render_sentence().into(),
-        None => super::checkers::rendered::explain(&mut check, g),
+        None => super::score::explain(&mut check, g),
     }
     check
 }
@@ -145,8 +145,8 @@ fn run_code(
     code: &dyn CodeChecker,
 ) -> (CodeOutcome, Option<super::checkers::FunctionsOutcome>) {
     let shapes = rubric.code_shapes();
-    let week = rubric.week.and_then(crate::weekly::Week::new);
-    let function_options = crate::weekly::FunctionOptions {
+    let week = rubric.week.and_then(crate::weekly::week::Week::new);
+    let function_options = crate::weekly::run::FunctionOptions {
         seed: rubric.seed,
         alpha: rubric.alpha.unwrap_or(crate::weekly::stats::DEFAULT_ALPHA),
     };
@@ -212,7 +212,7 @@ pub fn grade(
     let mut fingerprints = Vec::new();
     let mut function_checks = functions
         .as_ref()
-        .map(|f| super::checkers::weekly::function_checks(rubric, f))
+        .map(|f| super::score::weekly::function_checks(rubric, f))
         .unwrap_or_default();
     for g in &rubric.groups {
         match g.kind {

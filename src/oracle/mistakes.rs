@@ -776,7 +776,7 @@ pub fn buggy_extra() -> Vec<Variant> {
 #[cfg(test)]
 mod extra_tests {
     use super::*;
-    use crate::oracle::default_suite;
+    use crate::oracle::suite::default_suite;
 
     #[test]
     fn every_extra_buggy_variant_fails_a_definite_vector_and_differs_from_the_others() {
@@ -810,8 +810,8 @@ mod extra_tests {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::oracle::default_suite;
     use crate::oracle::profile::{Judging, Precision, Profile};
+    use crate::oracle::suite::default_suite;
 
     fn failures(v: &Variant, suite: &[crate::oracle::vectors::Case]) -> Vec<String> {
         suite
@@ -844,7 +844,7 @@ mod tests {
     }
 
     fn judged(j: Judging) -> Vec<crate::oracle::vectors::Case> {
-        crate::oracle::default_suite_with(0, j)
+        crate::oracle::suite::default_suite_with(0, j)
     }
 
     #[test]

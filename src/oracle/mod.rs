@@ -5,18 +5,14 @@
 //! benchmark ([`crate::bench::oracle`]) and the language-agnostic vector format ([`vectors`]).
 
 pub mod band;
-pub mod classify;
-pub mod exact;
-pub mod explain;
-pub mod fuzzing;
-pub mod generate;
-pub mod mistakes;
 pub mod profile;
-pub mod suite;
-pub mod tags;
 pub mod vectors;
+pub mod exact;
+pub mod tags;
+pub mod classify;
+pub mod explain;
+pub mod generate;
+pub mod fuzzing;
+pub mod mistakes;
 pub mod watertight;
-
-pub use classify::{analyse, analyse_with, classify, classify_tagged, classify_with};
-pub use profile::{Judging, Precision, Profile};
-pub use suite::{default_suite, default_suite_with};
+pub mod suite;

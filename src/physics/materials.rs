@@ -662,7 +662,7 @@ pub fn check_candidate_materials(
     let label = command.label.clone();
     let timeout = run.timeout;
     let mut session = crate::candidate::process::session::Session::start(command, run)?;
-    let mut runner = crate::weekly::SessionRunner::new(&mut session);
+    let mut runner = crate::weekly::runner::SessionRunner::new(&mut session);
     let mut source = super::source::ProtocolSource::new(&mut runner, label, timeout);
     let mut model = reference.map(super::models::ModelSource::new);
     Ok(check_materials(

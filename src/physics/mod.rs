@@ -14,12 +14,12 @@
 //!   and judged against their exact image with no golden.
 
 mod furnace;
+mod source;
+mod models;
+mod sphere;
 mod laws;
 mod materials;
-mod models;
 mod report;
-mod source;
-mod sphere;
 
 pub use furnace::{
     CandidateRenderer, DEFAULT_RENDERS, DEFAULT_SPP, Furnace, FurnaceOptions, FurnaceRenderer,

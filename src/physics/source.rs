@@ -13,7 +13,7 @@ use std::time::Duration;
 use glam::DVec3;
 use serde_json::{Value, json};
 
-use crate::weekly::{FunctionRunner, Reply};
+use crate::weekly::{runner::FunctionRunner, runner::Reply};
 
 /// One of the three material requests.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

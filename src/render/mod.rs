@@ -11,18 +11,18 @@
 //! prepared shapes (`fast/fixed_origin/`), and, on x86_64, four rays at once in AVX2
 //! (`fast/lanes.rs`, the one place the processor is chosen).
 
-mod brdf;
-mod fast;
 mod film;
-mod integrator;
+mod sampler;
 mod job;
 mod optics;
-mod renderer;
-mod sampler;
+mod brdf;
+mod surface;
 mod scatter;
+mod integrator;
+mod fast;
+mod renderer;
 #[cfg(test)]
 mod stats;
-mod surface;
 
 pub use brdf::{blinn, cook_torrance, ggx, halfvector, phong, smith_g1};
 pub use film::{Film, encode_book_png, encode_course_png};

@@ -1,5 +1,5 @@
 //! Who the code runs as: whether the harness is root, a user and group id of its own for every
-//! [`Sandbox`](super::Sandbox) made by a root harness, and the kill of every process of such an id.
+//! [`Sandbox`](super::lifecycle::Sandbox) made by a root harness, and the kill of every process of such an id.
 //!
 //! Promises:
 //! - [`allocate`] returns an id in `[2^30, 2^31)` that has no `passwd` entry and no live process,

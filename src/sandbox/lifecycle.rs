@@ -11,8 +11,7 @@ use super::bounds::reaper::Reaper;
 use super::bounds::{cgroup, held, ipc, scratch, watchdog};
 use super::identity::{self, running_as_root};
 use super::policy::{Isolation, SandboxError, SandboxPolicy};
-use super::start::admission::InfoSlot;
-use super::start::{bwrap, view};
+use super::view;
 
 /// A prepared sandbox: a temporary folder holding copies of the files, the policy, the
 /// isolation and the identity the code runs as.
@@ -208,7 +207,7 @@ impl Sandbox {
     /// The folder as the code sees it (`/sandbox` under bubblewrap).
     pub fn inside_dir(&self) -> PathBuf {
         match self.isolation {
-            Isolation::Bubblewrap => PathBuf::from(bwrap::INSIDE),
+            Isolation::Bubblewrap => PathBuf::from(view::INSIDE),
             _ => self.dir().to_path_buf(),
         }
     }
@@ -335,5 +334,29 @@ impl Drop for Sandbox {
         }
         // Killed and removed once empty.
         self.cgroup = None;
+    }
+}
+
+/// What bubblewrap's `--info-fd` said for one command, once its admission has read it.
+#[derive(Debug, Default)]
+pub(in crate::sandbox) struct InfoSlot {
+    text: Mutex<Option<String>>,
+    ready: std::sync::Condvar,
+}
+
+impl InfoSlot {
+    pub(in crate::sandbox) fn set(&self, text: String) {
+        *self.text.lock().unwrap_or_else(|e| e.into_inner()) = Some(text);
+        self.ready.notify_all();
+    }
+
+    /// The text, waiting up to `timeout` for it (empty when it does not come).
+    pub(in crate::sandbox) fn wait(&self, timeout: std::time::Duration) -> String {
+        let guard = self.text.lock().unwrap_or_else(|e| e.into_inner());
+        let (guard, _) = self
+            .ready
+            .wait_timeout_while(guard, timeout, |t| t.is_none())
+            .unwrap_or_else(|e| e.into_inner());
+        guard.clone().unwrap_or_default()
     }
 }

@@ -5,17 +5,17 @@
 //!
 //! # What it promises
 //! - **Never as root.** Untrusted code never runs as uid 0. A root harness gives every
-//!   [`Sandbox`] an unprivileged uid and gid of its own ([`identity`]: `2^30 + ...`, no `passwd`
+//!   [`Sandbox`](lifecycle::Sandbox) an unprivileged uid and gid of its own ([`identity`]: `2^30 + ...`, no `passwd`
 //!   entry needed), so no submission can signal, trace or read another's files; a harness that is
 //!   not root runs the code as its own (unprivileged) user. When no unprivileged identity can be
-//!   used, [`Sandbox::new`] fails ([`SandboxError::Unavailable`]): `grade` exits 2, and so do
+//!   used, [`Sandbox::new`](lifecycle::Sandbox::new) fails ([`SandboxError::Unavailable`](policy::SandboxError::Unavailable)): `grade` exits 2, and so do
 //!   `check` and `fuzz` unless `--unsandboxed` asks to run one's own code without a sandbox
-//!   ([`Isolation::Unsandboxed`], which the facts and the output then say).
-//! - **A real sandbox where one can be made: bubblewrap** ([`Isolation::Bubblewrap`]). bubblewrap
+//!   ([`Isolation::Unsandboxed`](policy::Isolation::Unsandboxed), which the facts and the output then say).
+//! - **A real sandbox where one can be made: bubblewrap** ([`Isolation::Bubblewrap`](policy::Isolation::Bubblewrap)). bubblewrap
 //!   is probed once per process (it fails in containers that refuse user namespaces). The code
 //!   runs in new user, PID, mount, IPC, network, UTS (and cgroup, where allowed) namespaces, with
 //!   `--die-with-parent`, `--new-session`, `--disable-userns`, `--cap-drop ALL`, a cleared
-//!   environment and a view of its own ([`start::view`], [`start::bwrap`]): the system's `/usr` and `/lib*`,
+//!   environment and a view of its own ([`view`], [`start::bwrap`]): the system's `/usr` and `/lib*`,
 //!   the loader's `/etc` files, a read-only `/dev` (but a 4 MiB tmpfs at `/dev/shm`, for
 //!   `multiprocessing`), a `/tmp` that is a tmpfs of bounded size, the
 //!   sandbox folder at `/sandbox`, and the paths exposed read-only (an interpreter and its
@@ -24,7 +24,7 @@
 //!   the rubric, the vectors, the reports, the batch folder, another submission, `/root` or
 //!   `/home`. bubblewrap itself runs as the submission's uid (the switch happens before it is
 //!   executed), so even outside its user namespace the code is that uid.
-//! - **A fallback where bubblewrap cannot run** ([`Isolation::FallbackUid`], root only): the
+//! - **A fallback where bubblewrap cannot run** ([`Isolation::FallbackUid`](policy::Isolation::FallbackUid), root only): the
 //!   limits, its own session, the per-submission uid and gid, with the sandbox folder owned by
 //!   that uid, mode `0700`, and, each where the kernel allows it (attempted, verified from
 //!   `/proc/<pid>/ns`, never assumed): a network namespace, an IPC namespace with its limits
@@ -34,8 +34,8 @@
 //!   processes: not the grader's command line, which names its binary, rubric and folders).
 //!   Where no namespace can be made (`RTORACLE_SANDBOX=uid-bare`) the code sees the host's
 //!   world-readable files and processes: what it must not read is made unreadable by others
-//!   while `grade` runs ([`keep_from_sandboxes`]), and no rtoracle binary runs for it
-//!   ([`oracles::refusal`]). [`Isolation::CurrentUser`] is the fallback without the uid switch
+//!   while `grade` runs ([`keep_from_sandboxes`](originals::keep_from_sandboxes)), and no rtoracle binary runs for it
+//!   ([`oracles::refusal`]). [`Isolation::CurrentUser`](policy::Isolation::CurrentUser) is the fallback without the uid switch
 //!   and the namespaces, for a harness that is not root.
 //! - **Limits** in every mode, set with `setrlimit` between `fork` and `exec` (inherited through
 //!   bubblewrap): CPU time, address space, open files, file size, POSIX message queues, no core
@@ -55,20 +55,20 @@
 //!   folders and IPC namespace is swept when the sandbox goes.
 //! - **No rtoracle binary reachable** ([`oracles`]): every rtoracle binary the view would show
 //!   is covered with an empty file, found by inode or content, never by name.
-//! - **Nothing outlives it.** [`Sandbox::reaper`] ends every process the code started: the PID
+//! - **Nothing outlives it.** [`Sandbox::reaper`](lifecycle::Sandbox::reaper) ends every process the code started: the PID
 //!   namespace dies with bubblewrap (killed with its process group), a per-submission uid is
 //!   swept with [`identity::kill_all`] (double-forked `setsid` sleepers included), and a cgroup
 //!   is killed whole. Dropping the sandbox does all that and removes its folder; while it
 //!   exists, the same cleanup is registered with [`crate::interrupt::on_interrupt`], so Ctrl-C
 //!   and SIGTERM leave nothing behind.
-//! - **Truthful facts** ([`SandboxFacts`]): which isolation was used, the namespaces that were
+//! - **Truthful facts** ([`SandboxFacts`](facts::SandboxFacts)): which isolation was used, the namespaces that were
 //!   seen made (bubblewrap's `--info-fd` compared with the harness's own namespaces), the uid,
 //!   the cgroup only when the code was seen in it, and `network_isolated` only when verified.
-//!   [`announce_on_stderr`] makes the first session of a run say it once on stderr, e.g.
+//!   [`announce_on_stderr`](facts::announce_on_stderr) makes the first session of a run say it once on stderr, e.g.
 //!   `rtoracle: sandbox: bubblewrap (user, pid, net, ipc, mount, uts namespaces), uid
 //!   1073741824 (one per submission)`.
 //!
-//! `RTORACLE_SANDBOX` forces a mode ([`Mode`]): `bubblewrap` (an error where it does not work),
+//! `RTORACLE_SANDBOX` forces a mode ([`Mode`](policy::Mode)): `bubblewrap` (an error where it does not work),
 //! `uid` (the fallback even where bubblewrap works), `uid-bare` (the fallback without any
 //! namespace, as in a container that refuses them), `none` (as on a host where neither works: a
 //! root harness then refuses to run untrusted code), `auto` (the default).
@@ -84,38 +84,31 @@
 //! does, with far fewer users).
 //!
 //! # Where each part lives
-//! Two rooms and the sandbox's own files. [`start`]: the command that runs a program inside
-//! ([`Sandbox::command`]), bubblewrap's command line, the child between fork and exec, the
-//! fallback's view made in the child, what the code sees of the host, and bubblewrap's first
-//! process limited before it goes on. [`bounds`]: what the code may write where, what its
-//! processes hold, its IPC, its cgroup, the watchdog that enforces the limits while it runs and
-//! the [`Reaper`]. Here: `policy` (limits, modes, isolations), `detect` (which isolation works
-//! here, and [`Sandbox::new`]), `lifecycle` (a [`Sandbox`]: its folder, identity, watchdog and
-//! cleanup), `probe` (trusted helpers run inside), `facts` ([`SandboxFacts`]), `paths`
-//! ([`replace_path`]), `originals` ([`keep_from_sandboxes`]), [`identity`] (uids) and
-//! [`oracles`] (rtoracle binaries).
+//! The rooms below, bottom floor first (each uses only those above it in this list):
+//! [`identity`] (uids, the processes a uid has); [`bounds`] (what the code may write where, what
+//! its processes hold, its IPC, its cgroup, the watchdog that enforces the limits while it runs,
+//! and the [`Reaper`](bounds::reaper::Reaper)); [`oracles`] (rtoracle binaries); [`view`] (what
+//! the code sees of the host, and its paths told in the user's terms); [`policy`] (limits,
+//! modes, isolations); [`lifecycle`] (a [`Sandbox`](lifecycle::Sandbox): its folder, identity,
+//! watchdog and cleanup); `probe` (trusted helpers run inside); [`start`] (the command that runs
+//! a program inside, [`Sandbox::command`](lifecycle::Sandbox::command): bubblewrap's command
+//! line, the child between fork and exec, the fallback's view made in the child, and
+//! bubblewrap's first process limited before it goes on); [`detect`] (which isolation works
+//! here, and [`Sandbox::new`](lifecycle::Sandbox::new)); [`facts`]
+//! ([`SandboxFacts`](facts::SandboxFacts)); [`originals`]
+//! ([`keep_from_sandboxes`](originals::keep_from_sandboxes)).
 
-pub mod bounds;
-mod detect;
-mod facts;
 pub mod identity;
-mod lifecycle;
+pub mod bounds;
 pub mod oracles;
-mod originals;
-mod paths;
-mod policy;
+pub mod view;
+pub mod policy;
+pub mod lifecycle;
 mod probe;
 pub mod start;
-
-pub use bounds::reaper::{Reaper, kill_group};
-pub use detect::{bubblewrap_works, isolation_for};
-pub use facts::{SandboxFacts, announce, announce_on_stderr};
-pub use identity::{lookup_user, running_as_root};
-pub use lifecycle::{MAX_COPIED_FILE_BYTES, Sandbox};
-pub use originals::{Restore, keep_from_sandboxes};
-pub use paths::replace_path;
-pub use policy::{Isolation, Mode, SandboxError, SandboxPolicy};
-pub use start::command::SANDBOX_PATH;
+pub mod detect;
+pub mod facts;
+pub mod originals;
 
 #[cfg(test)]
 mod tests;

@@ -1,5 +1,12 @@
 //! Tests of the sandbox: what the code sees, who it runs as, and that nothing outlives it.
 
+use super::bounds::reaper::kill_group;
+use super::detect::bubblewrap_works;
+use super::identity::running_as_root;
+use super::lifecycle::Sandbox;
+use super::policy::{Isolation, SandboxPolicy};
+use super::start::command::SANDBOX_PATH;
+use super::view::replace_path;
 use super::*;
 use std::io::Read;
 use std::os::unix::fs::PermissionsExt;

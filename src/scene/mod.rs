@@ -6,17 +6,17 @@
 //! materials and objects; [`SceneDescription::scene`] turns it into a [`World`].
 //! [`to_mitsuba_xml`] writes one for Mitsuba 3 where the two renderers share the physics.
 
-mod accel;
-mod builtin;
 mod camera;
-mod description;
 mod error;
-mod material;
-mod object;
 mod profile;
 mod settings;
 mod texture;
+mod material;
+mod object;
+mod accel;
 mod world;
+mod description;
+mod builtin;
 
 pub use accel::bvh::BVH_MIN_OBJECTS;
 #[cfg(test)]

@@ -14,7 +14,7 @@
 //!   `2 focus tan(angle / 2)`, and the answer says so. The codes are only words: what the
 //!   submission answers is judged as always.
 //! - **Work moved between functions** ([`schlick_in_material`], applied by
-//!   [`run_week`](super::run_week) after a week's checks ran): Schlick's random
+//!   [`run_week`](super::run::run_week) after a week's checks ran): Schlick's random
 //!   choice made in `Dielectric.scattering` instead of in `refract`. `refract` then answers
 //!   exactly as the catalogued `refract_without_schlick` (reflecting only under total internal
 //!   reflection) while the material, judged by what it does (`dielectric`, and

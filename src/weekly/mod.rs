@@ -3,31 +3,26 @@
 //! diagnosis of each week's catalogued mistakes (`docs/weekly-checks.md`).
 //!
 //! - [`week`]: the weeks, and which one a submission folder is.
-//! - [`runner`]: sending function requests ([`FunctionRunner`], a candidate's session).
+//! - [`runner`]: sending function requests ([`FunctionRunner`](runner::FunctionRunner), a candidate's session).
 //! - [`expect`]: what a deterministic request must answer, and judging an answer.
 //! - [`stats`]: chi-square and binomial tests at a stated false-alarm rate.
 //! - [`samplers`]: each random function's invariants, cells and catalogued mistakes.
 //! - [`samplers::mistakes`]: the same samplers (and mistakes) in Rust, to measure false alarms and power.
 //! - [`checks`]: each week's functions, their cases, expected answers and mistakes.
-//! - [`run`]: running a week's checks and judging them ([`WeekReport`]).
+//! - [`run`]: running a week's checks and judging them ([`WeekReport`](run::WeekReport)).
 //! - [`departures`]: departures that keep the course's behaviour, named and not charged.
 //! - [`report`]: the report in words.
 //! - [`score`]: each week's groups of functions and their points.
 //! - [`submission`]: a week's submission checked in one session (intersections and functions).
 
-pub mod checks;
 pub mod departures;
 pub mod expect;
-pub mod report;
-pub mod run;
 pub mod runner;
-pub mod samplers;
-pub mod score;
 pub mod stats;
-pub mod submission;
+pub mod samplers;
 pub mod week;
-
-pub use run::{FunctionOptions, FunctionResult, Status, WeekReport, run_week};
-pub use runner::{FunctionRunner, Reply, SessionRunner};
-pub use submission::{WeekCheck, check_week};
-pub use week::{Detected, Week, detect};
+pub mod checks;
+pub mod run;
+pub mod score;
+pub mod report;
+pub mod submission;

@@ -2,7 +2,8 @@
 //!
 //! - no import cycle between the files of `src/`, nor between its top-level modules;
 //! - the top-level modules stand on floors ([`FLOORS`]), and a module imports only from lower
-//!   floors;
+//!   floors; within a folder, a room (a file or a sub-folder) imports only the rooms its
+//!   folder's `mod.rs` declares before it;
 //! - no source file is over [`MAX_FILE_LINES`] lines before its `#[cfg(test)]`, and no
 //!   function over [`MAX_FN_LINES`] lines, except the tables of [`TABLES`], each with its reason.
 //!
@@ -169,13 +170,25 @@ fn the_exceptions_are_still_needed() {
     assert!(stale.is_empty(), "{}", stale.join("\n"));
 }
 
+/// Within a folder, the rooms (its files and sub-folders) stand on floors too: the folder's own
+/// file (`mod.rs`) declares them bottom floor first, and a room uses only rooms declared before
+/// it. So a folder reads top to bottom, no two rooms import each other around a loop, and a new
+/// arrow up fails here with the import that makes it and an order that would hold.
+#[test]
+fn within_a_folder_a_room_uses_only_rooms_declared_before_it() {
+    let house = House::read();
+    let problems = house.arrows_up_within_folders();
+    assert!(
+        problems.is_empty(),
+        "within a folder, a room uses only the rooms its mod.rs declares before it (bottom floor \
+         first):\n{}",
+        problems.join("\n")
+    );
+}
+
 /// The most `.rs` files a folder of `src/` holds directly (its sub-folders count as one each):
 /// past about a dozen, a folder is split into rooms along the groups its `mod.rs` names.
 const MAX_FOLDER_ENTRIES: usize = 13;
-
-/// Folders not yet split into rooms, with what they hold now: each goes when its split lands
-/// (the test fails when an entry is no longer needed, so the list only shrinks).
-const FOLDERS_BEING_SPLIT: &[(&str, &str)] = &[("src/cli", "the binary: one file per subcommand")];
 
 #[test]
 fn no_folder_holds_more_than_about_a_dozen_files() {
@@ -204,13 +217,7 @@ fn no_folder_holds_more_than_about_a_dozen_files() {
     crowded.remove("src");
     let mut too_many = Vec::new();
     for (name, entries) in &crowded {
-        let excused = FOLDERS_BEING_SPLIT.iter().any(|(f, _)| f == name);
-        if excused {
-            assert!(
-                *entries > MAX_FOLDER_ENTRIES,
-                "{name} holds {entries} entries now: remove it from FOLDERS_BEING_SPLIT"
-            );
-        } else if *entries > MAX_FOLDER_ENTRIES {
+        if *entries > MAX_FOLDER_ENTRIES {
             too_many.push(format!("{name} ({entries})"));
         }
     }
@@ -221,18 +228,6 @@ fn no_folder_holds_more_than_about_a_dozen_files() {
         too_many.join(", ")
     );
 }
-
-/// Modules that still show two surfaces, public files and re-exports of their items (so an item
-/// has two paths): each goes when its re-exports do (or its files become private), and the test
-/// fails when an entry is no longer needed, so the list only shrinks.
-const TWO_SURFACES: &[&str] = &[
-    "src/compare/mod.rs",
-    "src/grade/mod.rs",
-    "src/oracle/mod.rs",
-    "src/sandbox/mod.rs",
-    "src/weekly/mod.rs",
-    "src/weekly/samplers/mod.rs",
-];
 
 /// One surface per module: a module's own file either re-exports its children's items (a facade
 /// over private files) or declares public files, not both.
@@ -256,19 +251,9 @@ fn a_module_shows_one_surface() {
             both.insert(name);
         }
     }
-    for listed in TWO_SURFACES {
-        assert!(
-            both.contains(*listed),
-            "{listed} shows one surface now: remove it from TWO_SURFACES"
-        );
-    }
-    let new: Vec<_> = both
-        .iter()
-        .filter(|f| !TWO_SURFACES.contains(&f.as_str()))
-        .collect();
     assert!(
-        new.is_empty(),
-        "{new:?} both declare public files and re-export items: keep one surface (re-exports \
+        both.is_empty(),
+        "{both:?} both declare public files and re-export items: keep one surface (re-exports \
          over private files, or public files imported where they are defined)"
     );
 }
@@ -718,6 +703,71 @@ impl House {
         s
     }
 
+    /// For every folder, each import from one of its rooms to a room its own file declares
+    /// later (or not at all), with the evidence, and a declaration order that would hold.
+    fn arrows_up_within_folders(&self) -> Vec<String> {
+        let mut problems = vec![];
+        for owner in &self.files {
+            // The crate's root and the binary's: FLOORS orders the top-level modules.
+            if owner.module.is_empty() || owner.path == "src/main.rs" {
+                continue;
+            }
+            let folder = &owner.module;
+            let room_of = |module: &[String]| -> Option<String> {
+                (module.len() > folder.len() && module.starts_with(folder))
+                    .then(|| module[folder.len()].clone())
+            };
+            let rooms: BTreeSet<String> = self
+                .files
+                .iter()
+                .filter_map(|f| room_of(&f.module))
+                .collect();
+            if rooms.len() < 2 {
+                continue;
+            }
+            let mut order: Vec<String> = vec![];
+            for name in declared_modules(&owner.code) {
+                if rooms.contains(&name) && !order.contains(&name) {
+                    order.push(name);
+                }
+            }
+            let mut arrows: BTreeMap<(String, String), String> = BTreeMap::new();
+            for f in &self.files {
+                let Some(from) = room_of(&f.module) else {
+                    continue;
+                };
+                for a in &f.arrows {
+                    if let Some(to) = room_of(&module_of(&a.to)) {
+                        if to != from {
+                            arrows.entry((from.clone(), to)).or_insert_with(|| {
+                                format!("{}:{} uses {}", f.path, a.line, a.path)
+                            });
+                        }
+                    }
+                }
+            }
+            let position = |room: &str| order.iter().position(|r| r == room);
+            let mut up = vec![];
+            for ((from, to), evidence) in &arrows {
+                let (Some(a), Some(b)) = (position(from), position(to)) else {
+                    continue;
+                };
+                if b >= a {
+                    up.push(format!("  {from} uses {to}, declared after it: {evidence}"));
+                }
+            }
+            if !up.is_empty() {
+                problems.push(format!(
+                    "{}: {}\n{}",
+                    owner.path,
+                    suggested_order(&order, &arrows),
+                    up.join("\n")
+                ));
+            }
+        }
+        problems
+    }
+
     /// Whether `path` is too long (`what == ""`) or has a function `what` that is.
     fn too_long(&self, path: &str, what: &str) -> bool {
         let Some(f) = self.files.iter().find(|f| f.path == path) else {
@@ -731,6 +781,41 @@ impl House {
                 .any(|g| g.name == what && g.lines > MAX_FN_LINES)
         }
     }
+}
+
+/// A declaration order of the rooms in which each uses only rooms before it, as close to
+/// `order` as it can be (the earliest-declared room that is ready goes next); or the rooms that
+/// import each other around a loop when there is none.
+fn suggested_order(order: &[String], arrows: &BTreeMap<(String, String), String>) -> String {
+    let mut placed: Vec<String> = vec![];
+    let mut left: Vec<String> = order.to_vec();
+    while !left.is_empty() {
+        let ready = left.iter().position(|room| {
+            arrows
+                .keys()
+                .all(|(from, to)| from != room || placed.contains(to) || !left.contains(to))
+        });
+        match ready {
+            Some(i) => placed.push(left.remove(i)),
+            None => {
+                let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+                for (from, to) in arrows.keys() {
+                    if left.contains(from) && left.contains(to) {
+                        graph.entry(from.clone()).or_default().insert(to.clone());
+                    }
+                }
+                let loops: Vec<String> = strongly_connected(&graph)
+                    .iter()
+                    .map(|group| group.join(", "))
+                    .collect();
+                return format!(
+                    "no order holds, these rooms import each other around a loop: {}",
+                    loops.join("; ")
+                );
+            }
+        }
+    }
+    format!("an order that holds: {}", placed.join(", "))
 }
 
 fn collect_rs(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -1454,5 +1539,54 @@ fn scanner_reads_use_trees() {
             (s(&["super", "d"]), None),
             (s(&["super", "e"]), Some("e".to_string())),
         ]
+    );
+}
+
+#[test]
+fn scanner_finds_an_arrow_up_within_a_folder_and_an_order_that_holds() {
+    // In a/, `low` is declared first and `high` second; `sub/` (a room of a sub-folder) is
+    // declared last. `low` uses `high` (an arrow up), `sub`'s file uses `low` (fine), and `high`
+    // uses what the folder's own file defines (fine: not a room).
+    let h = house(&[
+        ("src/lib.rs", "pub mod a;\n"),
+        (
+            "src/a/mod.rs",
+            "pub mod low;\npub mod high;\npub mod sub;\npub fn shared() {}\n",
+        ),
+        ("src/a/low.rs", "use super::high::H;\npub struct L;\n"),
+        ("src/a/high.rs", "use super::shared;\npub struct H;\n"),
+        ("src/a/sub/mod.rs", "mod deep;\n"),
+        ("src/a/sub/deep.rs", "use crate::a::low::L;\n"),
+    ]);
+    let problems = h.arrows_up_within_folders();
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert!(
+        problems[0].starts_with("src/a/mod.rs: an order that holds: high, low, sub"),
+        "{}",
+        problems[0]
+    );
+    assert!(
+        problems[0]
+            .contains("low uses high, declared after it: src/a/low.rs:1 uses super::high::H"),
+        "{}",
+        problems[0]
+    );
+
+    // Two rooms that import each other through files that do not (no file cycle): no order.
+    let h = house(&[
+        ("src/lib.rs", "pub mod a;\n"),
+        ("src/a/mod.rs", "pub mod p;\npub mod q;\n"),
+        ("src/a/p/mod.rs", "pub mod one;\npub mod two;\n"),
+        ("src/a/p/one.rs", "pub struct One;\n"),
+        ("src/a/p/two.rs", "use crate::a::q::Q;\n"),
+        ("src/a/q.rs", "use crate::a::p::one::One;\npub struct Q;\n"),
+    ]);
+    assert!(h.file_cycles().is_empty());
+    let problems = h.arrows_up_within_folders();
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert!(
+        problems[0].contains("import each other around a loop: p, q"),
+        "{}",
+        problems[0]
     );
 }

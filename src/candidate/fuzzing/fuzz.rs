@@ -22,7 +22,7 @@ use crate::candidate::judging::diagnose::{Diagnosis, SAMPLE, diagnose};
 use crate::candidate::judging::repro::{expected_in_words, python_repro};
 use crate::candidate::process::error::HarnessError;
 use crate::candidate::process::outcome::Outcome;
-use crate::oracle::Judging;
+use crate::oracle::profile::Judging;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
 
 /// A candidate as the fuzzer sees it: a batch of cases in, one outcome per case out.

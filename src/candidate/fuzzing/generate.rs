@@ -3,14 +3,14 @@
 //! origin, finite intervals and rays exactly parallel to a quad.
 //!
 //! Classification goes through one function, [`oracle_expect`]: the exact oracle's class
-//! ([`crate::oracle::classify()`]), keeping only the definite cases (a candidate is judged on
+//! ([`crate::oracle::classify::classify()`]), keeping only the definite cases (a candidate is judged on
 //! nothing floating point cannot settle).
 
 use rand_core::Rng;
 use rand_pcg::Pcg64;
 
-use crate::oracle::Judging;
 use crate::oracle::generate::{self as og, Stream};
+use crate::oracle::profile::Judging;
 use crate::oracle::vectors::{Case, Expect, RaySpec, ShapeKind, ShapeSpec};
 
 /// The exact oracle's expected answer for a case when it is definite, `None` when it is not

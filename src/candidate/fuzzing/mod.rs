@@ -5,6 +5,6 @@
 //! - [`fuzz`](mod@fuzz): the driver, a budget of cases run through a session.
 //! - [`shrink`]: a failing case made smaller while it still fails.
 
-pub mod fuzz;
 pub mod generate;
 pub mod shrink;
+pub mod fuzz;

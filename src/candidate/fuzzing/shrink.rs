@@ -9,7 +9,7 @@
 use crate::candidate::fuzzing::generate::oracle_expect_with;
 #[cfg(doc)]
 use crate::candidate::judging::check::FailureKind;
-use crate::oracle::Judging;
+use crate::oracle::profile::Judging;
 use crate::oracle::vectors::{Case, RaySpec, ShapeSpec};
 
 /// How simple a number is: fewer fractional bits first, then smaller magnitude. The camera's

@@ -351,7 +351,7 @@ pub fn diagnose(cases: &[Case], outcomes: &[Outcome], winding: Option<Winding>) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::oracle::default_suite;
+    use crate::oracle::suite::default_suite;
 
     fn outcome_of(v: &Variant, case: &Case) -> Outcome {
         let answer = match (v.run)(&case.shape, &case.ray, case.interval) {

@@ -10,7 +10,7 @@
 
 pub mod check;
 pub mod diagnose;
-pub mod report;
-pub mod report_text;
 pub mod repro;
 pub mod watertight;
+pub mod report;
+pub mod report_text;

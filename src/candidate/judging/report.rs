@@ -40,7 +40,7 @@ use crate::candidate::judging::watertight::{GroupResult, crack_message, judge_gr
 use crate::candidate::process::outcome::Outcome;
 use crate::candidate::process::protocol::{Answer, CandidateError};
 use crate::oracle::vectors::{Case, Class, Expect, ShapeKind};
-use crate::sandbox::SandboxFacts;
+use crate::sandbox::facts::SandboxFacts;
 
 /// Counts of one group (or of the whole run).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -186,7 +186,7 @@ pub struct CheckReport {
     /// The candidate's name (from its hello).
     pub candidate: String,
     /// What the expectations were judged by (`"robust/f64"`, ...; see
-    /// [`crate::oracle::Judging`]), or where they came from.
+    /// [`crate::oracle::profile::Judging`]), or where they came from.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub judged_by: Option<String>,
     /// Counts over all shapes.

@@ -120,7 +120,7 @@ pub fn crack_message(group: &Group, cases: &[Case]) -> String {
 mod tests {
     use super::*;
     use crate::candidate::process::protocol::Answer;
-    use crate::oracle::Judging;
+    use crate::oracle::profile::Judging;
     use crate::oracle::watertight::watertight_cases;
 
     fn answered(answer: Answer) -> Outcome {

@@ -13,7 +13,7 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use crate::candidate::process::error::HarnessError;
-use crate::sandbox::{Sandbox, SandboxPolicy};
+use crate::sandbox::{lifecycle::Sandbox, policy::SandboxPolicy};
 
 /// The name the course adapter has in the sandbox folder.
 const ADAPTER_NAME: &str = "course_adapter.py";
@@ -23,7 +23,7 @@ const ADAPTER_NAME: &str = "course_adapter.py";
 const NEUTRAL_NAME: &str = "python-course";
 
 /// Largest submission file copied into the sandbox.
-pub const MAX_STAGED_FILE_BYTES: u64 = crate::sandbox::MAX_COPIED_FILE_BYTES;
+pub const MAX_STAGED_FILE_BYTES: u64 = crate::sandbox::lifecycle::MAX_COPIED_FILE_BYTES;
 
 /// Most bytes of submission files copied into the sandbox in all.
 pub const MAX_STAGED_TOTAL_BYTES: u64 = 8 << 20;
@@ -281,7 +281,7 @@ impl CandidateCommand {
             let found = if self.program.components().count() > 1 {
                 self.program.exists()
             } else {
-                std::env::split_paths(crate::sandbox::SANDBOX_PATH)
+                std::env::split_paths(crate::sandbox::start::command::SANDBOX_PATH)
                     .chain(
                         std::env::var_os("PATH")
                             .iter()
@@ -301,7 +301,7 @@ impl CandidateCommand {
                     sandbox.expose(p);
                 }
             }
-            if sandbox.isolation() != crate::sandbox::Isolation::Unsandboxed {
+            if sandbox.isolation() != crate::sandbox::policy::Isolation::Unsandboxed {
                 sandbox
                     .probe_access(&self.program, &self.args)
                     .map_err(|problem| HarnessError::Command {

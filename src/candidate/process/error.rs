@@ -1,6 +1,6 @@
 //! Why the harness itself cannot run a candidate ([`HarnessError`]).
 
-use crate::sandbox::SandboxError;
+use crate::sandbox::policy::SandboxError;
 
 /// Why the harness itself cannot run a candidate.
 #[derive(Debug, thiserror::Error)]

@@ -14,13 +14,13 @@
 //! - [`render_request`]: the `render` request, a scene rendered tile by tile with the
 //!   candidate's own code, with bounds on what comes back.
 
-pub mod command;
 pub mod error;
-pub mod lines;
 pub mod options;
+pub mod protocol;
+pub mod lines;
 pub mod outcome;
 pub mod pipe;
-pub mod protocol;
 pub mod python;
-pub mod render_request;
+pub mod command;
 pub mod session;
+pub mod render_request;

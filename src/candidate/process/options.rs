@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use crate::sandbox::SandboxPolicy;
+use crate::sandbox::policy::SandboxPolicy;
 
 /// How a candidate is run.
 #[derive(Clone, Debug, PartialEq)]

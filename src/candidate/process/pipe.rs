@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use crate::candidate::process::error::HarnessError;
 use crate::candidate::process::protocol::{MAX_QUOTE_CHARS, ParsedLine, parse_line, quote_line};
-use crate::sandbox::{Reaper, Sandbox};
+use crate::sandbox::{bounds::reaper::Reaper, lifecycle::Sandbox};
 
 /// How many bytes of the candidate's stderr are kept for the report.
 pub const STDERR_TAIL_BYTES: usize = 4096;
@@ -167,7 +167,7 @@ impl Proc {
             child,
             pid,
             reaper,
-            bwrap: sandbox.isolation() == crate::sandbox::Isolation::Bubblewrap,
+            bwrap: sandbox.isolation() == crate::sandbox::policy::Isolation::Bubblewrap,
             writer: Some(wtx),
             lines: lrx,
             stderr_done,

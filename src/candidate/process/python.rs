@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 use std::time::Duration;
 
-use crate::sandbox::{Sandbox, SandboxError, SandboxPolicy};
+use crate::sandbox::{lifecycle::Sandbox, policy::SandboxError, policy::SandboxPolicy};
 
 /// The modules the course's code imports at module level (`RT_utility.py`: numpy and Pillow;
 /// `docs/sandbox.md`, "The interpreter").
@@ -224,7 +224,7 @@ fn key(explicit: Option<&Path>, requires: &[String], policy: &SandboxPolicy) -> 
         std::env::var_os("RTORACLE_PYTHON").map(PathBuf::from),
         requires.to_vec(),
         policy.unsandboxed,
-        std::env::var(crate::sandbox::Mode::ENV).ok(),
+        std::env::var(crate::sandbox::policy::Mode::ENV).ok(),
     )
 }
 

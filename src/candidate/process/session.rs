@@ -5,7 +5,7 @@
 //! and a uid of its own; never root; see [`crate::sandbox`]) from its [`CandidateCommand`] and
 //! starts every process of the candidate, restarts included, through it (one
 //! [`pipe`](crate::candidate::process::pipe) each); when a process is killed or the session ends, every process the
-//! candidate started ends too ([`crate::sandbox::Reaper`]).
+//! candidate started ends too ([`crate::sandbox::bounds::reaper::Reaper`]).
 //!
 //! Requests are pipelined: a writer thread writes every pending request as fast as the pipe
 //! takes them while the session reads answers. Candidates may batch their answers; after the
@@ -51,7 +51,7 @@ use crate::candidate::process::protocol::{
     Answer, CandidateError, HELLO_LINE, Hello, ParsedLine, Request,
 };
 use crate::oracle::vectors::{Case, ShapeKind};
-use crate::sandbox::{Sandbox, SandboxFacts};
+use crate::sandbox::{facts::SandboxFacts, lifecycle::Sandbox};
 
 /// Characters of the candidate's stderr quoted in a start failure's message (its last lines).
 pub const STDERR_EXCERPT_CHARS: usize = 300;
@@ -163,7 +163,7 @@ impl Session {
             // The course adapter was told a neutral name; reports use the real label.
             session.hello.name = session.command.label.clone();
         }
-        crate::sandbox::announce(&session.sandbox_facts());
+        crate::sandbox::facts::announce(&session.sandbox_facts());
         Ok(session)
     }
 
@@ -230,7 +230,7 @@ impl Session {
         if inside != dir {
             let to = submission.display().to_string();
             for text in [&mut error.message, &mut error.traceback] {
-                *text = crate::sandbox::replace_path(text, &inside, &to);
+                *text = crate::sandbox::view::replace_path(text, &inside, &to);
             }
         }
         let mut seen = vec![dir.to_path_buf()];
@@ -898,7 +898,7 @@ mod tests {
         let python = system.is_file().then_some(system);
         let command = CandidateCommand::python_course_with(sub.path(), python, true).unwrap();
         let mut session = Session::start(command, RunOptions::default()).unwrap();
-        let cases: Vec<Case> = crate::oracle::default_suite(0)
+        let cases: Vec<Case> = crate::oracle::suite::default_suite(0)
             .into_iter()
             .filter(|c| c.shape.kind() == ShapeKind::Sphere)
             .collect();
@@ -922,11 +922,11 @@ mod tests {
         let facts = session.sandbox_facts();
         assert_eq!(report.sandbox.as_ref(), Some(&facts));
         assert!(tail.contains(&format!("uid {} ", facts.uid)), "{tail}");
-        if crate::sandbox::running_as_root() {
+        if crate::sandbox::identity::running_as_root() {
             // Never root, and a uid of its own.
             assert!(facts.uid >= 1 << 30, "{facts:?}");
         }
-        if facts.isolation == crate::sandbox::Isolation::Bubblewrap {
+        if facts.isolation == crate::sandbox::policy::Isolation::Bubblewrap {
             assert_eq!(facts.network_isolated, Some(true), "{facts:?}");
         }
         // The adapter was told a neutral name; the report keeps the real label.
@@ -979,7 +979,7 @@ mod tests {
             budget: Some(Duration::from_secs(5)),
             ..RunOptions::default()
         };
-        let cases: Vec<Case> = crate::oracle::default_suite(0)
+        let cases: Vec<Case> = crate::oracle::suite::default_suite(0)
             .into_iter()
             .filter(|c| c.shape.kind() == ShapeKind::Sphere)
             .take(50)

@@ -232,8 +232,11 @@ fn prepare() -> anyhow::Result<Vec<Shared>> {
         .iter()
         .map(|&name| {
             let description = rtoracle::scene::builtin(name)?;
-            let description =
-                crate::cli::render::with_profile(name, description, Some(Profile::Physical))?;
+            let description = crate::cli::reference::render::with_profile(
+                name,
+                description,
+                Some(Profile::Physical),
+            )?;
             let xml = rtoracle::scene::to_mitsuba_xml(&description)
                 .with_context(|| format!("cannot export {name} for Mitsuba"))?;
             Ok(Shared {

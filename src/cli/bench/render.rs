@@ -41,17 +41,17 @@ const BUDGET_FIXED_BYTES: u64 = 50_000_000;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Runs of each timing; the fastest is reported.
-    #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::num::runs)]
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::args::runs)]
     runs: u32,
     /// Width of the render whose peak memory is measured (the square quad scene, 1 spp; at most
     /// 10000, as `render` makes at most 100 million pixels).
-    #[arg(long, value_name = "W", default_value_t = 4000, value_parser = crate::cli::num::memory_width)]
+    #[arg(long, value_name = "W", default_value_t = 4000, value_parser = crate::cli::args::memory_width)]
     memory_width: u32,
     /// The C compiler that builds the baseline.
     #[arg(long, value_name = "CC", default_value = "cc")]
     cc: String,
     /// Samples per pixel of the renders timed against Mitsuba 3.
-    #[arg(long, value_name = "N", default_value_t = 64, value_parser = crate::cli::num::spp)]
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = crate::cli::args::spp)]
     mitsuba_spp: u32,
     /// The Python that imports Mitsuba 3 (`pip install mitsuba`); without it the comparison says
     /// it was skipped.

@@ -9,7 +9,7 @@
 //!   `s` is the one of a grid from 0.70 to 1.45, refined to 0.001, whose zoomed golden is closest
 //!   to the candidate (least squares on a subsample of pixels).
 
-use crate::compare::{CandidateImage, Encoding, Golden};
+use crate::compare::{candidate::CandidateImage, encoding::Encoding, noise_model::Golden};
 
 /// The candidate's linear value per pixel and channel: the middle of a code's interval, or an
 /// EXR's value.

@@ -12,8 +12,8 @@ pub mod mistakes;
 use rayon::prelude::*;
 
 use super::{
-    CandidateImage, CompareOptions, Diagnosis, ENCODINGS, Encoding, Evaluation, Golden,
-    HypothesisScore, evaluate,
+    CompareOptions, Diagnosis, HypothesisScore, candidate::CandidateImage, encoding::ENCODINGS,
+    encoding::Encoding, noise_model::Golden, verdict::Evaluation, verdict::evaluate,
 };
 
 /// A hypothesis must remove at least this share of the misfit to be named as the explanation.

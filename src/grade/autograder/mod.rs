@@ -273,7 +273,7 @@ pub fn build_package_with(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grade::Rubric;
+    use crate::grade::rubric::Rubric;
     use crate::grade::rubric::WEEK04_RUBRIC;
     use std::collections::BTreeMap;
 
@@ -313,7 +313,7 @@ mod tests {
     fn families(seed: u64) -> BTreeMap<String, usize> {
         let mut by = BTreeMap::new();
         let mut groups = std::collections::BTreeSet::new();
-        for c in crate::oracle::default_suite(seed) {
+        for c in crate::oracle::suite::default_suite(seed) {
             let id = match &c.expect.watertight {
                 Some(w) if !groups.insert(w.group.clone()) => continue,
                 Some(w) => w.group.clone(),
@@ -335,8 +335,8 @@ mod tests {
         }
         // And the seed matters: another seed gives other vectors.
         let (a, b) = (
-            crate::oracle::default_suite(0),
-            crate::oracle::default_suite(1),
+            crate::oracle::suite::default_suite(0),
+            crate::oracle::suite::default_suite(1),
         );
         assert_ne!(a[0].ray, b[0].ray);
     }

@@ -21,9 +21,9 @@ use crate::candidate::process::session::Session;
 use crate::grade::checkers::{CodeChecker, CodeOutcome, FailureKind, FailureSummary, GroupCounts};
 use crate::grade::rubric::credit;
 use crate::grade::rubric::sha256_hex;
-use crate::oracle::default_suite;
+use crate::oracle::suite::default_suite;
 use crate::oracle::vectors::{Case, Class, ShapeKind};
-use crate::sandbox::SandboxPolicy;
+use crate::sandbox::policy::SandboxPolicy;
 
 /// Checks a submission's `RT_object.py` with the course adapter of `rtoracle check
 /// --python-course`: one sandboxed interpreter per submission, restarted after a crash; a
@@ -59,7 +59,7 @@ pub struct CourseCodeChecker {
     /// The course week of the submissions (the rubric's `week`): from week 7 on, a sphere
     /// vector on which the course's own `get_uv` raises at a pole is not scored
     /// ([`crate::weekly::submission::excuse_pole_crashes`]).
-    pub week: Option<crate::weekly::Week>,
+    pub week: Option<crate::weekly::week::Week>,
 }
 
 impl Default for CourseCodeChecker {
@@ -170,8 +170,8 @@ impl CodeChecker for CourseCodeChecker {
     fn check_functions(
         &self,
         submission: &Path,
-        week: crate::weekly::Week,
-        options: crate::weekly::FunctionOptions,
+        week: crate::weekly::week::Week,
+        options: crate::weekly::run::FunctionOptions,
     ) -> crate::grade::checkers::FunctionsOutcome {
         course_functions(self, submission, week, options)
     }
@@ -403,7 +403,7 @@ impl PathStripper {
     fn strip(&self, text: &str) -> String {
         let text = if self.inside_dir != self.sandbox_dir {
             let to = self.submission_dir.display().to_string();
-            crate::sandbox::replace_path(text, &self.inside_dir, &to)
+            crate::sandbox::view::replace_path(text, &self.inside_dir, &to)
         } else {
             text.to_string()
         };
@@ -519,25 +519,25 @@ impl CourseCodeChecker {
     }
 }
 
-/// A [`FunctionRunner`](crate::weekly::FunctionRunner) that stops sending requests once a
+/// A [`FunctionRunner`](crate::weekly::runner::FunctionRunner) that stops sending requests once a
 /// wall-clock deadline has passed (the rubric's code time budget): the rest are not run.
 struct BudgetRunner<'a> {
-    inner: crate::weekly::SessionRunner<'a>,
+    inner: crate::weekly::runner::SessionRunner<'a>,
     deadline: Option<std::time::Instant>,
     refused: usize,
 }
 
-impl crate::weekly::FunctionRunner for BudgetRunner<'_> {
+impl crate::weekly::runner::FunctionRunner for BudgetRunner<'_> {
     fn supports(&self, op: &str) -> bool {
         self.inner.supports(op)
     }
 
-    fn call(&mut self, request: &Value, timeout: Duration) -> crate::weekly::Reply {
+    fn call(&mut self, request: &Value, timeout: Duration) -> crate::weekly::runner::Reply {
         let now = std::time::Instant::now();
         match self.deadline {
             Some(d) if now >= d => {
                 self.refused += 1;
-                crate::weekly::Reply::NotRun("the code time budget ran out".into())
+                crate::weekly::runner::Reply::NotRun("the code time budget ran out".into())
             }
             Some(d) => self.inner.call(request, timeout.min(d - now)),
             None => self.inner.call(request, timeout),
@@ -552,8 +552,8 @@ impl crate::weekly::FunctionRunner for BudgetRunner<'_> {
 fn course_functions(
     checker: &CourseCodeChecker,
     submission: &Path,
-    week: crate::weekly::Week,
-    options: crate::weekly::FunctionOptions,
+    week: crate::weekly::week::Week,
+    options: crate::weekly::run::FunctionOptions,
 ) -> crate::grade::checkers::FunctionsOutcome {
     use crate::grade::checkers::FunctionsOutcome;
     let fatal = |msg: String| FunctionsOutcome {
@@ -589,11 +589,11 @@ fn course_functions(
     }
     let deadline = budget.map(|b| std::time::Instant::now() + b);
     let mut runner = BudgetRunner {
-        inner: crate::weekly::SessionRunner::new(&mut session),
+        inner: crate::weekly::runner::SessionRunner::new(&mut session),
         deadline,
         refused: 0,
     };
-    let mut report = crate::weekly::run_week(&mut runner, week, options);
+    let mut report = crate::weekly::run::run_week(&mut runner, week, options);
     let out_of_time = runner.refused;
     for f in &mut report.functions {
         if let Some(failure) = &mut f.failure {
@@ -715,7 +715,7 @@ mod tests {
             .collect();
         assert!(definite.is_empty(), "{definite:?}");
         // Never root: a root harness gives the submission a uid of its own.
-        if crate::sandbox::running_as_root() {
+        if crate::sandbox::identity::running_as_root() {
             let uid = out.sandbox["uid"].as_u64().unwrap();
             assert!(uid >= 1 << 30, "{}", out.sandbox);
         }
@@ -784,7 +784,7 @@ mod tests {
     fn an_interpreter_the_sandbox_user_cannot_run_is_refused_never_run_as_root() {
         // Python under /root (mode 0700) cannot be run by a sandbox user.
         let private = Path::new("/root/.pyenv/versions/3.11.7/bin/python3");
-        if !crate::sandbox::running_as_root() || !private.exists() {
+        if !crate::sandbox::identity::running_as_root() || !private.exists() {
             eprintln!("skipped: needs root and a Python under /root");
             return;
         }

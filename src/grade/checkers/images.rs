@@ -23,7 +23,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use crate::compare::{
-    CandidateImage, CompareError, CompareOptions, Golden, check_size, compare_image, write_heatmap,
+    CompareError, CompareOptions, candidate::CandidateImage, check_size, compare_image,
+    heatmap::write_heatmap, noise_model::Golden,
 };
 use crate::golden::{FoundGolden, GoldenScene, golden_of, golden_spp, sha256_hex};
 use crate::grade::checkers::noise_floor::too_clean;

@@ -1,19 +1,18 @@
 //! The two narrow interfaces grading is built on: one checks a submission's code against the
 //! intersection vectors, the other compares one of its images with the reference.
 //!
-//! [`grade`](super::grade) only ever talks to a [`CodeChecker`] and an [`ImageChecker`]: the
-//! `check` harness ([`CourseCodeChecker`](super::CourseCodeChecker)), the noise-aware comparison
-//! ([`CompareImageChecker`](super::CompareImageChecker)) and the fakes of the tests implement
+//! [`grade`](super::run::grade) only ever talks to a [`CodeChecker`] and an [`ImageChecker`]: the
+//! `check` harness ([`CourseCodeChecker`](super::checkers::code::CourseCodeChecker)), the noise-aware comparison
+//! ([`CompareImageChecker`](super::checkers::images::CompareImageChecker)) and the fakes of the tests implement
 //! them.
 
 pub mod code;
 pub mod copies;
+pub mod noise_floor;
+pub mod images;
+pub mod rendered;
 #[cfg(test)]
 pub(crate) mod fakes;
-pub mod images;
-pub mod noise_floor;
-pub mod rendered;
-pub(crate) mod weekly;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -57,8 +56,8 @@ pub trait CodeChecker: Sync {
     fn check_functions(
         &self,
         submission: &Path,
-        week: crate::weekly::Week,
-        options: crate::weekly::FunctionOptions,
+        week: crate::weekly::week::Week,
+        options: crate::weekly::run::FunctionOptions,
     ) -> FunctionsOutcome {
         let _ = (submission, week, options);
         FunctionsOutcome {
@@ -74,7 +73,7 @@ use crate::candidate::process::render_request::{RenderJob, RenderOutcome, Render
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct FunctionsOutcome {
     /// The function checks, judged (`None` when nothing could be run: see `fatal`).
-    pub report: Option<crate::weekly::WeekReport>,
+    pub report: Option<crate::weekly::run::WeekReport>,
     /// Set when nothing could be run: the import failed (the message shows the exception), the
     /// interpreter is missing, the checker does not run function checks.
     pub fatal: Option<String>,
@@ -302,7 +301,9 @@ pub(crate) fn encoded(image: &RenderedImage) -> crate::image_io::Rgb8Image {
         None => image
             .data
             .iter()
-            .flat_map(|p| p.map(|x| crate::compare::Encoding::Course.encode(f64::from(x))))
+            .flat_map(|p| {
+                p.map(|x| crate::compare::encoding::Encoding::Course.encode(f64::from(x)))
+            })
             .collect(),
     };
     crate::image_io::Rgb8Image {

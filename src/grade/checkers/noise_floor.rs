@@ -24,7 +24,7 @@
 
 use serde::Serialize;
 
-use crate::compare::{CandidateImage, Encoding, Golden};
+use crate::compare::{candidate::CandidateImage, encoding::Encoding, noise_model::Golden};
 
 /// The least per-sample variance an honest sampler is assumed to have, as a share of the
 /// golden's: a quarter (the course's samplers are the reference's; stratified jitter lowers the

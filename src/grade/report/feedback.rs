@@ -13,15 +13,17 @@ use std::fmt::Write;
 use crate::candidate::judging::check::FailureKind;
 use crate::escape::{Untrusted, markdown_block, markdown_inline};
 use crate::grade::result::smallest_case_sentence;
-use crate::grade::{CheckResult, CheckStatus, FailureSummary, smallest_failure};
+use crate::grade::{
+    checkers::FailureSummary, result::CheckResult, result::CheckStatus, result::smallest_failure,
+};
 
-use crate::grade::rubric::score::MISSING;
+use crate::grade::score::MISSING;
 
 /// Whether `c` is an image check whose file is not in the submission.
 pub(crate) fn is_missing_image(c: &CheckResult) -> bool {
     c.status == CheckStatus::Error
         && c.image.as_ref().is_some_and(|i| match &i.verdict {
-            crate::grade::ImageVerdict::Unusable(why) => why.ends_with(MISSING),
+            crate::grade::checkers::ImageVerdict::Unusable(why) => why.ends_with(MISSING),
             _ => false,
         })
 }
@@ -299,7 +301,7 @@ fn ambiguous_counts(c: &CheckResult, checks: &[CheckResult]) -> Option<(usize, u
 /// block `quote` writes: it is the submission's text), the reproduction, and the notes.
 fn function_body(
     c: &CheckResult,
-    f: &crate::weekly::FunctionResult,
+    f: &crate::weekly::run::FunctionResult,
     quote: fn(&Untrusted) -> String,
 ) -> String {
     let mut md = c.message.markdown_inline();

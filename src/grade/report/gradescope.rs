@@ -11,7 +11,7 @@ use serde_json::{Value, json};
 
 use super::feedback::{Shown, ambiguous_body, check_body, is_ambiguous_note, worth_showing};
 use crate::escape::Untrusted;
-use crate::grade::{CheckResult, CheckStatus, GradeReport};
+use crate::grade::{result::CheckResult, result::CheckStatus, result::GradeReport};
 
 /// Text the submission controls, for Gradescope's Markdown: each line escaped with
 /// [`markdown_inline`] (so `<`, `>` and `&` are entities and nothing is a link, a heading or
@@ -72,7 +72,7 @@ pub fn value(report: &GradeReport) -> Value {
             })
         })
         .collect();
-    let score: f64 = crate::grade::round2(report.checks.iter().map(|c| c.score).sum());
+    let score: f64 = crate::grade::result::round2(report.checks.iter().map(|c| c.score).sum());
     let mut output = format!(
         "Graded by rtoracle {} with the {} rubric: {} / {}.",
         report.reproducibility.tool_version, report.rubric, score, report.max_score

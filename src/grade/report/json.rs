@@ -2,7 +2,7 @@
 //! order), headed by what it is and the version of its layout. Its JSON Schema is
 //! `docs/schemas/report.schema.json`.
 
-use crate::grade::GradeReport;
+use crate::grade::result::GradeReport;
 
 /// What `report.json` says it is (its `schema`).
 pub const REPORT_SCHEMA: &str = "rtoracle-grade-report";

@@ -4,7 +4,7 @@
 use std::fmt::Write;
 
 use crate::escape::Untrusted;
-use crate::grade::{CheckStatus, GradeReport};
+use crate::grade::{result::CheckStatus, result::GradeReport};
 
 /// Escapes text for XML content and attribute values ([`crate::escape::xml`]).
 pub fn escape(text: &str) -> String {

@@ -19,7 +19,7 @@ use super::feedback::{
 };
 use crate::escape::Untrusted;
 use crate::grade::rubric::Visibility;
-use crate::grade::{CheckResult, CheckStatus, GradeReport};
+use crate::grade::{result::CheckResult, result::CheckStatus, result::GradeReport};
 
 /// Points as short as they go: `15`, `7.5`, `33.33`.
 pub(crate) fn fmt_points(x: f64) -> String {
@@ -179,7 +179,7 @@ pub fn render(report: &GradeReport) -> String {
 #[cfg(test)]
 mod tests {
     use crate::grade::checkers::fakes::{FakeCode, all_pass, counts, fake_images};
-    use crate::grade::{Rubric, grade, rubric::WEEK04_RUBRIC};
+    use crate::grade::{rubric::Rubric, rubric::WEEK04_RUBRIC, run::grade};
 
     #[test]
     fn hidden_groups_keep_their_details_out_of_the_feedback_but_not_out_of_results_json() {

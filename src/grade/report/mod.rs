@@ -9,7 +9,7 @@ pub mod markdown;
 
 use std::path::Path;
 
-use super::{GradeError, GradeReport};
+use super::{result::GradeError, result::GradeReport};
 
 /// The report formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -86,7 +86,7 @@ impl Format {
 /// name 'root' is not defined (RT_object.py, line 29)`: the submission's text, unescaped), for a
 /// line of its own on the terminal: a code check's smallest failing vector that raised, a
 /// function's smallest failing case that raised, a render that raised.
-pub fn exception_of(check: &super::CheckResult) -> Option<crate::escape::Untrusted> {
+pub fn exception_of(check: &super::result::CheckResult) -> Option<crate::escape::Untrusted> {
     use crate::escape::Untrusted;
     if let Some(f) = &check.function {
         return f
@@ -101,7 +101,7 @@ pub fn exception_of(check: &super::CheckResult) -> Option<crate::escape::Untrust
             .strip_prefix("the render ")
             .filter(|w| w.starts_with("raised "));
     }
-    let f = super::smallest_failure(&check.failures)?;
+    let f = super::result::smallest_failure(&check.failures)?;
     (f.kind == crate::candidate::judging::check::FailureKind::Error
         && f.message.starts_with("raised "))
     .then(|| f.message.clone())

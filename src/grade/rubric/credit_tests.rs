@@ -6,9 +6,9 @@ use std::collections::BTreeMap;
 use super::*;
 use crate::candidate::judging::check::{decide_winding, judge_wound};
 use crate::candidate::process::protocol::Answer;
-use crate::oracle::default_suite;
 use crate::oracle::generate::{add, scale};
 use crate::oracle::mistakes::{self, Variant};
+use crate::oracle::suite::default_suite;
 use crate::oracle::vectors::ShapeKind;
 
 /// Deterministic pseudo-random numbers (splitmix64) for the coin-toss strategies.

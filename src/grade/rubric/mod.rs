@@ -61,7 +61,6 @@
 //! ([`crate::golden::golden_of`]).
 
 pub mod credit;
-pub mod score;
 pub mod weeks;
 
 use std::collections::BTreeSet;
@@ -389,21 +388,21 @@ fn default_code_time_budget() -> f64 {
 }
 
 fn default_memory_limit_mib() -> u64 {
-    crate::sandbox::SandboxPolicy::grading().memory_bytes >> 20
+    crate::sandbox::policy::SandboxPolicy::grading().memory_bytes >> 20
 }
 
 fn default_file_limit_mib() -> u64 {
-    crate::sandbox::SandboxPolicy::grading().disk_bytes >> 20
+    crate::sandbox::policy::SandboxPolicy::grading().disk_bytes >> 20
 }
 
 impl Rubric {
     /// The sandbox's limits for this rubric's submissions: `grade`'s, with its memory and file
     /// limits.
-    pub fn sandbox_policy(&self) -> crate::sandbox::SandboxPolicy {
-        crate::sandbox::SandboxPolicy {
+    pub fn sandbox_policy(&self) -> crate::sandbox::policy::SandboxPolicy {
+        crate::sandbox::policy::SandboxPolicy {
             memory_bytes: self.memory_limit_mib << 20,
             disk_bytes: self.file_limit_mib << 20,
-            ..crate::sandbox::SandboxPolicy::grading()
+            ..crate::sandbox::policy::SandboxPolicy::grading()
         }
     }
 }

@@ -28,7 +28,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::grade::rubric::{Group, GroupKind, Rubric, RubricError, WEEK04_RUBRIC};
-use crate::weekly::Week;
+use crate::weekly::week::Week;
 
 /// The names of the built-in rubrics.
 pub const BUILTIN_RUBRICS: &[&str] = &[
@@ -409,7 +409,7 @@ impl Rubric {
                 }
                 return Ok(());
             }
-            Some(n) => crate::weekly::Week::new(n).ok_or_else(|| {
+            Some(n) => crate::weekly::week::Week::new(n).ok_or_else(|| {
                 self.invalid(format!(
                     "week = {n}: function checks exist for weeks 5 to 10 (leave week out for week 4)"
                 ))
@@ -461,7 +461,7 @@ impl Rubric {
                 g.id
             )));
         }
-        let Some(week) = self.week.and_then(crate::weekly::Week::new) else {
+        let Some(week) = self.week.and_then(crate::weekly::week::Week::new) else {
             return Err(self.invalid(format!(
                 "functions group {:?} needs the rubric's week (week = 5 to 10)",
                 g.id

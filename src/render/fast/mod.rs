@@ -7,8 +7,8 @@
 //! - `lanes` (x86_64 only, chosen here): four rays at once in AVX2 intrinsics where the processor
 //!   has them, the portable lanes elsewhere.
 
-pub(super) mod fixed_origin;
 #[cfg(target_arch = "x86_64")]
 pub(super) mod lanes;
 pub(super) mod packet;
+pub(super) mod fixed_origin;
 pub(super) mod pinhole;

@@ -200,7 +200,7 @@ mod tests {
     /// made a forking submission "hold more than 1 GiB" that it did not hold).
     #[test]
     fn memory_shared_by_forked_children_is_counted_once() {
-        if !crate::sandbox::running_as_root() || !Path::new("/usr/bin/python3").exists() {
+        if !crate::sandbox::identity::running_as_root() || !Path::new("/usr/bin/python3").exists() {
             eprintln!("skipped: needs root and /usr/bin/python3");
             return;
         }
@@ -242,7 +242,7 @@ mod tests {
     /// A uid's System V segment with no process left counts as the uid's memory.
     #[test]
     fn a_uid_s_segment_counts_as_its_memory() {
-        if !crate::sandbox::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
+        if !crate::sandbox::identity::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
             eprintln!("skipped: needs root and ipcmk");
             return;
         }

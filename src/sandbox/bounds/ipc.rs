@@ -213,7 +213,7 @@ mod tests {
     /// by owner and removed, and another uid's are not touched.
     #[test]
     fn a_uid_s_system_v_objects_are_measured_and_swept() {
-        if !crate::sandbox::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
+        if !crate::sandbox::identity::running_as_root() || !Path::new("/usr/bin/ipcmk").exists() {
             eprintln!("skipped: needs root and ipcmk");
             return;
         }

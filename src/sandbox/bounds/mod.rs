@@ -4,8 +4,8 @@
 //! tick ([`watchdog`]), and the reaper that ends what it started (`reaper`).
 
 pub mod cgroup;
-pub mod held;
 pub mod ipc;
-pub(super) mod reaper;
+pub mod held;
+pub mod reaper;
 pub mod scratch;
 pub mod watchdog;

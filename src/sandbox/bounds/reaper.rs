@@ -50,7 +50,7 @@ impl Reaper {
     }
 }
 
-/// Kills a child spawned from [`Sandbox::command`](crate::sandbox::Sandbox::command) and everything in its process group, and
+/// Kills a child spawned from [`Sandbox::command`](crate::sandbox::lifecycle::Sandbox::command) and everything in its process group, and
 /// reaps it.
 pub fn kill_group(child: &mut Child) {
     // SAFETY: the child leads its own process group (setsid) and is not reaped yet, so its pid

@@ -7,6 +7,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use crate::sandbox::bounds::ipc::Limits as IpcLimits;
+use crate::sandbox::lifecycle::InfoSlot;
 
 /// The harness's side of one bubblewrap start: the descriptors bubblewrap is given, and the
 /// harness's copies of them, which must live until the command is spawned and then close.
@@ -49,30 +50,6 @@ pub(in crate::sandbox) fn start(
         block_fd: block_read.as_raw_fd(),
         _held: (info_write, block_read),
     })
-}
-
-/// What bubblewrap's `--info-fd` said for one command, once its admission has read it.
-#[derive(Debug, Default)]
-pub(in crate::sandbox) struct InfoSlot {
-    text: Mutex<Option<String>>,
-    ready: std::sync::Condvar,
-}
-
-impl InfoSlot {
-    pub(in crate::sandbox) fn set(&self, text: String) {
-        *self.text.lock().unwrap_or_else(|e| e.into_inner()) = Some(text);
-        self.ready.notify_all();
-    }
-
-    /// The text, waiting up to `timeout` for it (empty when it does not come).
-    pub(in crate::sandbox) fn wait(&self, timeout: Duration) -> String {
-        let guard = self.text.lock().unwrap_or_else(|e| e.into_inner());
-        let (guard, _) = self
-            .ready
-            .wait_timeout_while(guard, timeout, |t| t.is_none())
-            .unwrap_or_else(|e| e.into_inner());
-        guard.clone().unwrap_or_default()
-    }
 }
 
 /// Lets a bubblewrap sandbox's first process go on, once it has its limits: reads what

@@ -1,7 +1,7 @@
 //! The bubblewrap command line: which namespaces, which view, what is mounted where, and
 //! reading back what bubblewrap made (`--info-fd`).
 //!
-//! Promises: the sandbox sees the system view and the exposed paths ([`crate::sandbox::start::view`]: read-only,
+//! Promises: the sandbox sees the system view and the exposed paths ([`crate::sandbox::view`]: read-only,
 //! its rtoracle binaries covered with an empty file), a fresh `/proc` of the new PID namespace, a
 //! minimal read-only `/dev` whose `/dev/shm` is a tmpfs of [`SHM_BYTES`] (the semaphores and
 //! locks of Python's `multiprocessing`), a `/tmp` that is a tmpfs of bounded size
@@ -13,15 +13,12 @@
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use crate::sandbox::start::view::{SystemEntry, View, system};
+use crate::sandbox::view::{INSIDE, SystemEntry, View, system};
 
 /// The size of the tmpfs at `/dev/shm`: room for the POSIX semaphores and locks of Python's
 /// `multiprocessing` (a `Pool` makes a handful, a page each), small enough that what it holds
 /// in the host's memory stays a bounded extra beside the memory limit.
 pub const SHM_BYTES: u64 = 4 << 20;
-
-/// Where the sandbox folder is seen from inside.
-pub const INSIDE: &str = "/sandbox";
 
 /// Where bubblewrap is looked for (never on the harness's `PATH`: a root harness must not run
 /// whatever `bwrap` comes first there).

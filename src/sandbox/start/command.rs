@@ -11,13 +11,14 @@ use std::sync::Arc;
 
 use crate::sandbox::bounds::ipc::Limits as IpcLimits;
 use crate::sandbox::identity::running_as_root;
+use crate::sandbox::lifecycle::InfoSlot;
 use crate::sandbox::lifecycle::Sandbox;
 use crate::sandbox::policy::Isolation;
-use crate::sandbox::start::admission::{self, InfoSlot};
+use crate::sandbox::start::admission;
 use crate::sandbox::start::bwrap;
 use crate::sandbox::start::child::{ChildSetup, Fallback};
 use crate::sandbox::start::pivot::ViewPlan;
-use crate::sandbox::start::view::{self, View};
+use crate::sandbox::view::{self, View};
 
 /// The `PATH` inside the sandbox (the harness's own `PATH` may lead to a root-only Python).
 pub const SANDBOX_PATH: &str = "/usr/local/bin:/usr/bin:/bin";

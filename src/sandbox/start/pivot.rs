@@ -1,5 +1,5 @@
 //! The fallback's own view of the file system, made by its child in a mount namespace of its
-//! own (a root harness without bubblewrap): the same view as bubblewrap's ([`crate::sandbox::start::view`]), on
+//! own (a root harness without bubblewrap): the same view as bubblewrap's ([`crate::sandbox::view`]), on
 //! a new root that replaces the host's (`pivot_root`).
 //!
 //! Promises:
@@ -20,7 +20,7 @@ use std::ffi::CString;
 use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
 
-use crate::sandbox::start::view::{SystemEntry, View, system};
+use crate::sandbox::view::{SystemEntry, View, system};
 
 /// The device nodes of the minimal `/dev`.
 const DEVICES: [&str; 6] = ["null", "zero", "full", "random", "urandom", "tty"];

@@ -7,5 +7,5 @@
 //!   elsewhere), with the same arithmetic as the reference primitives.
 
 pub(super) mod bvh;
-pub(super) mod shape_lanes;
 pub(super) mod shape_set;
+pub(super) mod shape_lanes;

@@ -22,7 +22,7 @@ use crate::scene::{Camera, CameraSettings};
 use crate::weekly::expect::{Class, Expected, Want, numbers};
 use crate::weekly::samplers::mistakes;
 use crate::weekly::samplers::{
-    CAMERA_SAMPLES, DISK_SAMPLES, JitterSetting, Sample, SamplerCheck, Standing,
+    CAMERA_SAMPLES, DISK_SAMPLES, Sample, SamplerCheck, Standing, camera::JitterSetting,
 };
 
 /// A camera as a request states it (the course's `Camera` fields set before `init_camera`).

@@ -22,8 +22,8 @@ use crate::render::{Onb, reflect};
 use crate::weekly::expect::{Class, Expected, Want, numbers};
 use crate::weekly::samplers::mistakes;
 use crate::weekly::samplers::{
-    HEMISPHERE_SAMPLES, LAMBERTIAN_SAMPLES, METAL_SAMPLES, MetalSetting, Sample, SamplerCheck,
-    Standing, UNIT_SPHERE_SAMPLES,
+    HEMISPHERE_SAMPLES, LAMBERTIAN_SAMPLES, METAL_SAMPLES, Sample, SamplerCheck, Standing,
+    UNIT_SPHERE_SAMPLES, surfaces::MetalSetting,
 };
 
 pub(crate) fn checks(seed: u64) -> Vec<FunctionCheck> {

@@ -18,13 +18,13 @@ use super::expect::{Class, Expected};
 use super::samplers::{Sample, SamplerCheck, Standing};
 use super::week::Week;
 
-pub(crate) mod brdf;
-pub(crate) mod camera;
-pub(crate) mod lambert;
-pub(crate) mod lights;
-pub(crate) mod optics;
 pub(crate) mod py;
+pub(crate) mod lights;
 pub(crate) mod steer;
+pub(crate) mod optics;
+pub(crate) mod brdf;
+pub(crate) mod lambert;
+pub(crate) mod camera;
 pub(crate) mod steered_camera;
 pub(crate) mod surface;
 

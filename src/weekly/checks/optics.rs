@@ -19,7 +19,7 @@ use crate::render::{halfvector, reflect, refracted, schlick};
 use crate::weekly::expect::{Class, Expected, Want};
 use crate::weekly::samplers::mistakes;
 use crate::weekly::samplers::{
-    DIELECTRIC_SAMPLES, DielectricSetting, Sample, SamplerCheck, Standing,
+    DIELECTRIC_SAMPLES, Sample, SamplerCheck, Standing, surfaces::DielectricSetting,
 };
 
 mod dielectric;

@@ -19,7 +19,7 @@ use super::camera::{CameraInput, dof_camera};
 use super::steer::{self, Behaviour};
 use super::{Body, CASE_TIMEOUT, Case, FunctionCheck, jnum, py, stream, week};
 use crate::weekly::expect::{Class, Expected, Want, numbers};
-use crate::weekly::samplers::{JitterSetting, Sample, SamplerCheck};
+use crate::weekly::samplers::{Sample, SamplerCheck, camera::JitterSetting};
 
 pub(crate) fn checks(seed: u64) -> Vec<FunctionCheck> {
     vec![camera_ray_check(seed, 9), camera_ray_check(seed, 10)]

@@ -29,13 +29,10 @@ use serde::{Deserialize, Serialize};
 use super::stats::{TestResult, binomial, chi_square};
 use crate::render::PixelSampler;
 
-mod camera;
+pub mod camera;
 mod directions;
 pub mod mistakes;
-mod surfaces;
-
-pub use camera::JitterSetting;
-pub use surfaces::{DielectricSetting, MetalSetting};
+pub mod surfaces;
 
 /// One sample of a random function, in the domain its check reads (unused entries are 0).
 pub type Sample = [f64; 9];

@@ -2,6 +2,8 @@
 //! deterministic), the measurement with many seeds in `power` (ignored; its figures are in
 //! `docs/weekly-checks.md`).
 
+use super::camera::JitterSetting;
+use super::surfaces::{DielectricSetting, MetalSetting};
 use super::*;
 use crate::weekly::stats::DEFAULT_ALPHA;
 

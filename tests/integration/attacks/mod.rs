@@ -153,7 +153,7 @@ fn protocol_errors(report: &Value) -> u64 {
 /// The ids of week `week`'s statistical checks.
 fn sampler_ids(week: u8) -> Vec<&'static str> {
     use rtoracle::weekly::checks::{Body, week_checks};
-    week_checks(rtoracle::weekly::Week::new(week).unwrap(), 0)
+    week_checks(rtoracle::weekly::week::Week::new(week).unwrap(), 0)
         .into_iter()
         .filter(|c| matches!(c.body, Body::Samples { .. }))
         .map(|c| c.id)

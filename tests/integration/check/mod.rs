@@ -100,7 +100,7 @@ fn mixed() -> &'static [Case] {
     CASES.get_or_init(|| {
         let mut all = cases().to_vec();
         all.extend(
-            rtoracle::oracle::default_suite(0)
+            rtoracle::oracle::suite::default_suite(0)
                 .into_iter()
                 .filter(|c| c.shape.kind() == ShapeKind::Triangle),
         );
@@ -620,7 +620,7 @@ fn a_forked_child_is_killed_with_its_group() {
         .and_then(|s| s.parse().ok())
         .unwrap_or_else(|| panic!("no pid in {:?}", r.stderr_tail));
     let facts = r.sandbox.as_ref().expect("sandbox facts");
-    if facts.isolation == rtoracle::sandbox::Isolation::Bubblewrap {
+    if facts.isolation == rtoracle::sandbox::policy::Isolation::Bubblewrap {
         // The pid is the PID namespace's: no process of the sandbox's uid may be left.
         // SAFETY: geteuid has no preconditions.
         if unsafe { libc::geteuid() } == 0 {

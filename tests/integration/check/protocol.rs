@@ -407,7 +407,7 @@ fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
     if !python_ok() {
         return;
     }
-    use rtoracle::grade::{CodeChecker, CourseCodeChecker};
+    use rtoracle::grade::{checkers::CodeChecker, checkers::code::CourseCodeChecker};
     // Hangs on every miss: with a 2 s case timeout and 3 timeouts per group it would cost 12 s
     // and more; a 3 s budget stops it there.
     let dir = rtoracle::bench::harness::assemble_fixture("hostile_hang_on_miss").unwrap();
@@ -417,7 +417,7 @@ fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
         time_budget: Some(Duration::from_secs(3)),
         vectors: Some((
             "the seed-0 suite".into(),
-            rtoracle::oracle::default_suite(0),
+            rtoracle::oracle::suite::default_suite(0),
         )),
         ..CourseCodeChecker::default()
     };
@@ -441,7 +441,7 @@ fn grading_stops_a_slow_submission_at_its_budget_and_keeps_the_rest() {
 
 /// `n` vectors of class `any` (degenerate quads) from the default suite, then [`misses`].
 fn any_quads_then_misses(n: usize) -> Vec<Case> {
-    let any: Vec<Case> = rtoracle::oracle::default_suite(0)
+    let any: Vec<Case> = rtoracle::oracle::suite::default_suite(0)
         .into_iter()
         .filter(|c| c.shape.kind() == ShapeKind::Quad && c.expect.class == Class::Any)
         .take(n)

@@ -13,7 +13,7 @@ use rtoracle::bench::harness::course_python_or_skip;
 use rtoracle::candidate::process::command::CandidateCommand;
 use rtoracle::candidate::process::options::RunOptions;
 use rtoracle::candidate::process::session::Session;
-use rtoracle::weekly::{FunctionRunner, Reply, SessionRunner};
+use rtoracle::weekly::{runner::FunctionRunner, runner::Reply, runner::SessionRunner};
 use serde_json::json;
 
 fn python() -> Option<&'static Path> {

@@ -10,7 +10,9 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 use rtoracle::compare::diagnose::mistakes::{MUST_FAIL, Mistake, render_with_mistake};
-use rtoracle::compare::{CandidateImage, CompareOptions, Comparison, Golden, compare_image};
+use rtoracle::compare::{
+    CompareOptions, Comparison, candidate::CandidateImage, compare_image, noise_model::Golden,
+};
 use rtoracle::image_io::Rgb8Image;
 use rtoracle::render::{PixelJitter, RenderOptions, render};
 
@@ -294,7 +296,7 @@ fn the_course_pngs_pass() {
             &course_png(&dir, file),
             golden(scene),
             &CompareOptions {
-                encoding: rtoracle::compare::Encoding::Linear,
+                encoding: rtoracle::compare::encoding::Encoding::Linear,
                 diagnose: false,
                 ..Default::default()
             },
@@ -512,7 +514,7 @@ fn bad_candidates_exit_2_naming_the_file() {
 /// diagnosis and a heatmap, missing and wrong-size files are unusable.
 #[test]
 fn the_grading_image_checker_uses_the_comparison() {
-    use rtoracle::grade::CompareImageChecker;
+    use rtoracle::grade::checkers::images::CompareImageChecker;
     use rtoracle::grade::checkers::{ImageChecker, ImageVerdict};
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path();

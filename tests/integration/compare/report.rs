@@ -9,7 +9,8 @@
 use std::sync::OnceLock;
 
 use rtoracle::compare::{
-    CandidateImage, CompareOptions, Comparison, Golden, Region, compare_image,
+    CompareOptions, Comparison, Region, candidate::CandidateImage, compare_image,
+    noise_model::Golden,
 };
 use rtoracle::image_io::Rgb8Image;
 use rtoracle::render::{RenderOptions, encode_course_png, render};

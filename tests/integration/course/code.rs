@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 use rtoracle::bench::harness::course_python_or_skip;
 use rtoracle::weekly::checks::{Body, week_checks};
 use rtoracle::weekly::expect::{Expected, Want};
-use rtoracle::weekly::{Week, detect};
+use rtoracle::weekly::{week::Week, week::detect};
 use serde_json::{Value, json};
 
 use crate::common::{CourseTree, course_code, course_week_copy};

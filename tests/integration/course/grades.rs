@@ -153,7 +153,7 @@ fn scored_functions_live_in_the_files_the_week_changes() {
         read("skeleton") != read("solution")
     };
     for week in 5..=10u8 {
-        let rubric = rtoracle::grade::Rubric::builtin(&format!("week{week:02}")).unwrap();
+        let rubric = rtoracle::grade::rubric::Rubric::builtin(&format!("week{week:02}")).unwrap();
         for g in &rubric.groups {
             for f in g.functions.iter().flatten() {
                 assert!(

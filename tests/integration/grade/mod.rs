@@ -540,7 +540,7 @@ fn packaged_seed(zip: &Path) -> u64 {
     let mut archive = zip::ZipArchive::new(file).unwrap();
     let mut text = String::new();
     std::io::Read::read_to_string(&mut archive.by_name("rubric.toml").unwrap(), &mut text).unwrap();
-    rtoracle::grade::Rubric::from_toml(&text, "packaged")
+    rtoracle::grade::rubric::Rubric::from_toml(&text, "packaged")
         .unwrap()
         .seed
 }

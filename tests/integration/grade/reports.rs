@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 use pulldown_cmark::{Event, HeadingLevel, Parser, Tag, TagEnd};
 use rtoracle::candidate::judging::check::FailureKind;
 use rtoracle::grade::{
-    CodeChecker, CodeOutcome, FailureSummary, Format, GroupCounts, ImageChecker, ImageOutcome,
-    ImageVerdict, Rubric, grade_to_dir,
+    checkers::CodeChecker, checkers::CodeOutcome, checkers::FailureSummary, checkers::GroupCounts,
+    checkers::ImageChecker, checkers::ImageOutcome, checkers::ImageVerdict, report::Format,
+    rubric::Rubric, write::grade_to_dir,
 };
 use rtoracle::oracle::vectors::ShapeKind;
 

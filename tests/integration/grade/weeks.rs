@@ -468,8 +468,8 @@ fn built_in_rubrics_print_and_read_back() {
         let text = String::from_utf8(out.stdout).unwrap();
         let file = dir.path().join(format!("{name}.toml"));
         std::fs::write(&file, &text).unwrap();
-        let back = rtoracle::grade::Rubric::from_file(&file).unwrap();
-        let builtin = rtoracle::grade::Rubric::builtin(name).unwrap();
+        let back = rtoracle::grade::rubric::Rubric::from_file(&file).unwrap();
+        let builtin = rtoracle::grade::rubric::Rubric::builtin(name).unwrap();
         assert_eq!(back.groups, builtin.groups, "{name}");
         assert_eq!(back.week, builtin.week, "{name}");
     }

@@ -11,7 +11,7 @@ use rtoracle::oracle::band::Iv;
 use rtoracle::oracle::exact::{Dyadic, decide_with};
 use rtoracle::oracle::generate::{Stream, random_plane, random_sphere};
 use rtoracle::oracle::vectors::{Class, read_vectors};
-use rtoracle::oracle::{analyse, fuzzing};
+use rtoracle::oracle::{classify::analyse, fuzzing};
 
 #[test]
 fn vectors_writes_the_same_bytes_for_a_seed_and_a_sidecar() {
@@ -38,7 +38,7 @@ fn vectors_writes_the_same_bytes_for_a_seed_and_a_sidecar() {
     assert_eq!(meta["schema_version"], 1);
     // Every line's expect is what the oracle says of its inputs.
     for c in cases.iter().step_by(7) {
-        let again = rtoracle::oracle::classify(&c.shape, &c.ray, c.interval);
+        let again = rtoracle::oracle::classify::classify(&c.shape, &c.ray, c.interval);
         assert_eq!(again.class, c.expect.class, "{}", c.id);
         assert_eq!(
             again.t.map(f64::to_bits),
@@ -182,7 +182,9 @@ fn filter_and_exact_agree_and_reference_is_exact_on_a_million_cases() {
 mod truthful_tags {
     use rtoracle::oracle::exact::Dyadic;
     use rtoracle::oracle::vectors::{Case, Class, ShapeSpec};
-    use rtoracle::oracle::{Judging, Precision, Profile, default_suite_with};
+    use rtoracle::oracle::{
+        profile::Judging, profile::Precision, profile::Profile, suite::default_suite_with,
+    };
     use std::cmp::Ordering::*;
 
     type V = [Dyadic; 3];
@@ -471,16 +473,17 @@ fn vectors_and_explain_take_a_profile_and_a_precision() {
     assert_eq!(meta["precision"], "f32");
     // Every f32 hit carries the f32 normal tolerance, and the lines are what the oracle says
     // of their inputs under that judging.
-    let judging = rtoracle::oracle::Judging::new(
-        rtoracle::oracle::Profile::Robust,
-        rtoracle::oracle::Precision::F32,
+    let judging = rtoracle::oracle::profile::Judging::new(
+        rtoracle::oracle::profile::Profile::Robust,
+        rtoracle::oracle::profile::Precision::F32,
     );
     let cases = read_vectors(&dir.path().join("v.jsonl")).unwrap();
     for c in &cases {
         if c.expect.class == Class::Hit {
             assert_eq!(c.expect.normal_tol, Some(1e-3), "{}", c.id);
         }
-        let again = rtoracle::oracle::classify_with(&c.shape, &c.ray, c.interval, judging);
+        let again =
+            rtoracle::oracle::classify::classify_with(&c.shape, &c.ray, c.interval, judging);
         assert_eq!(again.class, c.expect.class, "{}", c.id);
     }
     let out = run_in(

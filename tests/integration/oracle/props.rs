@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, FileFailurePersistence, RngAlgorithm, RngSeed};
 
 use rtoracle::geometry::{DVec3, Interval, Ray, Shape, Triangle};
-use rtoracle::oracle::analyse;
+use rtoracle::oracle::classify::analyse;
 use rtoracle::oracle::exact::{Decision, ExactHit};
 use rtoracle::oracle::generate::{Raw, Stream, pow2, random_plane, random_sphere, raw_case};
 use rtoracle::oracle::vectors::{Class, RaySpec, ShapeKind, ShapeSpec};
@@ -100,7 +100,7 @@ proptest! {
     /// The reference decides every definite case as the exact oracle does, with t in t_tol.
     #[test]
     fn reference_equals_exact_on_definite_cases(c in case()) {
-        let e = rtoracle::oracle::classify(&c.shape, &c.ray, c.interval);
+        let e = rtoracle::oracle::classify::classify(&c.shape, &c.ray, c.interval);
         let hit = c.shape.object().intersect(&c.ray.ray(), Interval::new(c.interval[0], c.interval[1]));
         if e.class.is_definite() {
             prop_assert_eq!(hit.is_some(), e.class == Class::Hit);
@@ -210,14 +210,14 @@ proptest! {
     /// reference on definite hits); reversing the ray of a plane hit keeps the hit point.
     #[test]
     fn moving_the_origin_along_the_ray_shifts_t(c in case(), s in 0.0f64..0.5) {
-        let e = rtoracle::oracle::classify(&c.shape, &c.ray, c.interval);
+        let e = rtoracle::oracle::classify::classify(&c.shape, &c.ray, c.interval);
         let (Class::Hit, Some(t)) = (e.class, e.t) else { return Ok(()); };
         let shift = s * t;
         let mut d = c.clone();
         d.ray.origin = [0, 1, 2].map(|i| c.ray.origin[i] + shift * c.ray.direction[i]);
         d.interval = c.interval.map(|x| if x == f64::MAX { x } else { x - shift });
         let h = d.shape.object().hit_t(&d.ray.ray(), Interval::new(d.interval[0], d.interval[1]));
-        let e2 = rtoracle::oracle::classify(&d.shape, &d.ray, d.interval);
+        let e2 = rtoracle::oracle::classify::classify(&d.shape, &d.ray, d.interval);
         if e2.class == Class::Hit {
             let h = h.expect("definite hit");
             prop_assert!((h - (t - shift)).abs() <= 1e-6 * t.abs() + e2.t_tol.unwrap(), "{} vs {}", h, t - shift);
@@ -297,8 +297,8 @@ proptest! {
             },
             |v| apply(&m, v),
         );
-        let before = rtoracle::oracle::classify(&c.shape, &c.ray, c.interval);
-        let after = rtoracle::oracle::classify(&moved.shape, &moved.ray, moved.interval);
+        let before = rtoracle::oracle::classify::classify(&c.shape, &c.ray, c.interval);
+        let after = rtoracle::oracle::classify::classify(&moved.shape, &moved.ray, moved.interval);
         let definite = |e: &rtoracle::oracle::vectors::Expect| matches!(e.class, Class::Hit | Class::Miss);
         if !(definite(&before) && definite(&after)) {
             return Ok(());
@@ -370,11 +370,11 @@ proptest! {
     #[test]
     fn reversing_the_ray_meets_the_same_point(c in case()) {
         if matches!(c.shape, ShapeSpec::Sphere { .. }) { return Ok(()); }
-        let e = rtoracle::oracle::classify(&c.shape, &c.ray, c.interval);
+        let e = rtoracle::oracle::classify::classify(&c.shape, &c.ray, c.interval);
         let (Class::Hit, Some(p), Some(t)) = (e.class, e.point, e.t) else { return Ok(()); };
         let o2 = [0, 1, 2].map(|i| c.ray.origin[i] + 2.0 * t * c.ray.direction[i]);
         let back = RaySpec { origin: o2, direction: c.ray.direction.map(|x| -x) };
-        let e2 = rtoracle::oracle::classify(&c.shape, &back, [0.0, f64::MAX]);
+        let e2 = rtoracle::oracle::classify::classify(&c.shape, &back, [0.0, f64::MAX]);
         if e2.class == Class::Hit {
             let q = e2.point.unwrap();
             let size = c.shape.numbers().iter().chain(&c.ray.origin).fold(0.0f64, |m, x| m.max(x.abs()));

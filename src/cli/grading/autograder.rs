@@ -2,8 +2,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::grade::Rubric;
 use rtoracle::grade::autograder::{self, pack};
+use rtoracle::grade::rubric::Rubric;
 
 /// `rtoracle autograder --out autograder.zip [--rubric NAME|FILE.toml] [--binary PATH]`
 #[derive(Debug, clap::Args)]
@@ -23,7 +23,7 @@ pub struct Args {
     binary: Option<PathBuf>,
     /// The seed of the suite to package (default: the rubric's when non-zero, else a secret one
     /// drawn from the OS, so students cannot know the vectors in advance).
-    #[arg(long, value_name = "N", value_parser = super::num::seed)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::args::seed)]
     seed: Option<u64>,
 }
 
@@ -53,7 +53,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 || rubric
                     .groups
                     .iter()
-                    .any(|g| g.kind == rtoracle::grade::GroupKind::Code);
+                    .any(|g| g.kind == rtoracle::grade::rubric::GroupKind::Code);
             (pack::pack_rubric(&rubric, &text)?, rubric.seed, runs_code)
         }
         None => (

@@ -12,11 +12,11 @@ use rtoracle::candidate::process::options::RunOptions;
 use rtoracle::candidate::{check_command, process::python};
 use rtoracle::oracle::vectors::{Case, read_vectors};
 use rtoracle::oracle::{
-    Judging, Precision, Profile, classify::classify_tagged_with, default_suite_with,
+    classify::classify_tagged_with, profile::Judging, profile::Profile, suite::default_suite_with,
 };
-use rtoracle::sandbox::SandboxError;
-use rtoracle::sandbox::SandboxPolicy;
-use rtoracle::weekly::{FunctionOptions, Week, check_week, detect};
+use rtoracle::sandbox::policy::SandboxError;
+use rtoracle::sandbox::policy::SandboxPolicy;
+use rtoracle::weekly::{run::FunctionOptions, submission::check_week, week::Week, week::detect};
 
 /// Which candidate to run (shared by `check` and `fuzz`; `check` without either checks the
 /// course submission in the current folder).
@@ -31,35 +31,6 @@ pub struct Target {
     /// 'python3 my_adapter.py'.
     #[arg(long, value_name = "CMD ARGS")]
     pub adapter: Option<String>,
-}
-
-/// `--profile` and `--precision` (shared by `check`, `fuzz`, `vectors` and `explain`).
-#[derive(Debug, Clone, Copy, clap::Args)]
-pub struct JudgingArgs {
-    /// Whose formulas draw the line between definite and ambiguous: `course` (the course's
-    /// naive formulas; the default) or `robust` (the reference's robust formulas: finds the
-    /// precision bugs of naive code).
-    #[arg(long, value_name = "course|robust")]
-    pub profile: Option<Profile>,
-    /// The precision the candidate computes in: `f64` (the default) or `f32` (inputs rounded to
-    /// f32, bands and tolerances of f32 arithmetic).
-    #[arg(long, value_name = "f64|f32")]
-    pub precision: Option<Precision>,
-}
-
-impl JudgingArgs {
-    /// The judging, with `default` for an absent `--profile`.
-    pub fn judging(&self, default: Profile) -> Judging {
-        Judging::new(
-            self.profile.unwrap_or(default),
-            self.precision.unwrap_or_default(),
-        )
-    }
-
-    /// Whether either flag was given.
-    pub fn given(&self) -> bool {
-        self.profile.is_some() || self.precision.is_some()
-    }
 }
 
 /// Reclassifies `cases` under `judging`, keeping the file's provenance tags (its
@@ -91,7 +62,7 @@ impl Target {
     }
 
     /// What the report adds to `judged by:` when the default profile judged another renderer.
-    pub fn profile_hint(&self, judging: &JudgingArgs) -> &'static str {
+    pub fn profile_hint(&self, judging: &crate::cli::args::JudgingArgs) -> &'static str {
         if self.adapter.is_some() && judging.profile.is_none() {
             " (the default; --profile robust also judges the far, scaled and near-tangent cases a carefully written f64 intersector must get right)"
         } else {
@@ -168,7 +139,7 @@ impl Target {
         self.check()?;
         sandbox.check_shown()?;
         let policy = sandbox.policy();
-        rtoracle::sandbox::isolation_for(&policy).map_err(with_hint)?;
+        rtoracle::sandbox::detect::isolation_for(&policy).map_err(with_hint)?;
         Ok(match (&self.python_course, &self.adapter) {
             (Some(dir), _) => {
                 let python = python::choose(
@@ -240,7 +211,7 @@ pub struct Args {
     #[command(flatten)]
     target: Target,
     #[command(flatten)]
-    judging: JudgingArgs,
+    judging: crate::cli::args::JudgingArgs,
     #[command(flatten)]
     sandbox: SandboxArgs,
     /// A vector file (JSON lines); the built-in suite when absent. Its expectations are used as
@@ -248,19 +219,19 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     vectors: Option<PathBuf>,
     /// Seed of the built-in suite.
-    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = crate::cli::args::seed)]
     seed: u64,
     /// Time allowed per case, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = crate::cli::args::millis)]
     timeout_ms: u64,
     /// Time allowed for the candidate to start and answer the hello, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = crate::cli::args::millis)]
     hello_timeout_ms: u64,
     /// Print the whole report as one JSON object on stdout.
     #[arg(long)]
     json: bool,
     /// Failures shown in the text report.
-    #[arg(long, value_name = "N", default_value_t = 10, value_parser = super::num::show)]
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = crate::cli::args::show)]
     show: usize,
     /// Shapes the check must cover (sphere, quad, triangle; comma-separated or repeated): if any
     /// of their vectors is not run (a candidate without a usable Triangle, say), the check fails.
@@ -271,10 +242,10 @@ pub struct Args {
     /// The course week to check (4 to 10): from week 5 on, the week's functions (and the
     /// earlier weeks') are checked too. Without it, a course folder's week is found from the
     /// functions and classes its files define; an adapter is checked as week 4.
-    #[arg(long, value_name = "N", value_parser = super::num::week)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::args::week)]
     week: Option<u8>,
     /// False-alarm rate of each statistical test of the week's samplers.
-    #[arg(long, value_name = "P", default_value_t = rtoracle::weekly::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
+    #[arg(long, value_name = "P", default_value_t = rtoracle::weekly::stats::DEFAULT_ALPHA, value_parser = crate::cli::args::alpha)]
     alpha: f64,
     /// Score the ambiguous vectors too, each by its exact answer (as a grading rubric's
     /// `score_ambiguous` does): edges, corners and tangents answered otherwise then fail.
@@ -361,7 +332,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
-    rtoracle::sandbox::announce_on_stderr();
+    rtoracle::sandbox::facts::announce_on_stderr();
     let (command, folder) = if args.target.python_course.is_none() && args.target.adapter.is_none()
     {
         let here = Target {
@@ -394,7 +365,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(if report.passed() {
             0
         } else {
-            super::FAILED
+            crate::cli::FAILED
         }));
     }
     let mut report = check_command(command, &cases, options).context("check")?;
@@ -416,7 +387,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::from(if report.passed() {
         0
     } else {
-        super::FAILED
+        crate::cli::FAILED
     }))
 }
 

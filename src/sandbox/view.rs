@@ -7,6 +7,8 @@
 //!   the host has merged `/usr`) and the few `/etc` files the dynamic loader and Debian's
 //!   alternatives need. Nothing else of the host: no `/home`, `/root`, `/work`, `/opt`, `/var`,
 //!   `/run`, no `/tmp` of the host.
+//! - Under bubblewrap the sandbox folder is seen at [`INSIDE`]; [`replace_path`] tells the
+//!   sandbox's own paths in what its code says in the user's terms.
 //! - [`exposure`] shows no more than a program needs: for a program in a `bin/` folder (an
 //!   interpreter in a virtual environment or under `/opt`), the program and its prefix's
 //!   library tree (`lib`, `lib64`, `pyvenv.cfg`), never the rest of that `bin/` (where a venv
@@ -21,6 +23,29 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use crate::sandbox::oracles;
+
+/// Where the sandbox folder is seen from inside a bubblewrap sandbox.
+pub const INSIDE: &str = "/sandbox";
+
+/// `text` with the path `from` replaced by `to` where it starts a path (not inside a longer
+/// one: `/sandbox/x.py` is replaced, `/work/sandbox/x.py` and `/sandboxes` are not).
+pub fn replace_path(text: &str, from: &Path, to: &str) -> String {
+    let from = from.display().to_string();
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find(&from) {
+        let before = rest[..i].chars().next_back();
+        let after = rest[i + from.len()..].chars().next();
+        let path_char = |c: char| c.is_alphanumeric() || "._-/~".contains(c);
+        let starts = before.is_none_or(|c| !path_char(c));
+        let ends = after.is_none_or(|c| c == '/' || !path_char(c));
+        out.push_str(&rest[..i]);
+        out.push_str(if starts && ends { to } else { &from });
+        rest = &rest[i + from.len()..];
+    }
+    out.push_str(rest);
+    out
+}
 
 /// Top-level folders of the host shown read-only (or as the links they are).
 const SYSTEM: [&str; 7] = [

@@ -32,7 +32,7 @@ pub struct Args {
     dir: PathBuf,
     /// Samples per pixel (default: 4096 for the built-in scenes; for a scene file, the golden
     /// its grading uses: max(4096, 100 x the scene's samples_per_pixel)).
-    #[arg(long, value_name = "N", value_parser = super::num::spp)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::args::spp)]
     spp: Option<u32>,
     /// Only these built-in scenes (comma-separated; default: all of them).
     #[arg(long, value_name = "A,B", value_delimiter = ',')]
@@ -200,6 +200,6 @@ fn check(dir: &Path, scenes: &[(String, GoldenScene)], spp: u32) -> anyhow::Resu
     Ok(if all_equal {
         ExitCode::SUCCESS
     } else {
-        ExitCode::from(super::FAILED)
+        ExitCode::from(crate::cli::FAILED)
     })
 }

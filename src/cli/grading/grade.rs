@@ -4,7 +4,10 @@ use std::time::Duration;
 
 use anyhow::Context;
 use rtoracle::escape::terminal_line;
-use rtoracle::grade::{CourseCodeChecker, Format, ImageChecker, Rubric, batch, grade_to_dir};
+use rtoracle::grade::{
+    batch, checkers::ImageChecker, checkers::code::CourseCodeChecker, report::Format,
+    rubric::Rubric, write::grade_to_dir,
+};
 use rtoracle::oracle::vectors::read_vectors;
 
 /// `rtoracle grade SUBMISSION_DIR [--rubric FILE.toml] [--vectors FILE.jsonl] [--out DIR] [--format all|json,gradescope,junit,markdown]`
@@ -41,10 +44,10 @@ pub struct Args {
     #[arg(long, value_name = "FILE.jsonl")]
     vectors: Option<PathBuf>,
     /// Wall-clock limit per test vector, in milliseconds.
-    #[arg(long, value_name = "MS", default_value_t = 2000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "MS", default_value_t = 2000, value_parser = crate::cli::args::millis)]
     case_timeout_ms: u64,
     /// Worker threads for --batch (default: all cores).
-    #[arg(long, value_name = "T", value_parser = super::num::threads)]
+    #[arg(long, value_name = "T", value_parser = crate::cli::args::threads)]
     threads: Option<usize>,
     /// The Python 3 that runs the submissions (it must have the rubric's python_requires,
     /// default numpy and PIL); default: $RTORACLE_PYTHON, else the first of /usr/bin/python3,
@@ -97,16 +100,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // Where the code runs on the host as uids of their own (the fallback), what it must not
     // read is made unreadable by others until grading ends.
     let _kept = match code.python {
-        Some(_) => Some(rtoracle::sandbox::keep_from_sandboxes(&private_inputs(
-            &args, &rubric,
-        ))?),
+        Some(_) => Some(rtoracle::sandbox::originals::keep_from_sandboxes(
+            &private_inputs(&args, &rubric),
+        )?),
         None => None,
     };
     // Said once the grading is done, so bad input stays one line on stderr.
     let public_seed = (code.python.is_some() && code.vectors.is_none() && rubric.seed == 0).then_some(
         "warning: the rubric uses the public seed 0, so its vectors can be known in advance; set `seed = N` in it (`rtoracle autograder` writes a secret one)",
     );
-    let images = rtoracle::grade::CompareImageChecker::default();
+    let images = rtoracle::grade::checkers::images::CompareImageChecker::default();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()
@@ -173,7 +176,11 @@ fn check_inputs(args: &Args) -> anyhow::Result<()> {
         anyhow::bail!("--python {}: no such file", p.display());
     }
     // Replaced whole at the end: it may hold only rtoracle's reports.
-    rtoracle::output::check_replaceable(&args.out, "--out", &rtoracle::grade::REPORT_FOLDER)?;
+    rtoracle::output::check_replaceable(
+        &args.out,
+        "--out",
+        &rtoracle::grade::write::REPORT_FOLDER,
+    )?;
     if let Some(sub) = &args.submission {
         // The reports must not land among the student's files (nor replace them).
         let out = std::path::absolute(&args.out)?;
@@ -206,7 +213,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         || rubric
             .groups
             .iter()
-            .any(|g| g.kind == rtoracle::grade::GroupKind::Code || g.renders());
+            .any(|g| g.kind == rtoracle::grade::rubric::GroupKind::Code || g.renders());
     let policy = rubric.sandbox_policy();
     let python = if runs_code {
         let python = rtoracle::candidate::process::python::choose(
@@ -214,7 +221,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
             &rubric.python_requires,
             &policy,
         )?;
-        rtoracle::sandbox::announce_on_stderr();
+        rtoracle::sandbox::facts::announce_on_stderr();
         Some(python)
     } else {
         None
@@ -227,7 +234,7 @@ fn code_checker(args: &Args, rubric: &Rubric) -> anyhow::Result<CourseCodeChecke
         policy,
         python,
         python_requires: rubric.python_requires.clone(),
-        week: rubric.week.and_then(rtoracle::weekly::Week::new),
+        week: rubric.week.and_then(rtoracle::weekly::week::Week::new),
         ..Default::default()
     })
 }
@@ -278,13 +285,15 @@ fn print_batch(entries: &[batch::BatchEntry], args: &Args) -> anyhow::Result<()>
 }
 
 /// A submission's checks and total on stdout, and where the reports are on stderr.
-fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::Result<()> {
-    use rtoracle::grade::round2;
+fn print_report(report: &rtoracle::grade::result::GradeReport, args: &Args) -> anyhow::Result<()> {
+    use rtoracle::grade::result::round2;
     // Unscored checks are listed only when some ambiguous vector differs (no `0 / 0` rows).
-    let shown: Vec<&rtoracle::grade::CheckResult> = report
+    let shown: Vec<&rtoracle::grade::result::CheckResult> = report
         .checks
         .iter()
-        .filter(|c| c.status != rtoracle::grade::CheckStatus::Skipped || !c.failures.is_empty())
+        .filter(|c| {
+            c.status != rtoracle::grade::result::CheckStatus::Skipped || !c.failures.is_empty()
+        })
         .collect();
     let width = shown
         .iter()
@@ -293,7 +302,7 @@ fn print_report(report: &rtoracle::grade::GradeReport, args: &Args) -> anyhow::R
         .unwrap_or(0)
         .max(24);
     for c in shown {
-        if c.status == rtoracle::grade::CheckStatus::Skipped {
+        if c.status == rtoracle::grade::result::CheckStatus::Skipped {
             outln!("{:<width$} {:>15} not scored", terminal_line(&c.id), "")?;
             continue;
         }

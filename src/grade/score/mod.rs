@@ -1,9 +1,16 @@
-//! Scoring: from what the checkers found and the rubric's groups to the checks and their points.
+//! Scoring: from what the checkers found and the rubric's groups to the checks, their points and
+//! their messages (a render group's says what was judged and what became of the upload).
+
+pub mod weekly;
 
 use crate::candidate::judging::check::FailureKind;
 use std::path::Path;
 
+use serde_json::Value;
+
+use crate::escape::Untrusted;
 use crate::grade::checkers::copies::CopyFinding;
+use crate::grade::checkers::rendered::scene_description;
 use crate::grade::checkers::{
     CodeOutcome, FailureSummary, GroupCounts, ImageOutcome, ImageVerdict,
 };
@@ -353,4 +360,125 @@ pub(crate) fn image_check(
             copies: copy.into_iter().collect(),
         }),
     }
+}
+
+/// The course's jittered renders take floor(sqrt(spp))^2 samples and its film divides by spp;
+/// a film made by the submission that is brighter by exactly spp / floor(sqrt(spp))^2 divides by
+/// the samples taken. Says so, when the comparison's best explanation is that uniform scale.
+fn film_hint(g: &Group, render: &Value, metrics: &Value) -> Option<String> {
+    if render["made_by"].as_str() != Some("main_function") {
+        return None;
+    }
+    let spp = u32::try_from(render["spp"].as_u64()?).ok()?;
+    let scene = scene_description(&g.scene_source()?).ok()?;
+    if scene.render.sampling != crate::scene::PixelSampling::CourseJittered {
+        return None;
+    }
+    let taken = {
+        let m = (f64::from(spp).sqrt().floor()) as u32;
+        m * m
+    };
+    // "scale:1.25", or per channel "scale:1.25,1.25,1.33" (the clamp and the sky's blue).
+    let scales: Vec<f64> = metrics["diagnosis"]["best"]
+        .as_str()?
+        .strip_prefix("scale:")?
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .ok()?;
+    let expected = f64::from(spp) / f64::from(taken);
+    let mut sorted = scales.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let near = (median - expected).abs() <= 0.03 * expected
+        && scales
+            .iter()
+            .all(|k| (k - expected).abs() <= 0.08 * expected);
+    (taken != spp && near).then(|| {
+        format!(
+            " A film brighter by {spp}/{taken} is what dividing by the {taken} samples render_jittered takes gives, instead of by samples_per_pixel ({spp}) as the course's write_to_film does."
+        )
+    })
+}
+
+/// What the message says was judged: the render, by which function or from what, at what spp.
+fn judged(render: &Value) -> String {
+    let timing = match (render["spp"].as_u64(), render["seconds"].as_f64()) {
+        (Some(spp), Some(s)) => format!(" ({spp} spp, {s:.1} s)"),
+        _ => String::new(),
+    };
+    match (render["made_by"].as_str(), render["main_function"].as_str()) {
+        (Some("main_function"), Some(f)) => {
+            format!("The image your main.py's {f}() made{timing}")
+        }
+        _ => format!("The render of your code{timing}"),
+    }
+}
+
+/// Rewrites the message of a render group's check to say what was judged (the render of the
+/// submission's code, its spp and time) and what became of the upload.
+pub(crate) fn explain(check: &mut CheckResult, g: &Group) {
+    let file = g.file.clone().unwrap_or_default();
+    let Some(image) = &check.image else {
+        return;
+    };
+    let render = &image.metrics["render"];
+    let what = judged(render);
+    let mut message = check.message.clone();
+    for (from, to) in [
+        (
+            format!("{file} could not be compared and scores 0: "),
+            format!("{what} could not be judged and scores 0: "),
+        ),
+        (format!("{file} matches"), format!("{what} matches")),
+        (format!("{file} differs"), format!("{what} differs")),
+    ] {
+        if let Some(rest) = message.strip_prefix(&from) {
+            message = Untrusted::from(to).join("", &rest);
+            break;
+        }
+    }
+    // A render that matches but whose variant does not: say that it matched.
+    if render["variant"]["scene_matches"] == true && check.status != CheckStatus::Passed {
+        if let Some(d) = image.diagnosis.as_deref() {
+            if message.starts_with(&format!("{what} differs")) {
+                message = format!("{what} matches the reference, but it scores 0: {d}.").into();
+            }
+        }
+    }
+    let upload = &image.metrics["upload"];
+    let said = match upload["verdict"]["verdict"].as_str() {
+        Some("pass") => format!(
+            " Your uploaded {file} matches the reference (uploads earn no points: the grader renders your code)."
+        ),
+        Some("fail") => format!(
+            " Your uploaded {file} differs from the reference (uploads earn no points: the grader renders your code)."
+        ),
+        _ => match upload["verdict"]["reason"].as_str() {
+            Some(why) if why.contains("missing") => {
+                format!(
+                    " {file} is missing from the submission; it costs nothing: the grader renders your code."
+                )
+            }
+            Some(why) => format!(
+                " Your uploaded {file} could not be compared ({}); uploads earn no points.",
+                why.trim_end_matches('.')
+            ),
+            None => String::new(),
+        },
+    };
+    message.push_str(&said);
+    if let Some(hint) = film_hint(g, render, &image.metrics) {
+        message.push_str(&hint);
+    }
+    if let (Some(f), Some(why)) = (
+        render["main_function"].as_str(),
+        render["main_function_not_used"].as_str(),
+    ) {
+        message.push_str(&format!(
+            " Your main.py's {f}() was not used ({}), so the grader rendered its own description of the scene with your classes.",
+            why.trim_end_matches('.')
+        ));
+    }
+    check.message = message;
 }

@@ -4,8 +4,9 @@ use std::process::ExitCode;
 use anyhow::Context;
 use rtoracle::compare::noise_model::recorded_scene;
 use rtoracle::compare::{
-    CandidateImage, CompareOptions, Comparison, Encoding, Golden, check_size, compare_image,
-    report, write_heatmap, write_report_to,
+    CompareOptions, Comparison, candidate::CandidateImage, check_size, compare_image,
+    encoding::Encoding, heatmap::write_heatmap, noise_model::Golden, report,
+    report::write_report_to,
 };
 use rtoracle::golden::{GoldenRecord, GoldenScene, cache_dir};
 
@@ -34,7 +35,7 @@ pub struct Args {
     golden: Option<PathBuf>,
     /// The candidate's samples per pixel (default: the scene's, 20 for the course scenes; with
     /// --golden alone, the scene's that the golden records, else 20).
-    #[arg(long, value_name = "N", value_parser = super::num::spp)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::args::spp)]
     spp: Option<u32>,
     /// How the candidate's 8-bit codes encode linear values.
     #[arg(long, value_name = "E", default_value = "course",

@@ -31,7 +31,7 @@ enum Area {
     /// and distances, the naive course formula beside it, classification rate, suite generation.
     Oracle {
         /// Random sphere cases (planes get a fifth as many).
-        #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = super::num::count)]
+        #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = crate::cli::args::count)]
         cases: usize,
     },
     /// Checking candidates: vectors per second through the Python adapter against the in-process

@@ -19,7 +19,7 @@
 use crate::grade::checkers::FunctionsOutcome;
 use crate::grade::result::{CheckResult, CheckStatus};
 use crate::grade::rubric::{Group, GroupKind, Rubric, Visibility};
-use crate::weekly::{FunctionResult, Status};
+use crate::weekly::{run::FunctionResult, run::Status};
 
 /// The id of the unscored check that lists the failing functions that carry no points.
 pub const UNSCORED_ID: &str = "functions.unscored";
@@ -228,7 +228,7 @@ mod tests {
     use super::*;
     use crate::weekly::run::{CaseCounts, NamedMistake};
     use crate::weekly::samplers::Standing;
-    use crate::weekly::{FunctionOptions, Week, WeekReport};
+    use crate::weekly::{run::FunctionOptions, run::WeekReport, week::Week};
 
     fn result(id: &str, week: u8, status: Status, mistake: Option<&str>) -> FunctionResult {
         FunctionResult {

@@ -1,4 +1,5 @@
-//! Numeric options, parsed the same way everywhere.
+//! Options several subcommands share: `--profile` and `--precision` ([`JudgingArgs`]), and the
+//! numeric options, parsed the same way everywhere.
 //!
 //! Each numeric option takes a value parser from here, so that `--seed -1`, `--seed=-1`,
 //! `--spp -2`, `--width 1e308`, `--count NaN` and `--threads 99999999999` all get the same kind
@@ -6,6 +7,8 @@
 //! option's name in front of the message), exit 2, before any work. Negative numbers are accepted
 //! as values by the parser (see [`allow_negative_numbers`]) so that they reach these checks
 //! instead of clap's "unexpected argument" with its misleading `-- -1` tip.
+
+use rtoracle::oracle::profile::{Judging, Precision, Profile};
 
 /// An integer in `LO..=HI`.
 pub fn int_in<const LO: u64, const HI: u64>(s: &str) -> Result<u64, String> {
@@ -105,6 +108,35 @@ pub fn seconds(s: &str) -> Result<f64, String> {
 pub fn allow_negative_numbers(cmd: clap::Command) -> clap::Command {
     cmd.allow_negative_numbers(true)
         .mut_subcommands(allow_negative_numbers)
+}
+
+/// `--profile` and `--precision` (shared by `check`, `fuzz`, `vectors` and `explain`).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct JudgingArgs {
+    /// Whose formulas draw the line between definite and ambiguous: `course` (the course's
+    /// naive formulas; the default) or `robust` (the reference's robust formulas: finds the
+    /// precision bugs of naive code).
+    #[arg(long, value_name = "course|robust")]
+    pub profile: Option<Profile>,
+    /// The precision the candidate computes in: `f64` (the default) or `f32` (inputs rounded to
+    /// f32, bands and tolerances of f32 arithmetic).
+    #[arg(long, value_name = "f64|f32")]
+    pub precision: Option<Precision>,
+}
+
+impl JudgingArgs {
+    /// The judging, with `default` for an absent `--profile`.
+    pub fn judging(&self, default: Profile) -> Judging {
+        Judging::new(
+            self.profile.unwrap_or(default),
+            self.precision.unwrap_or_default(),
+        )
+    }
+
+    /// Whether either flag was given.
+    pub fn given(&self) -> bool {
+        self.profile.is_some() || self.precision.is_some()
+    }
 }
 
 #[cfg(test)]

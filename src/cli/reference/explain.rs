@@ -2,11 +2,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::oracle::Profile;
 use rtoracle::oracle::explain::explain_with;
 use rtoracle::oracle::generate::CAMERA;
+use rtoracle::oracle::profile::Profile;
 use rtoracle::oracle::vectors::{Case, RaySpec, ShapeSpec, read_vectors};
-use rtoracle::oracle::{classify_with, default_suite_with};
+use rtoracle::oracle::{classify::classify_with, suite::default_suite_with};
 
 /// `rtoracle explain (ID | 'JSON') [--seed S] [--vectors FILE]`
 #[derive(Debug, clap::Args)]
@@ -16,13 +16,13 @@ pub struct Args {
     /// camera's `(1e-6, f64::MAX)`).
     case: String,
     /// Seed of the default suite the id refers to.
-    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = crate::cli::args::seed)]
     seed: u64,
     /// A vector file the id refers to instead of the default suite.
     #[arg(long, value_name = "FILE")]
     vectors: Option<PathBuf>,
     #[command(flatten)]
-    judging: super::check::JudgingArgs,
+    judging: crate::cli::args::JudgingArgs,
 }
 
 #[derive(serde::Deserialize)]

@@ -9,7 +9,7 @@ use rtoracle::candidate::process::options::RunOptions;
 use rtoracle::physics::check_candidate_materials;
 use rtoracle::physics::{Family, MaterialCase, MaterialOptions, default_materials};
 
-use super::check::{SandboxArgs, Target};
+use crate::cli::checking::check::{SandboxArgs, Target};
 
 /// `rtoracle physics (--adapter 'CMD ARGS' | --python-course DIR) [--material JSON]...`
 #[derive(Debug, clap::Args)]
@@ -29,16 +29,16 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = rtoracle::physics::DEFAULT_SAMPLES, value_parser = samples)]
     samples: usize,
     /// Seeds the normals, the outgoing directions and the random numbers sent.
-    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = crate::cli::args::seed)]
     seed: u64,
     /// The false-alarm rate of the whole run (shared by its statistical tests).
-    #[arg(long, value_name = "P", default_value_t = rtoracle::weekly::stats::DEFAULT_ALPHA, value_parser = super::num::alpha)]
+    #[arg(long, value_name = "P", default_value_t = rtoracle::weekly::stats::DEFAULT_ALPHA, value_parser = crate::cli::args::alpha)]
     alpha: f64,
     /// Time allowed per request, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 20_000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "N", default_value_t = 20_000, value_parser = crate::cli::args::millis)]
     timeout_ms: u64,
     /// Time allowed for the candidate to start and answer the hello, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = crate::cli::args::millis)]
     hello_timeout_ms: u64,
     /// Print the report as one JSON object.
     #[arg(long)]
@@ -61,17 +61,17 @@ pub struct Args {
 
 /// Samples per pixel of a furnace render: 1 to 4096.
 fn furnace_spp(s: &str) -> Result<u32, String> {
-    super::num::int_in::<1, 4096>(s).map(|n| n as u32)
+    crate::cli::args::int_in::<1, 4096>(s).map(|n| n as u32)
 }
 
 /// Renders per furnace: 2 to 64.
 fn renders(s: &str) -> Result<usize, String> {
-    super::num::int_in::<2, 64>(s).map(|n| n as usize)
+    crate::cli::args::int_in::<2, 64>(s).map(|n| n as usize)
 }
 
 /// Samples per direction: 100 to 1,000,000.
 fn samples(s: &str) -> Result<usize, String> {
-    super::num::int_in::<100, 1_000_000>(s).map(|n| n as usize)
+    crate::cli::args::int_in::<100, 1_000_000>(s).map(|n| n as usize)
 }
 
 /// A material given on the command line: a JSON object with a string "type".
@@ -115,7 +115,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // submission (week 9's sampling from week 9 on), the book's for any other renderer.
     let family = match &args.target.python_course {
         Some(dir) => {
-            let week = rtoracle::weekly::detect(dir).week.map_or(9, |w| w.number());
+            let week = rtoracle::weekly::week::detect(dir)
+                .week
+                .map_or(9, |w| w.number());
             Family::Course { cosine: week >= 9 }
         }
         None => Family::Book,
@@ -131,7 +133,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         samples: args.samples,
         alpha: args.alpha,
     };
-    rtoracle::sandbox::announce_on_stderr();
+    rtoracle::sandbox::facts::announce_on_stderr();
     let report = check_candidate_materials(command, run, &cases, options, Some(family))
         .context("physics")?;
     verdict(args.json, &report, report.to_text(), report.passed())
@@ -162,7 +164,7 @@ fn furnace(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         let command = args.target.command(&args.sandbox)?;
         let run = run_options(&args);
-        rtoracle::sandbox::announce_on_stderr();
+        rtoracle::sandbox::facts::announce_on_stderr();
         let mut session = rtoracle::candidate::process::session::Session::start(command, run)
             .context("physics")?;
         let mut renderer =
@@ -197,5 +199,5 @@ fn verdict(
     } else {
         out!("{text}")?;
     }
-    Ok(ExitCode::from(if passed { 0 } else { super::FAILED }))
+    Ok(ExitCode::from(if passed { 0 } else { crate::cli::FAILED }))
 }

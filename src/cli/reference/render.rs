@@ -16,16 +16,16 @@ pub struct Args {
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's, 20 for the course scenes).
-    #[arg(long, value_name = "N", value_parser = super::num::spp)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::args::spp)]
     spp: Option<u32>,
     /// Seed of the per-pixel random streams.
-    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = crate::cli::args::seed)]
     seed: u64,
     /// Image width in pixels (the height follows the scene's aspect ratio).
-    #[arg(long, value_name = "W", value_parser = super::num::width)]
+    #[arg(long, value_name = "W", value_parser = crate::cli::args::width)]
     width: Option<usize>,
     /// Worker threads (default: all cores). The image is the same for any count.
-    #[arg(long, value_name = "T", value_parser = super::num::threads)]
+    #[arg(long, value_name = "T", value_parser = crate::cli::args::threads)]
     threads: Option<usize>,
     /// Render by these rules instead of the scene's own: `course` (what the course's code of
     /// the scene's week computes) or `physical` (as Ray Tracing in One Weekend computes it).

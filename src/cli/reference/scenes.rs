@@ -15,7 +15,7 @@ pub struct Args {
     textures: Option<PathBuf>,
     /// With --dump or --export: the scene under this profile (course or physical) instead of its
     /// own.
-    #[arg(long, value_name = "P", value_parser = super::render::parse_profile)]
+    #[arg(long, value_name = "P", value_parser = crate::cli::reference::render::parse_profile)]
     profile: Option<rtoracle::scene::Profile>,
     /// Print the scene NAME (built-in, or a .toml scene file) for another renderer instead:
     /// `mitsuba` (a Mitsuba 3 scene file, where the two share the physics;
@@ -41,8 +41,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--profile is for --dump NAME or --export FORMAT NAME");
     }
     if let Some(name) = &args.name {
-        let (_, description) = super::render::load_scene_with(name, None)?;
-        let description = super::render::with_profile(name, description, args.profile)?;
+        let (_, description) = crate::cli::reference::render::load_scene_with(name, None)?;
+        let description =
+            crate::cli::reference::render::with_profile(name, description, args.profile)?;
         let xml = rtoracle::scene::to_mitsuba_xml(&description)
             .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
         out!("{xml}")?;
@@ -58,7 +59,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 None => TextureSource::Generated,
             };
             let description = rtoracle::scene::builtin_with_textures(&name, &source)?;
-            let description = super::render::with_profile(&name, description, args.profile)?;
+            let description =
+                crate::cli::reference::render::with_profile(&name, description, args.profile)?;
             out!("{}", description.to_toml())?
         }
         None => {

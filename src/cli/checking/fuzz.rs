@@ -24,27 +24,27 @@ const MIN_TIME_SECS: f64 = 1e-3;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    target: super::check::Target,
+    target: crate::cli::checking::check::Target,
     #[command(flatten)]
-    judging: super::check::JudgingArgs,
+    judging: crate::cli::args::JudgingArgs,
     #[command(flatten)]
-    sandbox: super::check::SandboxArgs,
+    sandbox: crate::cli::checking::check::SandboxArgs,
     /// How many random cases to run (default 10000 when --time is not given; with both,
     /// whichever comes first).
-    #[arg(long, value_name = "N", value_parser = super::num::count)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::args::count)]
     cases: Option<usize>,
     /// Seed of the generator.
-    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = crate::cli::args::seed)]
     seed: u64,
     /// Run for this many seconds (checked between rounds of 1000 cases; shrinking what was
     /// found takes a tenth of it more, at least 0.2 s and at most 5 s).
-    #[arg(long, value_name = "SECS", value_parser = super::num::seconds)]
+    #[arg(long, value_name = "SECS", value_parser = crate::cli::args::seconds)]
     time: Option<f64>,
     /// Time allowed per case, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = crate::cli::args::millis)]
     timeout_ms: u64,
     /// Time allowed for the candidate to start and answer the hello, in milliseconds.
-    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = super::num::millis)]
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = crate::cli::args::millis)]
     hello_timeout_ms: u64,
     /// Print the report as JSON.
     #[arg(long)]
@@ -90,7 +90,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         limits: args.sandbox.policy(),
         ..RunOptions::default()
     };
-    rtoracle::sandbox::announce_on_stderr();
+    rtoracle::sandbox::facts::announce_on_stderr();
     let command = args.target.command(&args.sandbox)?;
     let mut session = Session::start(command, options).context("fuzz")?;
     if let Some(e) = &session.hello().error {
@@ -165,7 +165,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::from(if report.failed == 0 {
         0
     } else {
-        super::FAILED
+        crate::cli::FAILED
     }))
 }
 

@@ -2,8 +2,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use rtoracle::oracle::Profile;
 use rtoracle::oracle::generate::generate_with;
+use rtoracle::oracle::profile::Profile;
 use rtoracle::oracle::suite::{DEFAULT_COUNT, suite_with};
 use rtoracle::oracle::vectors::{SCHEMA_VERSION, ShapeKind};
 use rtoracle::output::OutputFile;
@@ -12,16 +12,16 @@ use rtoracle::output::OutputFile;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Seed of the generators: the same seed gives the same bytes.
-    #[arg(long, value_name = "S", default_value_t = 0, value_parser = super::num::seed)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = crate::cli::args::seed)]
     seed: u64,
     /// Number of generated vectors (the default suite has 4000).
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_COUNT, value_parser = super::num::count)]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_COUNT, value_parser = crate::cli::args::count)]
     count: usize,
     /// Comma-separated shapes to generate.
     #[arg(long, value_name = "LIST", default_value = "sphere,quad,triangle")]
     shapes: String,
     #[command(flatten)]
-    judging: super::check::JudgingArgs,
+    judging: crate::cli::args::JudgingArgs,
     /// Add the watertight groups of the shapes asked for after the generated vectors, as the
     /// built-in suite of `check` has them (`--count 4000 --watertight` is that suite).
     #[arg(long)]
