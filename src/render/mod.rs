@@ -25,13 +25,12 @@ mod renderer;
 mod stats;
 
 pub use brdf::{blinn, cook_torrance, ggx, halfvector, phong, smith_g1};
+pub use fast::vector_instructions;
 pub use film::{Film, encode_book_png, encode_course_png};
 pub use integrator::{occluded, radiance, sky, trace};
 pub use job::PixelJitter;
 pub use optics::{Onb, reflect, refract_or_reflect, refracted, schlick};
-pub use renderer::{
-    CourseJitter, RenderError, RenderOptions, render, samples_taken, vector_instructions,
-};
+pub use renderer::{CourseJitter, RenderError, RenderOptions, render, samples_taken};
 pub use sampler::PixelSampler;
 pub use scatter::{cosine_about, normal_plus_unit};
 pub use surface::sphere_uv;

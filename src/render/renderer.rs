@@ -3,8 +3,7 @@ use std::io::IsTerminal;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-#[cfg(target_arch = "x86_64")]
-use super::fast::lanes;
+use super::fast;
 use super::fast::pinhole::Pinhole;
 use super::job::{Job, Moments, PixelJitter, Spread, Trace};
 use super::{Film, PixelSampler, trace};
@@ -66,10 +65,8 @@ impl Trace for World {
     ) {
         let width = job.camera.width;
         let world = job.tracer;
-        #[cfg(target_arch = "x86_64")]
-        if let Some(set) = lanes::takes_lanes(world) {
-            // SAFETY: `takes_lanes` checked that the processor has AVX2.
-            return unsafe { lanes::row::<VARIANCE, JITTER>(job, set, j, means, variances) };
+        if fast::lanes_row::<VARIANCE, JITTER>(job, j, means, variances) {
+            return;
         }
         for (i, mean) in means.iter_mut().enumerate() {
             let mut sampler = PixelSampler::new(job.seed, (j * width + i) as u64);
@@ -149,23 +146,6 @@ fn takes_the_fast_path(world: &World, camera: &Camera) -> bool {
             .materials
             .iter()
             .any(|m| matches!(m, Material::Textured { .. }))
-}
-
-/// The vector instructions the renderer's fast path runs with on this processor: `"AVX2"` (four
-/// `f64` lanes per instruction) where it has them, else the target's baseline (`"SSE2"` on
-/// x86-64, two lanes). The film is the same either way.
-pub fn vector_instructions() -> &'static str {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        return "AVX2";
-    }
-    if cfg!(target_arch = "x86_64") {
-        "SSE2"
-    } else if cfg!(target_arch = "aarch64") {
-        "NEON"
-    } else {
-        "the target's baseline"
-    }
 }
 
 /// Renders every pixel of `camera` over `world`.

@@ -1,7 +1,7 @@
 //! The two queries of a [`ShapeSet`] (the closest hit, the course's occlusion test) for four
 //! rays at once, on x86-64 with AVX2 ([`ShapeSet::closest_lanes`], and
 //! [`ShapeSet::shadowed_lanes`] for shadow rays to a point light): the renderer's lanes of
-//! paths ask them.
+//! paths ask them. The whole file is x86-64 only (its parent declares it so, once).
 //!
 //! It promises, lane by lane, the scalar set's answers, so [`Scene::closest`]'s and
 //! [`Scene::count_hits`]'s, bit for bit; where a lane's sphere arithmetic over- or underflows, it
@@ -29,76 +29,17 @@
 //! [`Scene::closest`]: crate::scene::Scene::closest
 //! [`Scene::count_hits`]: crate::scene::Scene::count_hits
 
-use glam::DVec3;
-
-#[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-#[cfg(target_arch = "x86_64")]
+use glam::DVec3;
+
+use super::{LANES, RayLanes};
 use crate::geometry::{Interval, PARALLEL_EPSILON, Quad};
-#[cfg(target_arch = "x86_64")]
-use crate::scene::accel::shape_set::{Ball, Member, ShapeSet};
 use crate::scene::accel::shape_set::{
-    LEAVING_MIN, LEAVING_SLOPE, PREFILTER_MARGIN, PREFILTER_RANGE,
+    Ball, LEAVING_MIN, LEAVING_SLOPE, Member, PREFILTER_MARGIN, PREFILTER_RANGE, ShapeSet,
 };
 
-/// How many rays [`ShapeSet::closest_lanes`] and [`ShapeSet::shadowed_lanes`] take at once:
-/// four `f64` lanes, one AVX2 vector.
-pub(crate) const LANES: usize = 4;
-
-/// Up to [`LANES`] rays side by side (origins, directions and times), for the lanes queries. A
-/// lane that is not `active` is ignored.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct RayLanes {
-    ox: [f64; LANES],
-    oy: [f64; LANES],
-    oz: [f64; LANES],
-    dx: [f64; LANES],
-    dy: [f64; LANES],
-    dz: [f64; LANES],
-    time: [f64; LANES],
-    active: [u64; LANES],
-}
-
-impl RayLanes {
-    /// Puts the ray from `origin` along `direction` at `time` in lane `k`.
-    #[inline(always)]
-    pub(crate) fn set(&mut self, k: usize, origin: DVec3, direction: DVec3, time: f64) {
-        (self.ox[k], self.oy[k], self.oz[k]) = (origin.x, origin.y, origin.z);
-        (self.dx[k], self.dy[k], self.dz[k]) = (direction.x, direction.y, direction.z);
-        self.time[k] = time;
-        self.active[k] = u64::MAX;
-    }
-}
-
-/// Whether this processor runs the lanes queries ([`ShapeSet::closest_lanes`],
-/// [`ShapeSet::shadowed_lanes`]): an x86-64 with AVX2. Elsewhere the renderer traces one ray at
-/// a time, to the same film.
-#[inline]
-pub(crate) fn has_lanes() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-/// For the tests of the lanes: whether this processor has none (no AVX2), in which case it says
-/// so on stderr, with `what` the test would have checked, so that `cargo test` shows the skip.
-#[cfg(test)]
-pub(crate) fn skipped_without_lanes(what: &str) -> bool {
-    let skipped = !has_lanes();
-    if skipped {
-        eprintln!("skipped: this processor has no AVX2, so {what}");
-    }
-    skipped
-}
-
 /// Three coordinates, one vector each.
-#[cfg(target_arch = "x86_64")]
 type Vec3Lanes = [__m256d; 3];
 
 /// `u . v` lane by lane, in glam's order `(x x' + y y') + z z'`.
@@ -106,7 +47,6 @@ type Vec3Lanes = [__m256d; 3];
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn dot(u: Vec3Lanes, v: Vec3Lanes) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
@@ -123,7 +63,6 @@ unsafe fn dot(u: Vec3Lanes, v: Vec3Lanes) -> __m256d {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn finite(x: __m256d) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
@@ -138,7 +77,6 @@ unsafe fn finite(x: __m256d) -> __m256d {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) unsafe fn splat(x: f64) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
@@ -150,7 +88,6 @@ pub(crate) unsafe fn splat(x: f64) -> __m256d {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn splat3(v: DVec3) -> Vec3Lanes {
     // SAFETY: AVX2 is there (this function's contract).
@@ -163,7 +100,6 @@ unsafe fn splat3(v: DVec3) -> Vec3Lanes {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn cross(a: Vec3Lanes, b: Vec3Lanes) -> Vec3Lanes {
     // SAFETY: AVX2 is there (this function's contract).
@@ -181,7 +117,6 @@ unsafe fn cross(a: Vec3Lanes, b: Vec3Lanes) -> Vec3Lanes {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) unsafe fn between<const OPEN: bool>(lo: __m256d, x: __m256d, hi: __m256d) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
@@ -205,7 +140,6 @@ pub(crate) unsafe fn between<const OPEN: bool>(lo: __m256d, x: __m256d, hi: __m2
 /// `a PREFILTER_MARGIN`, where `a` is sane for `roots_of` (`a.is_normal() && a < 1e300`, which
 /// for a sum of squares is `MIN_POSITIVE <= a < 1e300`: false for 0, subnormals, infinity and
 /// NaN alike) and where it lies in the pre-filter's range.
-#[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy)]
 struct Loaded {
     origin: Vec3Lanes,
@@ -217,7 +151,6 @@ struct Loaded {
     a_in_range: __m256d,
 }
 
-#[cfg(target_arch = "x86_64")]
 impl Loaded {
     /// `rays`, loaded.
     ///
@@ -249,7 +182,6 @@ impl Loaded {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
 impl RayLanes {
     /// Each lane's `d.y / |d|`, the `y` of its direction's unit vector, with the scalar
     /// `direction.y / direction.length()`'s operations (`|d| = sqrt((x x + y y) + z z)`, each
@@ -285,7 +217,6 @@ impl RayLanes {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn lanes_of(x: &[f64; LANES]) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract); each read is of an element of `x`,
@@ -302,7 +233,6 @@ unsafe fn lanes_of(x: &[f64; LANES]) -> __m256d {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn mask(x: &[u64; LANES]) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract); each read is of an element of `x`,
@@ -325,7 +255,6 @@ unsafe fn mask(x: &[u64; LANES]) -> __m256d {
 /// # Safety
 ///
 /// The processor must have AVX2 (the caller checked [`has_lanes`]).
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn ball_lanes(
     center: Vec3Lanes,
@@ -417,7 +346,6 @@ unsafe fn ball_lanes(
 /// # Safety
 ///
 /// The processor must have AVX2 (the caller checked [`has_lanes`]).
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn aimed_ball_lanes(
     ball: &Ball,
@@ -455,7 +383,6 @@ unsafe fn aimed_ball_lanes(
 
 /// One sphere's parts for the lanes' rays: `f = o - center`, `a = d . d`, `b' = f . d`,
 /// `r^2` and `c = f . f - r^2`.
-#[cfg(target_arch = "x86_64")]
 struct Parts {
     f: Vec3Lanes,
     a: __m256d,
@@ -471,7 +398,6 @@ struct Parts {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn roots_lanes(
     parts: &Parts,
@@ -548,7 +474,6 @@ unsafe fn roots_lanes(
 /// # Safety
 ///
 /// The processor must have AVX2 (the caller checked [`has_lanes`]).
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn quad_lanes(
     quad: &Quad,
@@ -609,7 +534,6 @@ unsafe fn quad_lanes(
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn member_lanes(
     member: &Member,
@@ -641,7 +565,6 @@ unsafe fn member_lanes(
     }
 }
 
-#[cfg(target_arch = "x86_64")]
 impl ShapeSet {
     /// [`ShapeSet::closest`] for each active lane of `rays` at once: lane `k`'s closest hit in
     /// `interval`, or `Err(())` where the lane's ray must be decided by the scalar path (over-
@@ -813,7 +736,6 @@ impl ShapeSet {
 }
 
 #[cfg(test)]
-#[cfg(target_arch = "x86_64")]
 mod tests {
     use super::*;
     use crate::geometry::Ray;
@@ -827,7 +749,7 @@ mod tests {
     /// occlusion (on its own reach) is the scene's count above one.
     #[test]
     fn lanes_answer_as_the_scene_loop_does() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(29, 7);
@@ -898,7 +820,7 @@ mod tests {
     /// loop's.
     #[test]
     fn quads_at_the_ends_of_the_interval_and_nearly_parallel_rays() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let c = DVec3::new;
@@ -972,7 +894,7 @@ mod tests {
     /// finite roots, so a lane that took them would answer where the scalar set does not.
     #[test]
     fn rays_at_the_edges_of_a_sane_length_are_handed_back_as_the_scalar_set_does() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let scene = Scene {
@@ -1029,7 +951,7 @@ mod tests {
     /// square under- or overflows (a `y` of 0 over an infinite length), infinite components.
     #[test]
     fn unit_y_is_the_scalar_unit_vectors_y_bit_for_bit() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(11, 4);
@@ -1084,7 +1006,7 @@ mod tests {
     /// are answered.
     #[test]
     fn an_overflowing_lane_is_handed_back_alone() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(3, 1);
@@ -1117,7 +1039,7 @@ mod tests {
     /// the three, and with the two hit objects aimed at or not.
     #[test]
     fn a_lane_that_met_two_objects_is_dark_whatever_overflows_after() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let ball = |center: DVec3, r: f64| crate::scene::SceneObject {
@@ -1172,7 +1094,7 @@ mod tests {
     /// inside and outside the aimed sphere's sure case occur.
     #[test]
     fn shadow_rays_to_a_light_answer_as_the_scene_loop_does() {
-        if skipped_without_lanes("there are no lanes to check") {
+        if super::super::skipped_without_lanes("there are no lanes to check") {
             return;
         }
         let mut s = PixelSampler::new(53, 4);
