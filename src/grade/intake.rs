@@ -65,9 +65,75 @@ fn kind_of(t: &FileType) -> &'static str {
     }
 }
 
+/// What went wrong reading a file of a submission: each says which file (as the submission
+/// names it) and what is wrong with it, in a sentence the student reads.
+#[derive(Debug, thiserror::Error)]
+pub enum IntakeError {
+    /// The path leaves the submission (absolute, or through `..`).
+    #[error("{shown} is outside the submission")]
+    Outside {
+        /// The file, as the rubric names it.
+        shown: String,
+    },
+    /// A folder on the way is something else (a file, a symbolic link, ...).
+    #[error("{shown} is {kind}, not a folder")]
+    NotAFolder {
+        /// The folder, relative to the submission.
+        shown: String,
+        /// What it is instead ("a symbolic link", "a regular file", ...).
+        kind: &'static str,
+    },
+    /// There is no such file.
+    #[error("{shown} is missing from the submission")]
+    Missing {
+        /// The file.
+        shown: String,
+    },
+    /// It is not a regular file (a FIFO, a socket, a device, a folder or a symbolic link).
+    #[error("{shown} is {kind}, not a regular file")]
+    NotRegular {
+        /// The file.
+        shown: String,
+        /// What it is instead.
+        kind: &'static str,
+    },
+    /// It is larger than the cap (known before reading, or found while reading).
+    #[error("{shown} is {}, over the limit of {cap} bytes", size_words(*.len, *.cap))]
+    TooLarge {
+        /// The file.
+        shown: String,
+        /// Its size in bytes; `None` when it grew past the cap while being read.
+        len: Option<u64>,
+        /// The cap, in bytes.
+        cap: u64,
+    },
+    /// It was replaced between the look and the open.
+    #[error("{shown} changed while it was being read")]
+    Changed {
+        /// The file.
+        shown: String,
+    },
+    /// The system refused to read it.
+    #[error("{shown} cannot be read ({kind})")]
+    Unreadable {
+        /// The file.
+        shown: String,
+        /// Why, as the system says.
+        kind: std::io::ErrorKind,
+    },
+}
+
+/// "N bytes", or "more than CAP bytes" for a file that grew past the cap while being read.
+fn size_words(len: Option<u64>, cap: u64) -> String {
+    match len {
+        Some(len) => format!("{len} bytes"),
+        None => format!("more than {cap} bytes"),
+    }
+}
+
 /// `rel` under `root`, refusing absolute paths, `..`, and folders on the way that are symbolic
 /// links or not folders. `rel` names the file in messages.
-fn inside(root: &Path, rel: &str) -> Result<PathBuf, String> {
+fn inside(root: &Path, rel: &str) -> Result<PathBuf, IntakeError> {
     let rel_path = Path::new(rel);
     let mut path = root.to_path_buf();
     let parts: Vec<Component> = rel_path.components().collect();
@@ -75,19 +141,19 @@ fn inside(root: &Path, rel: &str) -> Result<PathBuf, String> {
         match part {
             Component::Normal(name) => path.push(name),
             Component::CurDir => continue,
-            _ => return Err(format!("{rel} is outside the submission")),
+            _ => return Err(IntakeError::Outside { shown: rel.into() }),
         }
         if i + 1 < parts.len() {
             match std::fs::symlink_metadata(&path) {
                 Ok(m) if m.is_dir() => {}
                 Ok(m) => {
                     let shown = path.strip_prefix(root).unwrap_or(&path).display();
-                    return Err(format!(
-                        "{shown} is {}, not a folder",
-                        kind_of(&m.file_type())
-                    ));
+                    return Err(IntakeError::NotAFolder {
+                        shown: shown.to_string(),
+                        kind: kind_of(&m.file_type()),
+                    });
                 }
-                Err(_) => return Err(format!("{rel} is missing from the submission")),
+                Err(_) => return Err(IntakeError::Missing { shown: rel.into() }),
             }
         }
     }
@@ -96,21 +162,31 @@ fn inside(root: &Path, rel: &str) -> Result<PathBuf, String> {
 
 /// Opens `path` only if it is a regular file of at most `cap` bytes (see the module's
 /// promises); `shown` names it in the error.
-pub fn open_regular(path: &Path, shown: &str, cap: u64) -> Result<(File, Metadata), String> {
+pub fn open_regular(path: &Path, shown: &str, cap: u64) -> Result<(File, Metadata), IntakeError> {
+    let unreadable = |e: std::io::Error| IntakeError::Unreadable {
+        shown: shown.into(),
+        kind: e.kind(),
+    };
     let before = std::fs::symlink_metadata(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
-            format!("{shown} is missing from the submission")
+            IntakeError::Missing {
+                shown: shown.into(),
+            }
         } else {
-            format!("{shown} cannot be read ({})", e.kind())
+            unreadable(e)
         }
     })?;
     if !before.file_type().is_file() {
-        return Err(format!(
-            "{shown} is {}, not a regular file",
-            kind_of(&before.file_type())
-        ));
+        return Err(IntakeError::NotRegular {
+            shown: shown.into(),
+            kind: kind_of(&before.file_type()),
+        });
     }
-    let over = |len: u64| format!("{shown} is {len} bytes, over the limit of {cap} bytes");
+    let over = |len: u64| IntakeError::TooLarge {
+        shown: shown.into(),
+        len: Some(len),
+        cap,
+    };
     if before.len() > cap {
         return Err(over(before.len()));
     }
@@ -120,16 +196,19 @@ pub fn open_regular(path: &Path, shown: &str, cap: u64) -> Result<(File, Metadat
         .open(path)
         .map_err(|e| {
             if e.raw_os_error() == Some(libc::ELOOP) {
-                format!("{shown} is a symbolic link, not a regular file")
+                IntakeError::NotRegular {
+                    shown: shown.into(),
+                    kind: "a symbolic link",
+                }
             } else {
-                format!("{shown} cannot be read ({})", e.kind())
+                unreadable(e)
             }
         })?;
-    let after = file
-        .metadata()
-        .map_err(|e| format!("{shown} cannot be read ({})", e.kind()))?;
+    let after = file.metadata().map_err(unreadable)?;
     if !after.file_type().is_file() || (after.dev(), after.ino()) != (before.dev(), before.ino()) {
-        return Err(format!("{shown} changed while it was being read"));
+        return Err(IntakeError::Changed {
+            shown: shown.into(),
+        });
     }
     if after.len() > cap {
         return Err(over(after.len()));
@@ -138,16 +217,21 @@ pub fn open_regular(path: &Path, shown: &str, cap: u64) -> Result<(File, Metadat
 }
 
 /// The bytes of the regular file `path`, at most `cap` of them (an error past it).
-pub fn read_regular(path: &Path, shown: &str, cap: u64) -> Result<Vec<u8>, String> {
+pub fn read_regular(path: &Path, shown: &str, cap: u64) -> Result<Vec<u8>, IntakeError> {
     let (file, meta) = open_regular(path, shown, cap)?;
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     file.take(cap + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("{shown} cannot be read ({})", e.kind()))?;
+        .map_err(|e| IntakeError::Unreadable {
+            shown: shown.into(),
+            kind: e.kind(),
+        })?;
     if bytes.len() as u64 > cap {
-        return Err(format!(
-            "{shown} is more than {cap} bytes, over the limit of {cap} bytes"
-        ));
+        return Err(IntakeError::TooLarge {
+            shown: shown.into(),
+            len: None,
+            cap,
+        });
     }
     Ok(bytes)
 }
@@ -277,8 +361,8 @@ pub fn stage_image(
     expected: Option<(usize, usize)>,
     stage_dir: &Path,
 ) -> Result<PathBuf, String> {
-    let path = inside(submission, rel)?;
-    let bytes = read_regular(&path, rel, MAX_IMAGE_BYTES)?;
+    let path = inside(submission, rel).map_err(|e| e.to_string())?;
+    let bytes = read_regular(&path, rel, MAX_IMAGE_BYTES).map_err(|e| e.to_string())?;
     check_image_header(rel, &bytes, expected)?;
     let name = path.file_name().unwrap_or_else(|| "image".as_ref());
     let staged = stage_dir.join(name);
@@ -320,16 +404,11 @@ pub fn submission_hashes(dir: &Path) -> BTreeMap<String, String> {
                 total += bytes.len() as u64;
                 sha256_hex(&bytes)
             }
-            Err(why) => {
-                let size = std::fs::symlink_metadata(&path).map_or(0, |m| m.len());
-                if size > cap {
-                    format!(
-                        "not hashed: {size} bytes, over the cap ({HASH_FILE_CAP} per file, {HASH_TOTAL_CAP} in all)"
-                    )
-                } else {
-                    format!("not hashed: {why}")
-                }
-            }
+            Err(IntakeError::TooLarge { len, .. }) => format!(
+                "not hashed: {}, over the cap ({HASH_FILE_CAP} per file, {HASH_TOTAL_CAP} in all)",
+                size_words(len, cap)
+            ),
+            Err(why) => format!("not hashed: {why}"),
         };
         out.insert(name, value);
     }
@@ -361,7 +440,11 @@ mod tests {
         let _sock = std::os::unix::net::UnixListener::bind(d.join("sock.png")).unwrap();
         std::fs::create_dir(d.join("dir.png")).unwrap();
         let start = Instant::now();
-        let err = |name: &str| read_regular(&d.join(name), name, 100).unwrap_err();
+        let err = |name: &str| {
+            read_regular(&d.join(name), name, 100)
+                .unwrap_err()
+                .to_string()
+        };
         assert_eq!(
             err("week04_sphere.png"),
             "week04_sphere.png is a FIFO, not a regular file"
@@ -411,8 +494,15 @@ mod tests {
         assert_eq!(hashes["RT_object.py"], sha256_hex(b"x = 1\n"));
         assert!(!hashes.contains_key("link.py"), "{hashes:?}");
         let e = read_regular(&dir.path().join("big.bin"), "big.bin", MAX_IMAGE_BYTES).unwrap_err();
-        assert_eq!(
+        assert!(matches!(
             e,
+            IntakeError::TooLarge {
+                len: Some(4294967296),
+                ..
+            }
+        ));
+        assert_eq!(
+            e.to_string(),
             format!("big.bin is 4294967296 bytes, over the limit of {MAX_IMAGE_BYTES} bytes")
         );
     }
