@@ -289,6 +289,48 @@ fn the_files_the_architecture_page_points_to_exist() {
     );
 }
 
+/// Every source path the docs name (`src/...` in README.md and docs/*.md) is there: a move
+/// that leaves a page pointing at nothing fails here.
+#[test]
+fn every_source_path_the_docs_name_exists() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut pages = vec![root.join("README.md")];
+    for entry in std::fs::read_dir(root.join("docs")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "md") {
+            pages.push(path);
+        }
+    }
+    let mut missing = vec![];
+    let mut named = 0;
+    for page in &pages {
+        let text = std::fs::read_to_string(page).unwrap();
+        let bytes = text.as_bytes();
+        let mut from = 0;
+        while let Some(i) = text[from..].find("src/").map(|i| from + i) {
+            from = i + 4;
+            let starts_a_path = i == 0
+                || !(bytes[i - 1].is_ascii_alphanumeric() || b"_/.-".contains(&bytes[i - 1]));
+            if !starts_a_path {
+                continue;
+            }
+            let end = text[i..]
+                .find(|c: char| !(c.is_ascii_alphanumeric() || "_/.".contains(c)))
+                .map_or(text.len(), |e| i + e);
+            let path = text[i..end].trim_end_matches(['.', '/']);
+            named += 1;
+            if !root.join(path).exists() {
+                missing.push(format!("{} names {path}", page.display()));
+            }
+        }
+    }
+    assert!(
+        named >= 40,
+        "only {named} paths found: the scanner lost them"
+    );
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
+}
+
 #[test]
 fn the_floors_name_every_module_once() {
     let mut seen = BTreeSet::new();
