@@ -121,7 +121,7 @@ pub(crate) fn spawn_killed_on_interrupt(
     let child = command
         .process_group(0)
         .spawn()
-        .with_context(|| format!("cannot start {command:?}"))?;
+        .with_context(|| format!("cannot start {}", command.get_program().to_string_lossy()))?;
     let pid = child.id() as libc::pid_t;
     let kill = rtoracle::interrupt::on_interrupt(move || {
         // SAFETY: kill(2) on our own child's process group; at worst the child has exited

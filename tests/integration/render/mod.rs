@@ -1066,6 +1066,15 @@ fn bench_render_finds_the_c_loops_films_the_same_bit_for_bit() {
             && stdout.contains("goal: ahead of Mitsuba's scalar_rgb: not measured"),
         "{stdout}"
     );
+    // The reason names the program, not the embedded timer's whole source.
+    let skipped = stdout
+        .lines()
+        .find(|l| l.starts_with("against Mitsuba 3"))
+        .unwrap();
+    assert!(
+        skipped.contains("cannot start /nonexistent/python: ") && skipped.len() < 300,
+        "{skipped}"
+    );
     for scene in scenes {
         let row = stdout
             .lines()
