@@ -7,7 +7,7 @@
 //! A short tour, bottom floor first (a module uses only the ones above it in this list):
 //! - [`arithmetic`]: outward-rounded intervals, exact dyadic rationals and the exact decisions
 //!   of a ray against the three primitives, shared by the reference and the oracle.
-//! - [`escape`]: untrusted text kept as text in every format (terminal, Markdown, HTML, CSV).
+//! - [`escape`]: untrusted text kept as text in every format (terminal, Markdown, HTML, CSV, XML).
 //! - [`interrupt`]: Ctrl-C and SIGTERM clean up what was started or half-written.
 //! - [`secret`]: the seeds a candidate sees, derived from the rubric's secret by HMAC-SHA256.
 //! - [`output`]: output files and folders checked before the work, written whole or not at all.

@@ -12,15 +12,16 @@
 //! code by default ([`checkers::rendered`]): the code checker renders, the image checker judges
 //! the render.
 //!
-//! Four rooms, and the single-submission path on top:
+//! Rooms, bottom floor first, and the single-submission path on top:
 //!
-//! - [`rubric`]: the [`Rubric`](rubric::Rubric) (built-in weeks in [`rubric::weeks`], TOML files), partial
-//!   credit ([`rubric::credit`]) and the points of each group ([`score`]).
+//! - [`rubric`]: the [`Rubric`](rubric::Rubric) (built-in weeks in [`rubric::weeks`], TOML
+//!   files) and partial credit ([`rubric::credit`]).
 //! - [`checkers`]: the two interfaces and their real implementations: the course's code through
-//!   the `check` harness ([`checkers::code`]), the weekly function checks
-//!   (`score::weekly`), images against their reference ([`checkers::images`]), renders
-//!   asked of the submission's own code ([`checkers::rendered`], [`checkers::noise_floor`]) and
-//!   copied images ([`checkers::copies`]).
+//!   the `check` harness ([`checkers::code`]), images against their reference
+//!   ([`checkers::images`]), renders asked of the submission's own code ([`checkers::rendered`],
+//!   [`checkers::noise_floor`]) and copied images ([`checkers::copies`]).
+//! - [`score`]: what the checkers found made checks, points and messages, the weekly function
+//!   checks' in [`score::weekly`].
 //! - [`batch`]: a folder of submissions in parallel, the gradebook, one shard's entry
 //!   ([`batch::entry`]), the merge of shards ([`batch::merge`]) and the pairs whose noise is
 //!   shared ([`batch::shared_noise`]).

@@ -19,7 +19,7 @@ pub struct Film {
     pub variance: Option<Vec<DVec3>>,
     /// Per pixel and channel, the largest distance of one of its samples from its mean; kept
     /// with the variance. A golden's measured bound on a sample (see
-    /// `compare::Golden`): a rare bright path the variance hardly shows still shows here.
+    /// `compare::noise_model::Golden`): a rare bright path the variance hardly shows still shows here.
     pub deviation: Option<Vec<DVec3>>,
 }
 

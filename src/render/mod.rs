@@ -9,7 +9,7 @@
 //! The fast paths are in `fast/`, each giving the same bytes as the reference (the tests compare
 //! them bit for bit): primary rays of a pinhole camera in packets, rays from one origin against
 //! prepared shapes (`fast/fixed_origin/`), and, on x86_64, four rays at once in AVX2
-//! (`fast/lanes.rs`, the one place the processor is chosen).
+//! (`fast/lanes.rs`; the processor is chosen in `fast/mod.rs`, the one place).
 
 mod film;
 mod sampler;

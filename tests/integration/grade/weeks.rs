@@ -8,8 +8,8 @@
 //! render is seeded (the rubric's seed 0) and every golden is committed, so each verdict is the
 //! same on every run. With the course's real code at hand (`RTORACLE_COURSE_CODE`), only
 //! week 8's replay runs: `course_grades` grades every week's real solution and skeleton. The
-//! function mistakes are graded by the same rubric in
-//! `weekly::week_is_judged_fairly`, from the same sessions that check them.
+//! catalogued function mistakes are caught and named on the course's real code in
+//! `course::code::mistakes_are_caught_and_named`.
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
