@@ -49,7 +49,8 @@ pub use format::{
     VARIANCE_MEANING, golden_file_name,
 };
 pub use source::{
-    GoldenInput, GoldenScene, at_spp, files_read, golden_fits, scene_sha256, sha256_hex,
+    GoldenInput, GoldenMisfit, GoldenScene, at_spp, files_read, golden_fits, scene_sha256,
+    sha256_hex,
 };
 
 use crate::image_io::{ExrImage, ImageError, decode_exr};
@@ -403,22 +404,35 @@ mod tests {
         assert!(d.fits(&on_disk, &path).is_ok());
         let other = tiny_scene(0.3);
         let e = other.fits(&on_disk, &path).unwrap_err();
-        assert!(e.contains("another scene"), "{e}");
+        assert!(matches!(e, GoldenMisfit::OtherScene { .. }), "{e}");
+        assert!(e.to_string().contains("another scene"), "{e}");
         let mut wider = d.clone();
         wider.description.image.width = 9;
-        assert!(wider.fits(&on_disk, &path).unwrap_err().contains("is 8x"));
+        let e = wider.fits(&on_disk, &path).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                GoldenMisfit::Size {
+                    found: (8, _),
+                    expected: (9, _)
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().starts_with("is 8x"), "{e}");
         let e = d
             .clone()
             .with_profile("physical")
             .fits(&on_disk, &path)
             .unwrap_err();
-        assert!(e.contains("course profile"), "{e}");
+        assert!(e.to_string().contains("course profile"), "{e}");
         let e = d
             .clone()
             .with_input("t.png", b"x")
             .fits(&on_disk, &path)
             .unwrap_err();
-        assert!(e.contains("other files"), "{e}");
+        assert!(matches!(e, GoldenMisfit::OtherInputs { .. }), "{e}");
+        assert!(e.to_string().contains("other files"), "{e}");
         // A scene file's golden holds the scene.
         let image = decode_exr(&on_disk, &path).unwrap();
         assert_eq!(

@@ -214,63 +214,125 @@ impl GoldenScene {
 
     /// Checks that EXR `bytes` (read from `source`) are a golden of this scene: an EXR with a
     /// `variance` layer, the scene's size, its hash in `rtoracle.sceneSha256`, the same profile
-    /// and the same other files (their hashes). The error is one line without the file name.
-    pub fn fits(&self, bytes: &[u8], source: &Path) -> Result<ExrImage, String> {
+    /// and the same other files (their hashes). The error says which, in one line without the
+    /// file name.
+    pub fn fits(&self, bytes: &[u8], source: &Path) -> Result<ExrImage, GoldenMisfit> {
         let image = decode_exr(bytes, source).map_err(|e| {
             let text = e.to_string();
             let prefix = format!("{}: ", source.display());
-            text.strip_prefix(&prefix).map(String::from).unwrap_or(text)
+            GoldenMisfit::Unreadable(text.strip_prefix(&prefix).map(String::from).unwrap_or(text))
         })?;
         self.fits_image(&image)?;
         Ok(image)
     }
 
     /// [`GoldenScene::fits`] of an image already decoded.
-    pub fn fits_image(&self, image: &ExrImage) -> Result<(), String> {
+    pub fn fits_image(&self, image: &ExrImage) -> Result<(), GoldenMisfit> {
         let camera = self.description.camera(None);
         if (image.width, image.height) != (camera.width, camera.height) {
-            return Err(format!(
-                "is {}x{} but the scene is {}x{}",
-                image.width, image.height, camera.width, camera.height
-            ));
+            return Err(GoldenMisfit::Size {
+                found: (image.width, image.height),
+                expected: (camera.width, camera.height),
+            });
         }
         let record = GoldenRecord::of(image);
         // The profile is part of the scene's text too: say it first, as the more telling reason.
         if record.profile != self.profile {
-            return Err(format!(
-                "was rendered in the {} profile ({ATTR_PROFILE}), not {}",
-                record.profile, self.profile
-            ));
+            return Err(GoldenMisfit::Profile {
+                found: record.profile,
+                expected: self.profile.clone(),
+            });
         }
         let want = self.scene_sha256();
         match &record.scene_sha256 {
             Some(h) if *h == want => {}
             Some(h) => {
-                return Err(format!(
-                    "was made from another scene ({ATTR_SCENE_SHA256} {h}, but the scene's is {want})"
-                ));
+                return Err(GoldenMisfit::OtherScene {
+                    found: h.clone(),
+                    expected: want,
+                });
             }
-            None => return Err(format!("has no {ATTR_SCENE_SHA256} attribute")),
+            None => return Err(GoldenMisfit::NoSceneHash),
         }
         if let Some(toml) = &record.scene_toml {
             if sha256_hex(toml.as_bytes()) != want {
-                return Err(format!(
-                    "holds a scene ({ATTR_SCENE_TOML}) whose hash is not its {ATTR_SCENE_SHA256}"
-                ));
+                return Err(GoldenMisfit::SceneTextMismatch);
             }
         }
         if record.inputs != self.inputs_text() {
-            return Err(format!(
-                "was made from other files than the scene reads ({ATTR_INPUTS} '{}', but the scene's are '{}')",
-                record.inputs.trim_end().replace('\n', "; "),
-                self.inputs_text().trim_end().replace('\n', "; ")
-            ));
+            return Err(GoldenMisfit::OtherInputs {
+                found: record.inputs.trim_end().replace('\n', "; "),
+                expected: self.inputs_text().trim_end().replace('\n', "; "),
+            });
         }
         if image.variance.is_none() {
-            return Err("has no 'variance' layer".to_string());
+            return Err(GoldenMisfit::NoVariance);
         }
         Ok(())
     }
+}
+
+/// Why an EXR is not the golden of a scene ([`GoldenScene::fits`]): each says what differs, in
+/// one line that goes after the file's name.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum GoldenMisfit {
+    /// It is not a readable EXR (the decoder's reason).
+    #[error("{0}")]
+    Unreadable(String),
+    /// Its size is not the scene's.
+    #[error("is {}x{} but the scene is {}x{}", .found.0, .found.1, .expected.0, .expected.1)]
+    Size {
+        /// The image's width and height.
+        found: (usize, usize),
+        /// The scene's.
+        expected: (usize, usize),
+    },
+    /// It was rendered in another profile.
+    #[error(
+        "was rendered in the {found} profile ({}), not {expected}",
+        ATTR_PROFILE
+    )]
+    Profile {
+        /// The image's profile.
+        found: String,
+        /// The scene's.
+        expected: String,
+    },
+    /// Its scene hash is another scene's.
+    #[error(
+        "was made from another scene ({} {found}, but the scene's is {expected})",
+        ATTR_SCENE_SHA256
+    )]
+    OtherScene {
+        /// The image's scene hash.
+        found: String,
+        /// The scene's.
+        expected: String,
+    },
+    /// It records no scene hash.
+    #[error("has no {} attribute", ATTR_SCENE_SHA256)]
+    NoSceneHash,
+    /// The scene text it holds does not hash to the scene hash it records.
+    #[error(
+        "holds a scene ({}) whose hash is not its {}",
+        ATTR_SCENE_TOML,
+        ATTR_SCENE_SHA256
+    )]
+    SceneTextMismatch,
+    /// It was made from other files than the scene reads.
+    #[error(
+        "was made from other files than the scene reads ({} '{found}', but the scene's are '{expected}')",
+        ATTR_INPUTS
+    )]
+    OtherInputs {
+        /// The image's files and hashes, one `; ` apart.
+        found: String,
+        /// The scene's.
+        expected: String,
+    },
+    /// It has no variance layer.
+    #[error("has no 'variance' layer")]
+    NoVariance,
 }
 
 /// Checks that EXR `bytes` (read from `source`) are a golden of `description`, a scene that reads
@@ -279,7 +341,7 @@ pub fn golden_fits(
     bytes: &[u8],
     source: &Path,
     description: &SceneDescription,
-) -> Result<ExrImage, String> {
+) -> Result<ExrImage, GoldenMisfit> {
     let scene = GoldenScene {
         name: String::new(),
         description: description.clone(),
