@@ -40,9 +40,7 @@ use glam::DVec3;
 use self::cone::Bound;
 pub(crate) use self::cone::Cone;
 use self::cone::{SANE_MAX, SANE_MIN};
-use self::quad::quad_hit_lanes;
-#[cfg(target_arch = "x86_64")]
-use self::quad::quads_hit_avx2;
+use self::quad::{quad_hit_lanes, quads_hit};
 use self::sphere::{PREFILTER_MARGIN, PreparedSphere};
 use self::triangle::PreparedTriangle;
 use super::packet::{Directions, Lanes, NO_HIT, WIDTH};
@@ -268,39 +266,15 @@ impl FixedOrigin {
                     }
                 }
             }
-            Layout::Quads(quads) => {
-                #[cfg(target_arch = "x86_64")]
-                if crate::scene::has_lanes() {
-                    // SAFETY: the processor has AVX2, just checked.
-                    unsafe {
-                        quads_hit_avx2(
-                            quads,
-                            candidates,
-                            self.origin,
-                            d,
-                            interval.min,
-                            &mut closest,
-                            &mut index,
-                        )
-                    };
-                    return index;
-                }
-                for (me, (quad, offset)) in quads.iter().enumerate() {
-                    if !is_candidate(candidates, me) {
-                        continue;
-                    }
-                    quad_hit_lanes(
-                        quad,
-                        *offset,
-                        self.origin,
-                        d,
-                        interval.min,
-                        &mut closest,
-                        &mut index,
-                        me as u64,
-                    );
-                }
-            }
+            Layout::Quads(quads) => quads_hit(
+                quads,
+                candidates,
+                self.origin,
+                d,
+                interval.min,
+                &mut closest,
+                &mut index,
+            ),
             Layout::Mixed(objects) => {
                 let (a, a_margin) = Self::squared_lengths(d);
                 for (me, object) in objects.iter().enumerate() {

@@ -389,7 +389,8 @@ fn both_quad_forms(
     min: f64,
     start: Lanes,
 ) -> [u64; WIDTH] {
-    use super::quad::{quad_hit_lanes, quads_hit_avx2};
+    use super::quad::avx2::quads_hit_avx2;
+    use super::quad::quad_hit_lanes;
     let (mut t, mut index) = (start, [NO_HIT; WIDTH]);
     for (me, (quad, offset)) in quads.iter().enumerate() {
         if is_candidate(candidates, me) {

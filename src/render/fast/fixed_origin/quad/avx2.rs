@@ -1,72 +1,14 @@
-//! A quad's hit for a packet of lanes: portable code the compiler vectorizes
-//! ([`quad_hit_lanes`]), and on x86-64 with AVX2 every quad of a packet in one vector per
-//! coordinate ([`quads_hit_avx2`]), to the same bits.
+//! Every quad of a packet in one AVX2 vector per coordinate ([`quads_hit_avx2`]), to the bits
+//! of the portable [`quad_hit_lanes`](super::quad_hit_lanes); x86-64 only (its parent declares
+//! it so, once).
+
+use std::arch::x86_64::*;
 
 use glam::DVec3;
 
 use crate::geometry::{PARALLEL_EPSILON, Quad};
 use crate::render::fast::packet::{Directions, Lanes, WIDTH};
-
-#[cfg(target_arch = "x86_64")]
 use crate::scene::{lanes_between, lanes_splat};
-#[cfg(target_arch = "x86_64")]
-use std::arch::x86_64::*;
-
-/// `Quad::solve_from` for each lane's direction from `origin`, against each lane's interval
-/// `[min, closest[k]]`: where it hits, `closest[k]` becomes its `t` and `index[k]` becomes `me`.
-/// The same operations in the same order as the scalar path, so the same bits.
-#[inline(always)]
-// Lane loops index several arrays in step.
-#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
-pub(super) fn quad_hit_lanes(
-    quad: &Quad,
-    offset: f64,
-    origin: DVec3,
-    d: &Directions,
-    min: f64,
-    closest: &mut Lanes,
-    index: &mut [u64; WIDTH],
-    me: u64,
-) {
-    let (n, q, u, v, w) = (quad.normal, quad.q, quad.u, quad.v, quad.w);
-    // The plane first: when no lane meets it within its interval (behind the eye, or beyond
-    // what a lane has already hit), the quad is skipped for the whole packet.
-    let mut denoms = [0.0; WIDTH];
-    let mut ts = [0.0; WIDTH];
-    let mut inside = [0u64; WIDTH];
-    for k in 0..WIDTH {
-        denoms[k] = n.x * d.x[k] + n.y * d.y[k] + n.z * d.z[k];
-        ts[k] = offset / denoms[k];
-        inside[k] = if (min <= ts[k]) & (ts[k] <= closest[k]) {
-            u64::MAX
-        } else {
-            0
-        };
-    }
-    if inside.iter().fold(0, |any, &i| any | i) == 0 {
-        return;
-    }
-    for k in 0..WIDTH {
-        let (denom, t) = (denoms[k], ts[k]);
-        // `ray.at(t) - q`.
-        let px = (origin.x + d.x[k] * t) - q.x;
-        let py = (origin.y + d.y[k] * t) - q.y;
-        let pz = (origin.z + d.z[k] * t) - q.z;
-        // `w . (planar x v)` and `w . (u x planar)`.
-        let alpha =
-            w.x * (py * v.z - v.y * pz) + w.y * (pz * v.x - v.z * px) + w.z * (px * v.y - v.x * py);
-        let beta =
-            w.x * (u.y * pz - py * u.z) + w.y * (u.z * px - pz * u.x) + w.z * (u.x * py - px * u.y);
-        let hit = (denom.abs() >= PARALLEL_EPSILON)
-            & t.is_finite()
-            & (min <= t)
-            & (t <= closest[k])
-            & (0.0..=1.0).contains(&alpha)
-            & (0.0..=1.0).contains(&beta);
-        closest[k] = if hit { t } else { closest[k] };
-        index[k] = if hit { me } else { index[k] };
-    }
-}
 
 /// [`quad_hit_lanes`] for every quad of `quads` that `candidates` holds (bit `me`, every quad
 /// from the 64th), in order, in AVX2 vectors: the same operations in the same order lane by
@@ -80,9 +22,8 @@ pub(super) fn quad_hit_lanes(
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn quads_hit_avx2(
+pub(in crate::render::fast::fixed_origin) unsafe fn quads_hit_avx2(
     quads: &[(Quad, f64)],
     candidates: u64,
     origin: DVec3,
@@ -165,7 +106,6 @@ pub(super) unsafe fn quads_hit_avx2(
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn halves(x: &Lanes) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract); each load reads two of the four.
@@ -179,7 +119,6 @@ unsafe fn halves(x: &Lanes) -> __m256d {
 /// # Safety
 ///
 /// The processor must have AVX2.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn dot_cross(w: DVec3, a: [__m256d; 3], b: [__m256d; 3]) -> __m256d {
     // SAFETY: AVX2 is there (this function's contract).
