@@ -219,9 +219,17 @@ pub fn insert_first_in_def(
 /// `examples/adapter-c/adapter.c` built with `cc` (or `$CC`, and `extra` flags) in `dir`, or
 /// `None` after saying the test is skipped.
 pub fn build_c_adapter(dir: &Path, name: &str, extra: &[&str]) -> Option<PathBuf> {
+    build_c_example(dir, "adapter.c", name, extra)
+}
+
+/// `examples/adapter-c/SOURCE` built with `cc` (or `$CC`; `-O2 -Wall -Werror` and `extra`)
+/// into `dir/name`, or `None` after saying the test is skipped.
+pub fn build_c_example(dir: &Path, source: &str, name: &str, extra: &[&str]) -> Option<PathBuf> {
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let exe = dir.join(name);
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/adapter.c");
+    let source = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/adapter-c")
+        .join(source);
     let built = Command::new(&cc)
         .args(["-O2", "-Wall", "-Werror"])
         .args(extra)

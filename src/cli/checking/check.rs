@@ -314,9 +314,6 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
             format!("{judging}{}", args.target.profile_hint(&args.judging)),
         ),
     };
-    if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
-        anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
-    }
     let (cases, judged_by) = if args.score_ambiguous {
         let scored = rtoracle::candidate::judging::check::score_ambiguous(cases);
         (

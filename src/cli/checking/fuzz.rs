@@ -69,9 +69,6 @@ fn time_limit(secs: Option<f64>) -> anyhow::Result<Option<Duration>> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    if args.timeout_ms == 0 || args.hello_timeout_ms == 0 {
-        anyhow::bail!("--timeout-ms and --hello-timeout-ms must be positive");
-    }
     if args.cases == Some(0) {
         anyhow::bail!("--cases 0: at least one case is needed");
     }

@@ -916,20 +916,10 @@ fn blame_lands_on_the_right_case_even_when_the_adapter_batches_its_answers() {
 
 #[test]
 fn the_c_example_adapter_passes_the_sphere_vectors() {
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let tmp = tempfile::tempdir().unwrap();
-    let exe = tmp.path().join("sphere_adapter");
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adapter-c/sphere_adapter.c");
-    let built = std::process::Command::new(&cc)
-        .args(["-O2", "-o"])
-        .arg(&exe)
-        .arg(&source)
-        .arg("-lm")
-        .status();
-    if !built.map(|s| s.success()).unwrap_or(false) {
-        eprintln!("skipped: no working C compiler ({cc})");
+    let Some(_) = build_c_example(tmp.path(), "sphere_adapter.c", "sphere_adapter", &[]) else {
         return;
-    }
+    };
     let vectors = write_vectors(tmp.path(), &cases()[..600]);
     let out = run_in(
         tmp.path(),
