@@ -35,6 +35,7 @@ pub(super) fn lanes_row<const VARIANCE: bool, const JITTER: u8>(
         unsafe { lanes::row::<VARIANCE, JITTER>(job, set, j, means, variances) };
         return true;
     }
+    // Where there are no lanes to ask (another processor), the arguments go unused.
     let _ = (job, j, means, variances);
     false
 }
